@@ -1,0 +1,19 @@
+"""deforma: deformable 2D objects.
+
+A shape (a box or an image) becomes a Delaunay triangle mesh, the mesh becomes a
+mass-spring soft body, and the body moves under gravity among rotated-rectangle
+colliders with friction.
+
+Examples
+--------
+>>> import numpy as np, deforma
+>>> tris = deforma.delaunay(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float))
+>>> tris.shape
+(2, 3)
+"""
+
+from . import mesh
+from .mesh.delaunay import delaunay
+
+__all__ = ["delaunay", "mesh"]
+__version__ = "0.1.0"

@@ -1,0 +1,6 @@
+"""Geometry only: Delaunay triangulation and the meshes built on it (no physics)."""
+
+from .delaunay import delaunay
+from .mesh import Mesh
+
+__all__ = ["Mesh", "delaunay"]
