@@ -1,0 +1,54 @@
+"""Shared helpers for the benchmark modules: median timing and one table format.
+
+Every ``benchmarks/bench_*.py`` module exposes ``run(quick: bool) -> list[Row]``;
+``python benchmarks/run.py`` calls them all and prints one table. Peers are always
+measured in the same run as deforma, so ratios compare like with like on a noisy machine.
+"""
+
+from __future__ import annotations
+
+import gc
+import statistics
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+
+@dataclass
+class Row:
+    """One line of the benchmark table.
+
+    ``value`` is the measured figure (median) in ``unit``; ``goal`` says in words what the
+    issue asks and ``met`` whether this run met it (None when the row is informational).
+    """
+
+    topic: str
+    case: str
+    value: float
+    unit: str
+    ratio: str = ""
+    goal: str = ""
+    met: bool | None = None
+
+
+def median_seconds(fn: Callable[[], object], *, repeat: int = 5, warmup: int = 1) -> float:
+    """Median wall time of ``fn()`` in seconds over ``repeat`` runs after ``warmup`` runs."""
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(repeat):
+        gc.collect()
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def format_table(rows: list[Row]) -> str:
+    """Render rows as a GitHub-flavoured Markdown table."""
+    head = "| topic | case | median | ratio | goal | met |\n| --- | --- | ---: | --- | --- | --- |"
+    lines = [head]
+    for r in rows:
+        met = "" if r.met is None else ("yes" if r.met else "**no**")
+        lines.append(f"| {r.topic} | {r.case} | {r.value:.4g} {r.unit} | {r.ratio} | {r.goal} | {met} |")
+    return "\n".join(lines)
