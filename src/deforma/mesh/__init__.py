@@ -1,6 +1,7 @@
 """Geometry only: Delaunay triangulation and the meshes built on it (no physics)."""
 
+from .box import box
 from .delaunay import delaunay
 from .mesh import Mesh
 
-__all__ = ["Mesh", "delaunay"]
+__all__ = ["Mesh", "box", "delaunay"]

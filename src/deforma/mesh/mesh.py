@@ -1,4 +1,4 @@
-"""The Mesh type: vertices, triangles and what follows from them."""
+"""The Mesh type: vertices, triangles and what follows from them (edges, boundary, quality)."""
 
 from __future__ import annotations
 
@@ -6,30 +6,57 @@ from functools import cached_property
 
 import numpy as np
 
+from . import quality
+
 
 class Mesh:
-    """A 2D triangle mesh.
+    """A 2D triangle mesh: the geometry a soft body is built from.
+
+    Any arrays can be turned into a Mesh; they are checked here, once, so that everything
+    downstream (springs, masses, the renderer) can trust them.
 
     Parameters
     ----------
     vertices : (N, 2) array_like of float
-        Vertex positions in metres.
+        Vertex positions in metres, y up. Finite, N >= 3.
     triangles : (M, 3) array_like of int
-        Vertex indices per triangle, counter-clockwise.
+        Vertex indices per triangle, M >= 1. Clockwise triangles are reversed so that every
+        stored triangle is counter-clockwise. A triangle whose corners are collinear or
+        coincide (see :func:`deforma.mesh.quality.degenerate_triangles`), a triangle listed
+        twice, and an edge shared by more than two triangles are rejected.
     uv : (N, 2) array_like of float, optional
-        Texture coordinates in [0, 1]. By default the vertices' positions normalised to
+        Texture coordinates in [0, 1], ``u`` to the right and ``v`` up (v = 0 is the bottom
+        row of the picture, as in OpenGL). By default the vertices' positions normalised to
         their bounding box.
+    texture : (H, W, 4) array_like of uint8, optional, keyword-only
+        The RGBA picture ``uv`` refers to, row 0 at the top (as Pillow stores it). Meshes
+        made by :func:`deforma.mesh.from_image` carry their image here; ``None`` lets the
+        renderer choose.
+
+    Attributes
+    ----------
+    vertices : (N, 2) ndarray of float64
+    triangles : (M, 3) ndarray of int32, counter-clockwise
+    uv : (N, 2) ndarray of float64
+    texture : (H, W, 4) ndarray of uint8 or None
+
+    Notes
+    -----
+    Vertices that no triangle uses are allowed (they carry mass but no spring); the mesh
+    builders in this package never produce them.
 
     Examples
     --------
     >>> import deforma
-    >>> m = deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]])
-    >>> m.edges.shape
-    (3, 2)
+    >>> m = deforma.mesh.Mesh([[0, 0], [1, 0], [1, 1], [0, 1]], [[0, 1, 2], [0, 2, 3]])
+    >>> m.edges.shape, m.area, len(m.boundary)
+    ((5, 2), 1.0, 1)
+    >>> round(m.min_angle, 6), m.euler_characteristic
+    (45.0, 1)
     """
 
-    def __init__(self, vertices, triangles, uv=None):
-        v = np.ascontiguousarray(vertices, dtype=np.float64)
+    def __init__(self, vertices, triangles, uv=None, *, texture=None):
+        v = np.array(vertices, dtype=np.float64, copy=True)
         if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3:
             raise ValueError(f"vertices must be an (N, 2) array with N >= 3, got shape {v.shape}")
         if not np.all(np.isfinite(v)):
@@ -40,35 +67,145 @@ class Mesh:
         if not np.issubdtype(t.dtype, np.integer):
             raise ValueError(f"triangles must hold integers, got dtype {t.dtype}")
         if t.min() < 0 or t.max() >= len(v):
-            raise ValueError(f"triangle indices must lie in [0, {len(v) - 1}]")
+            raise ValueError(f"triangle indices must lie in [0, {len(v) - 1}], got [{t.min()}, {t.max()}]")
+        t = np.array(t, dtype=np.int32, copy=True)
+
+        bad = quality.degenerate_triangles(v, t)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"triangle {k} {t[k].tolist()} is degenerate (collinear or repeated corners); "
+                f"{int(bad.sum())} such triangles, only triangles with positive area are allowed"
+            )
+        cw = quality.triangle_signed_areas(v, t) < 0
+        t[cw] = t[cw][:, [0, 2, 1]]
+
+        keys = np.sort(t, axis=1)
+        if len(np.unique(keys, axis=0)) != len(t):
+            raise ValueError("triangles contain the same triangle twice; each triangle may appear once")
+        _, counts = np.unique(_undirected(t), axis=0, return_counts=True)
+        if counts.max() > 2:
+            raise ValueError(
+                f"an edge is shared by {counts.max()} triangles; a mesh edge may border at most 2"
+            )
         self.vertices = v
-        self.triangles = np.ascontiguousarray(t, dtype=np.int32)
+        self.triangles = t
+
         if uv is None:
             lo, hi = v.min(axis=0), v.max(axis=0)
             uv = (v - lo) / np.where(hi > lo, hi - lo, 1.0)
-        uv = np.ascontiguousarray(uv, dtype=np.float64)
+        uv = np.array(uv, dtype=np.float64, copy=True)
         if uv.shape != v.shape:
             raise ValueError(f"uv must have the vertices' shape {v.shape}, got {uv.shape}")
+        if not np.all(np.isfinite(uv)) or uv.min() < 0.0 or uv.max() > 1.0:
+            raise ValueError("uv must be finite texture coordinates in [0, 1]")
         self.uv = uv
+
+        if texture is not None:
+            texture = np.ascontiguousarray(texture)
+            if texture.ndim != 3 or texture.shape[2] != 4 or texture.dtype != np.uint8:
+                raise ValueError(
+                    f"texture must be an (H, W, 4) uint8 RGBA array, got shape {texture.shape} "
+                    f"and dtype {texture.dtype}"
+                )
+        self.texture = texture
+
+    # ---- topology -------------------------------------------------------------------------
 
     @cached_property
     def edges(self) -> np.ndarray:
         """(E, 2) int32: each undirected edge once, as (low, high) index pairs, sorted."""
+        return np.unique(_undirected(self.triangles), axis=0).astype(np.int32)
+
+    @cached_property
+    def boundary_edges(self) -> np.ndarray:
+        """(B, 2) int32: edges used by one triangle only, directed as in that triangle.
+
+        With counter-clockwise triangles the outside is on the right of each edge: outer
+        outlines run counter-clockwise and holes clockwise.
+        """
         t = self.triangles
-        e = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
-        e.sort(axis=1)
-        return np.unique(e, axis=0).astype(np.int32)
+        directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+        keys = np.sort(directed, axis=1)
+        _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+        return np.ascontiguousarray(directed[counts[inverse.ravel()] == 1], dtype=np.int32)
+
+    @cached_property
+    def boundary(self) -> list[np.ndarray]:
+        """Boundary loops: a list of int32 arrays of vertex indices, each a closed loop.
+
+        Outer outlines run counter-clockwise, holes clockwise; loops are sorted by the area
+        they enclose, largest first, so ``boundary[0]`` is the outline of the largest part.
+        A donut has two loops, a box one.
+        """
+        following: dict[int, list[int]] = {}
+        for a, b in self.boundary_edges.tolist():
+            following.setdefault(a, []).append(b)
+        loops = []
+        for start in list(following):
+            while following.get(start):
+                loop = [start]
+                here = following[start].pop()
+                while here != start:
+                    loop.append(here)
+                    nxt = following.get(here)
+                    if not nxt:  # cannot happen on a valid mesh: every boundary vertex has an exit
+                        break
+                    here = nxt.pop()
+                loops.append(np.array(loop, dtype=np.int32))
+        v = self.vertices
+
+        def enclosed(loop):
+            x, y = v[loop, 0], v[loop, 1]
+            return abs(0.5 * (np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+
+        return sorted(loops, key=enclosed, reverse=True)
+
+    @property
+    def euler_characteristic(self) -> int:
+        """V - E + F: 1 for a disc, 0 for an annulus (one hole), 1 - h for h holes."""
+        return len(self.vertices) - len(self.edges) + len(self.triangles)
+
+    # ---- measures -------------------------------------------------------------------------
 
     @property
     def triangle_areas(self) -> np.ndarray:
         """(M,) float64: signed triangle areas in square metres (positive when counter-clockwise)."""
-        a, b, c = (self.vertices[self.triangles[:, k]] for k in range(3))
-        return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+        return quality.triangle_signed_areas(self.vertices, self.triangles)
 
     @property
     def area(self) -> float:
         """Total area in square metres."""
         return float(self.triangle_areas.sum())
 
+    @property
+    def triangle_min_angles(self) -> np.ndarray:
+        """(M,) float64: smallest interior angle of each triangle, in degrees (60 at best)."""
+        return quality.triangle_min_angles(self.vertices, self.triangles)
+
+    @property
+    def min_angle(self) -> float:
+        """Smallest interior angle over all triangles, in degrees."""
+        return float(self.triangle_min_angles.min())
+
+    @property
+    def aspect_ratios(self) -> np.ndarray:
+        """(M,) float64: radius ratio R / (2 r) of each triangle, 1 when equilateral."""
+        return quality.triangle_aspect_ratios(self.vertices, self.triangles)
+
+    @property
+    def max_aspect_ratio(self) -> float:
+        """Worst (largest) radius ratio over all triangles; dimensionless, >= 1."""
+        return float(self.aspect_ratios.max())
+
     def __repr__(self) -> str:
-        return f"Mesh({len(self.vertices)} vertices, {len(self.triangles)} triangles)"
+        return (
+            f"Mesh({len(self.vertices)} vertices, {len(self.triangles)} triangles, "
+            f"area {self.area:.4g} m^2, min angle {self.min_angle:.1f} deg)"
+        )
+
+
+def _undirected(t: np.ndarray) -> np.ndarray:
+    e = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    e.sort(axis=1)
+    return e

@@ -1,0 +1,148 @@
+"""Box meshes: a convex quadrilateral filled with an even (bilinear) grid of points."""
+
+from __future__ import annotations
+
+import operator
+
+import numpy as np
+
+from .delaunay import delaunay
+from .mesh import Mesh
+
+#: Largest ``detail`` accepted: (detail + 2)**2 points, about a million, is as far as a
+#: mass-spring body is still useful and stays well inside memory.
+MAX_DETAIL = 1000
+
+
+def box(corners, *, detail=8, edges=False) -> Mesh:
+    """A quadrilateral ("box") mesh filled evenly with points, as in the original's Square.
+
+    Parameters
+    ----------
+    corners : (4, 2) array_like of float
+        The corners in metres, in order around the outline (counter-clockwise or clockwise),
+        forming a convex quadrilateral: a rectangle, a parallelogram, a kite, any convex quad.
+        A crossed (self-intersecting), concave or degenerate quad (coinciding corners, three
+        corners on a line) raises ``ValueError``.
+    detail : int, keyword-only
+        ``n``: ``n * n`` interior points at the bilinear positions ``(i/(n+1), j/(n+1))``,
+        ``i, j = 1..n``, between the corners. 0 gives the bare quad (two triangles).
+        Allowed range ``[0, MAX_DETAIL]``.
+    edges : bool, keyword-only
+        Also put ``n`` points on each of the four sides at the same parameters, so the points
+        form a full ``(n+2) x (n+2)`` grid and the triangles along the sides are as good as
+        those inside. Without it the sides are single long edges and the outermost triangles
+        are thin (minimum angle about ``atan(1/(n+1))``), as in the original.
+
+    Returns
+    -------
+    Mesh
+        ``n*n + 4`` vertices (``+ 4n`` with ``edges``): the four corners first, in the given
+        order, then the interior points row by row, then the side points. ``uv`` is the
+        bilinear parameter: ``u`` runs from ``corners[0]`` to ``corners[1]``, ``v`` from
+        ``corners[0]`` to ``corners[3]``. Its area equals the quad's area (up to rounding).
+
+    Notes
+    -----
+    Side points are computed as ``a + s (b - a)`` so that points on an axis-aligned side
+    share its coordinate exactly; where rounding still moves one off the line, Delaunay
+    makes a near-zero-area triangle of three points on one side. Those triangles are
+    dropped (they lie outside the quad or have no area), so no triangle is degenerate.
+
+    Examples
+    --------
+    >>> import deforma
+    >>> m = deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=8, edges=True)
+    >>> len(m.vertices), round(m.area, 12), len(m.boundary)
+    (100, 2.0, 1)
+    """
+    c = _check_corners(corners)
+    n = _check_detail(detail)
+    if not isinstance(edges, (bool, np.bool_)):
+        raise ValueError(f"edges must be True or False, got {edges!r}")
+
+    a, b, cc, d = c
+    s = np.arange(1, n + 1, dtype=np.float64) / (n + 1)
+    # interior: the bilinear map of the unit square, (s, t) -> a + s(b-a) + t(d-a) + st(a-b+c-d)
+    ss, tt = np.meshgrid(s, s)
+    ss, tt = ss.ravel(), tt.ravel()
+    twist = a - b + cc - d
+    interior = a + ss[:, None] * (b - a) + tt[:, None] * (d - a) + (ss * tt)[:, None] * twist
+    points = [c, interior]
+    uv = [np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), np.stack([ss, tt], axis=1)]
+    side_of = [np.full(4, -1), np.full(n * n, -1)]
+    if edges and n > 0:
+        z, o = np.zeros(n), np.ones(n)
+        for k, (p, q, uvs) in enumerate(
+            ((a, b, (s, z)), (b, cc, (o, s)), (d, cc, (s, o)), (a, d, (z, s)))
+        ):
+            points.append(p + s[:, None] * (q - p))
+            uv.append(np.stack(uvs, axis=1))
+            side_of.append(np.full(n, k))
+    points = np.concatenate(points)
+    uv = np.concatenate(uv)
+    side_of = np.concatenate(side_of)
+
+    tris = delaunay(points)
+    if edges and n > 0:
+        # A triangle with all three corners on one side (corners count on both of theirs)
+        # is a rounding sliver along the hull: drop it.
+        on_side = np.zeros((len(points), 4), dtype=bool)
+        on_side[side_of >= 0, side_of[side_of >= 0]] = True
+        for k, (i, j) in enumerate(((0, 1), (1, 2), (3, 2), (0, 3))):
+            on_side[[i, j], k] = True
+        flat = np.zeros(len(tris), dtype=bool)
+        for k in range(4):
+            flat |= on_side[tris, k].all(axis=1)
+        tris = tris[~flat]
+    return Mesh(points, tris, uv)
+
+
+def _check_corners(corners) -> np.ndarray:
+    try:
+        c = np.array(corners, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"corners must be four (x, y) pairs of numbers, got {corners!r}") from None
+    if c.shape != (4, 2):
+        raise ValueError(f"corners must be four (x, y) pairs, shape (4, 2), got shape {c.shape}")
+    if not np.all(np.isfinite(c)):
+        raise ValueError("corners must be finite numbers (no NaN or inf)")
+    size = float(np.ptp(c, axis=0).max())
+    if size == 0.0:
+        raise ValueError("corners are all the same point; they must span a convex quadrilateral")
+    e = np.roll(c, -1, axis=0) - c
+    lengths = np.hypot(e[:, 0], e[:, 1])
+    if lengths.min() <= 1e-12 * size:
+        raise ValueError("two neighbouring corners coincide; the four corners must be distinct")
+    # cross product at each corner, relative to the two sides' lengths: sin of the turn
+    turn = (e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0])
+    sin_turn = turn / (lengths * np.roll(lengths, -1))
+    if np.abs(sin_turn).min() < 1e-9:
+        raise ValueError(
+            "three corners lie on a line (degenerate quad); corners must form a convex "
+            "quadrilateral with no straight angle"
+        )
+    positive = int((sin_turn > 0).sum())
+    if positive == 2:
+        raise ValueError(
+            "corners form a self-intersecting (crossed) quad; give them in order around the "
+            "outline, counter-clockwise or clockwise"
+        )
+    if positive in (1, 3):
+        raise ValueError(
+            "corners form a concave quad; only a convex quadrilateral is allowed (every "
+            "corner turning the same way)"
+        )
+    return c
+
+
+def _check_detail(detail) -> int:
+    if isinstance(detail, (bool, np.bool_)):
+        raise ValueError(f"detail must be an integer in [0, {MAX_DETAIL}], got {detail!r}")
+    try:
+        n = operator.index(detail)
+    except TypeError:
+        raise ValueError(f"detail must be an integer in [0, {MAX_DETAIL}], got {detail!r}") from None
+    if not 0 <= n <= MAX_DETAIL:
+        raise ValueError(f"detail must be an integer in [0, {MAX_DETAIL}], got {n}")
+    return n
