@@ -1,0 +1,331 @@
+"""Write rendered frames to MP4 (imageio-ffmpeg), GIF or a folder of PNGs (Pillow).
+
+Every writer puts its bytes in a temporary file beside the target and renames it into
+place only when the last frame is written, so an interrupted run (Ctrl-C, a crash, an
+unstable simulation) never leaves a broken video: either the old file or a complete one.
+PNG folders get the same guarantee per file.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["FrameWriter", "GifWriter", "Mp4Writer", "PngFolderWriter", "check_output", "open_writer",
+           "output_kind"]
+
+VIDEO_SUFFIXES = {".mp4": "mp4", ".gif": "gif"}
+
+
+def output_kind(path) -> str:
+    """'mp4', 'gif' or 'png' (a folder of frames) from the output path.
+
+    A path ending in ``/`` is a folder; otherwise ``.mp4`` and ``.gif`` name videos, and an
+    existing folder or a name without a suffix is a folder.
+
+    Raises
+    ------
+    ValueError
+        For any other suffix, naming the ones allowed.
+    """
+    s = str(path)
+    p = Path(s)
+    if s.endswith(("/", os.sep)):
+        return "png"
+    kind = VIDEO_SUFFIXES.get(p.suffix.lower())
+    if kind is None and (p.is_dir() or p.suffix == ""):
+        return "png"
+    if kind is None:
+        raise ValueError(f"{s}: unknown output type {p.suffix!r}; allowed: .mp4, .gif, or a folder for PNG frames")
+    return kind
+
+
+def check_output(path) -> str:
+    """Check, before any work, that ``path`` can be written; returns its kind (see :func:`output_kind`).
+
+    The parent folder must exist and be writable; a PNG folder may not exist yet (its
+    parent must) and is created by the writer.
+
+    Raises
+    ------
+    ValueError
+        If the type is unknown, the folder is missing or not writable, or the path is a folder
+        where a file is wanted.
+    """
+    kind = output_kind(path)
+    p = Path(str(path).rstrip("/" + os.sep) or ".")
+    if kind == "png":
+        if p.exists():
+            if not p.is_dir():
+                raise ValueError(f"{path}: exists and is not a folder; PNG frames need a folder")
+            folder = p
+        else:
+            folder = p.parent
+            if not folder.is_dir():
+                raise ValueError(f"{path}: the folder {str(folder)!r} does not exist")
+    else:
+        if p.is_dir():
+            raise ValueError(f"{path}: is a folder; give a file name ending in .{kind}")
+        folder = p.parent
+        if not folder.is_dir():
+            raise ValueError(f"{path}: the folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f"{path}: the folder {str(folder)!r} is not writable")
+    return kind
+
+
+def _temp_beside(target: Path) -> Path:
+    """A fresh hidden file next to ``target`` with the same suffix (ffmpeg picks formats by it)."""
+    fd, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=f".partial{target.suffix}", dir=target.parent)
+    os.close(fd)
+    return Path(name)
+
+
+class FrameWriter:
+    """Base class: a context manager that takes (H, W, 3) uint8 frames of one size.
+
+    Use :func:`open_writer` to get the right writer for a path. Leaving the ``with`` block
+    normally commits the output; leaving it through an exception (KeyboardInterrupt too)
+    discards it.
+    """
+
+    def __init__(self, path, *, fps: float):
+        if not (isinstance(fps, (int, float)) and np.isfinite(fps) and 0 < fps <= 1000):
+            raise ValueError(f"fps must be a number in (0, 1000], got {fps!r}")
+        self.path = Path(str(path).rstrip("/" + os.sep) or ".")
+        self.fps = float(fps)
+        self.frames_written = 0
+        self.size: tuple[int, int] | None = None
+        self._closed = False
+
+    def _check(self, frame) -> np.ndarray:
+        f = np.asarray(frame)
+        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] not in (3, 4):
+            raise ValueError(f"a frame must be an (H, W, 3) uint8 array, got {f.dtype} {f.shape}")
+        f = f[:, :, :3]
+        size = (f.shape[1], f.shape[0])
+        if self.size is None:
+            self.size = size
+        elif size != self.size:
+            raise ValueError(f"every frame must have the first frame's size {self.size}, got {size}")
+        return f
+
+    def write(self, frame) -> None:
+        """Append one frame."""
+        if self._closed:
+            raise ValueError(f"{self.path}: writer is closed")
+        self._write(self._check(frame))
+        self.frames_written += 1
+
+    def close(self) -> None:
+        """Finish the file and move it into place."""
+        if not self._closed:
+            self._closed = True
+            self._commit()
+
+    def abort(self) -> None:
+        """Throw away everything written so far; the target is left as it was."""
+        if not self._closed:
+            self._closed = True
+            self._discard()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+        return False
+
+    def _write(self, frame):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _commit(self):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _discard(self):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+class Mp4Writer(FrameWriter):
+    """H.264 MP4 (yuv420p, plays everywhere) through the ffmpeg binary bundled with imageio-ffmpeg.
+
+    Odd widths or heights are padded by one pixel, as yuv420p needs even sizes.
+    """
+
+    def __init__(self, path, *, fps: float, quality: float = 7.0):
+        super().__init__(path, fps=fps)
+        try:
+            import imageio_ffmpeg  # noqa: F401
+        except ImportError:
+            raise RuntimeError("MP4 output needs imageio-ffmpeg: pip install 'deforma[render]'") from None
+        self.quality = quality
+        self._tmp = _temp_beside(self.path)
+        self._gen = None
+
+    def _write(self, frame):
+        import imageio_ffmpeg
+
+        h, w = frame.shape[:2]
+        if self._gen is None:
+            self._padded = (w + w % 2, h + h % 2)
+            self._gen = imageio_ffmpeg.write_frames(
+                str(self._tmp), self._padded, fps=self.fps, codec="libx264", pix_fmt_in="rgb24",
+                pix_fmt_out="yuv420p", quality=self.quality, macro_block_size=1, ffmpeg_log_level="error",
+                output_params=["-movflags", "+faststart"],
+            )
+            self._gen.send(None)
+        if (w, h) != self._padded:
+            frame = np.pad(frame, ((0, self._padded[1] - h), (0, self._padded[0] - w), (0, 0)), mode="edge")
+        self._gen.send(np.ascontiguousarray(frame))
+
+    def _commit(self):
+        if self._gen is None:
+            self._tmp.unlink(missing_ok=True)
+            raise ValueError(f"{self.path}: no frames were written")
+        try:
+            self._gen.close()
+        except BaseException:
+            self._tmp.unlink(missing_ok=True)
+            raise
+        os.replace(self._tmp, self.path)
+
+    def _discard(self):
+        if self._gen is not None:
+            try:
+                self._gen.close()
+            except BaseException:  # noqa: BLE001 - ffmpeg may already be gone after Ctrl-C
+                pass
+        self._tmp.unlink(missing_ok=True)
+
+
+class GifWriter(FrameWriter):
+    """Animated GIF with one shared 256-colour palette, looping forever.
+
+    The palette is chosen from the first second of frames (kept in memory until then), so
+    colours do not flicker between frames. GIF times are in hundredths of a second: frame
+    durations alternate (e.g. 30 and 40 ms at 30 fps) so the average rate is exact.
+    Identical consecutive frames are stored once with their durations added (Pillow does
+    this), so a still ending costs nothing.
+    """
+
+    def __init__(self, path, *, fps: float):
+        super().__init__(path, fps=fps)
+        self._pending: list[np.ndarray] = []
+        self._frames = []
+        self._palette = None
+        self._palette_after = max(1, int(round(self.fps)))
+
+    def _quantize(self, frame):
+        from PIL import Image
+
+        return Image.fromarray(frame).quantize(palette=self._palette, dither=Image.Dither.NONE)
+
+    def _build_palette(self):
+        from PIL import Image
+
+        picks = self._pending[:: max(1, len(self._pending) // 4)]
+        mosaic = Image.fromarray(np.concatenate(picks, axis=0))
+        self._palette = mosaic.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+        self._frames.extend(self._quantize(f) for f in self._pending)
+        self._pending.clear()
+
+    def _write(self, frame):
+        if self._palette is None:
+            self._pending.append(frame.copy())
+            if len(self._pending) >= self._palette_after:
+                self._build_palette()
+        else:
+            self._frames.append(self._quantize(frame))
+
+    def durations_ms(self, n: int) -> list[int]:
+        """Per-frame durations in ms, multiples of 10, summing to n / fps seconds (rounded)."""
+        cs = np.round(np.arange(n + 1) * 100.0 / self.fps).astype(int)
+        return [int(max(d, 1)) * 10 for d in np.diff(cs)]
+
+    def _commit(self):
+        if self._palette is None and self._pending:
+            self._build_palette()
+        if not self._frames:
+            raise ValueError(f"{self.path}: no frames were written")
+        tmp = _temp_beside(self.path)
+        try:
+            first, rest = self._frames[0], self._frames[1:]
+            first.save(tmp, format="GIF", save_all=True, append_images=rest, loop=0,
+                       duration=self.durations_ms(len(self._frames)), disposal=1, optimize=False)
+            os.replace(tmp, self.path)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+        finally:
+            self._frames = []
+
+    def _discard(self):
+        self._frames = []
+        self._pending = []
+
+
+class PngFolderWriter(FrameWriter):
+    """Numbered PNG frames ``frame_00000.png, ...`` in a folder (created if missing).
+
+    Each file is written under a temporary name and renamed, so every ``frame_*.png`` present
+    is complete. Frames from an earlier, longer run are not deleted.
+    """
+
+    def __init__(self, path, *, fps: float, compress_level: int = 3):
+        super().__init__(path, fps=fps)
+        self.compress_level = compress_level
+
+    def frame_path(self, i: int) -> Path:
+        return self.path / f"frame_{i:05d}.png"
+
+    def _write(self, frame):
+        from PIL import Image
+
+        if self.frames_written == 0:
+            self.path.mkdir(exist_ok=True)
+        target = self.frame_path(self.frames_written)
+        tmp = _temp_beside(target)
+        try:
+            Image.fromarray(frame).save(tmp, format="PNG", compress_level=self.compress_level)
+            os.replace(tmp, target)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+
+    def _commit(self):
+        if self.frames_written == 0:
+            raise ValueError(f"{self.path}: no frames were written")
+
+    def _discard(self):
+        pass
+
+
+def open_writer(path, *, fps: float) -> FrameWriter:
+    """The writer for ``path``: ``.mp4``, ``.gif``, or a folder (``frames/``) of PNGs.
+
+    Parameters
+    ----------
+    path : str or Path
+        Output file or folder. Its folder must exist (see :func:`check_output`).
+    fps : float
+        Frames per second of the video.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> with open_writer(os.path.join(d, "ramp.gif"), fps=10) as w:
+    ...     for k in range(5):
+    ...         w.write(np.full((8, 8, 3), 50 * k, np.uint8))
+    >>> from PIL import Image
+    >>> Image.open(os.path.join(d, "ramp.gif")).n_frames
+    5
+    """
+    kind = check_output(path)
+    return {"mp4": Mp4Writer, "gif": GifWriter, "png": PngFolderWriter}[kind](path, fps=fps)

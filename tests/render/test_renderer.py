@@ -1,0 +1,183 @@
+"""Headless rendering with EGL: pixels land where the geometry is."""
+
+import numpy as np
+import pytest
+
+from deforma.render import Camera, Renderer, collider_corners
+
+RED = [255, 0, 0]
+
+
+def square_mesh(x0, y0, x1, y1, n=4):
+    xs, ys = np.meshgrid(np.linspace(x0, x1, n), np.linspace(y0, y1, n))
+    pts = np.c_[xs.ravel(), ys.ravel()]
+    i = np.arange(n * n).reshape(n, n)
+    a, b, c, d = i[:-1, :-1].ravel(), i[:-1, 1:].ravel(), i[1:, 1:].ravel(), i[1:, :-1].ravel()
+    tris = np.r_[np.c_[a, b, c], np.c_[a, c, d]].astype(np.int32)
+    uv = (pts - (x0, y0)) / (x1 - x0, y1 - y0)
+    return pts, tris, uv
+
+
+@pytest.fixture
+def renderer(gl_ctx):
+    # 200 x 100 pixels showing x in [-2, 2], y in [-1, 1]: 50 pixels per metre
+    r = Renderer(gl_ctx, (200, 100), samples=0, camera=Camera((0, 0), (4, 2)))
+    yield r
+    r.release()
+
+
+def test_camera_fits_the_view_to_the_aspect_ratio():
+    cam = Camera((1, 2), (4, 2))
+    assert cam.extent((200, 100)) == (2.0, 1.0)
+    assert cam.extent((100, 100)) == (2.0, 2.0)   # taller picture: more height, same width
+    assert cam.extent((400, 100)) == (4.0, 1.0)   # wider picture: more width, same height
+    px = cam.world_to_pixel([(1, 2), (-1, 3)], (200, 100))
+    np.testing.assert_allclose(px, [[100, 50], [0, 0]])
+    np.testing.assert_allclose(cam.pixel_to_world(px, (200, 100)), [[1, 2], [-1, 3]])
+
+
+def test_camera_rejects_bad_values():
+    with pytest.raises(ValueError, match="size must be two positive"):
+        Camera((0, 0), (0, 1))
+    with pytest.raises(ValueError, match="center must be two finite"):
+        Camera((0, float("nan")), (1, 1))
+
+
+def test_flat_body_covers_exactly_its_pixels(renderer):
+    pts, tris, uv = square_mesh(-1.0, -0.5, 0.5, 0.5)
+    h = renderer.add_mesh(tris, uv, color="#ff0000")
+    renderer.render([(h, pts)])
+    img = renderer.read()
+    assert img.shape == (100, 200, 3)
+    red = np.all(img == RED, axis=-1)
+    rows, cols = np.nonzero(red)
+    # x in [-1, 0.5] -> columns [50, 125); y in [-0.5, 0.5] -> rows [25, 75)
+    assert (cols.min(), cols.max(), rows.min(), rows.max()) == (50, 124, 25, 74)
+    assert red.sum() == 75 * 50
+
+
+def test_moving_the_body_moves_its_pixels(renderer):
+    pts, tris, uv = square_mesh(-1.0, -0.5, 0.5, 0.5)
+    h = renderer.add_mesh(tris, uv, color="#ff0000")
+    renderer.render([(h, pts + (1.0, 0.2))])   # 50 px right, 10 px up
+    rows, cols = np.nonzero(np.all(renderer.read() == RED, axis=-1))
+    assert (cols.min(), cols.max(), rows.min(), rows.max()) == (100, 174, 15, 64)
+
+
+def test_texture_is_upright_and_follows_the_uvs(renderer):
+    tex = np.zeros((64, 64, 4), np.uint8)
+    tex[..., 3] = 255
+    tex[:32, :, 0] = 255      # top half of the image red
+    tex[32:, :, 2] = 255      # bottom half blue
+    pts, tris, uv = square_mesh(-1.0, -1.0, 1.0, 1.0)
+    h = renderer.add_mesh(tris, uv, texture=tex)
+    renderer.render([(h, pts)])
+    img = renderer.read().astype(int)
+    top, bottom = img[20, 100], img[80, 100]   # y = +0.6 and y = -0.6
+    assert top[0] > 200 and top[2] < 50
+    assert bottom[2] > 200 and bottom[0] < 50
+    # mirrored uvs put blue on top: the picture really comes from the uvs
+    h2 = renderer.add_mesh(tris, uv * (1, -1) + (0, 1), texture=tex)
+    renderer.render([(h2, pts)])
+    assert renderer.read()[20, 100, 2] > 200
+
+
+def test_transparent_texels_show_the_background(renderer):
+    tex = np.full((8, 8, 4), 255, np.uint8)
+    tex[:, :4, 3] = 0         # left half fully transparent
+    pts, tris, uv = square_mesh(-1.0, -1.0, 1.0, 1.0)
+    renderer.render()
+    empty = renderer.read()
+    h = renderer.add_mesh(tris, uv, texture=tex, color=(0, 1, 0))
+    renderer.render([(h, pts)])
+    img = renderer.read()
+    np.testing.assert_array_equal(img[50, 60], empty[50, 60])      # x = -0.8: transparent
+    assert img[50, 140].tolist() == [0, 255, 0]                   # x = +0.8: tinted green
+
+
+def test_rotated_collider_is_drawn_where_it_is(renderer):
+    renderer.render()
+    empty = renderer.read().astype(int)
+    rect = ((0.5, 0.0), (2.0, 0.4), 30.0)
+    renderer.render(colliders=[rect])
+    img = renderer.read().astype(int)
+    cam, vp = renderer.camera, renderer.size
+    changed = np.abs(img - empty).sum(-1) > 30
+    # points inside the rectangle, along its long axis, are drawn
+    a = np.radians(30)
+    for t in (-0.8, -0.4, 0.0, 0.4, 0.8):
+        c, r = cam.world_to_pixel((0.5 + t * np.cos(a), t * np.sin(a)), vp).astype(int)
+        assert changed[r, c], (t, c, r)
+    # a point beside it (0.5 m off its axis) is not
+    c, r = cam.world_to_pixel((0.5 - 0.5 * np.sin(a), 0.5 * np.cos(a)), vp).astype(int)
+    assert not changed[r, c]
+    # the drawn area is the rectangle's area: 2 m * 0.4 m * 2500 px/m^2 = 2000 px
+    assert abs(changed.sum() - 2000) < 150
+
+
+def test_collider_corners_are_counter_clockwise_and_rotated():
+    c = collider_corners((1, 1), (2, 1), 90.0)
+    np.testing.assert_allclose(c, [[1.5, 0], [1.5, 2], [0.5, 2], [0.5, 0]], atol=1e-12)
+
+
+def test_wireframe_draws_the_springs_over_the_body(renderer):
+    pts, tris, uv = square_mesh(-1.0, -1.0, 1.0, 1.0, n=5)
+    h = renderer.add_mesh(tris, uv, color="#ff0000")
+    renderer.render([(h, pts)])
+    plain = np.all(renderer.read() == RED, axis=-1).sum()
+    renderer.render([(h, pts)], wireframe=True)
+    wired = np.all(renderer.read() == RED, axis=-1).sum()
+    # interior grid lines every 0.5 m (25 px) darken a good share of the body's pixels
+    assert plain == 100 * 100
+    assert 0.05 * plain < plain - wired < 0.5 * plain
+
+
+def test_read_gives_rgba_and_a_fresh_array(renderer):
+    renderer.render()
+    a = renderer.read()
+    b = renderer.read(components=4)
+    assert b.shape == (100, 200, 4) and np.all(b[..., 3] == 255)
+    a[:] = 0
+    assert renderer.read().any()
+
+
+def test_multisampled_render_matches_geometry(gl_ctx):
+    r = Renderer(gl_ctx, (200, 100), samples=4, camera=Camera((0, 0), (4, 2)))
+    pts, tris, uv = square_mesh(-1.0, -0.5, 0.5, 0.5)
+    h = r.add_mesh(tris, uv, color="#ff0000")
+    r.render([(h, pts)])
+    red = np.all(r.read() == RED, axis=-1)
+    # the interior is solid; smoothing only touches the border pixels
+    assert red[26:74, 51:124].all() and red.sum() <= 75 * 50
+    r.release()
+
+
+def test_resize_changes_the_picture(renderer):
+    renderer.resize((64, 32))
+    renderer.render()
+    assert renderer.read().shape == (32, 64, 3)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(texture=np.zeros((4, 4, 4), np.float32)), "uint8"),
+        (dict(color="#12345"), "colour must be"),
+        (dict(color=(2, 0, 0)), "colour must be"),
+    ],
+)
+def test_add_mesh_rejects_bad_input(renderer, kwargs, message):
+    pts, tris, uv = square_mesh(0, 0, 1, 1)
+    with pytest.raises(ValueError, match=message):
+        renderer.add_mesh(tris, uv, **kwargs)
+
+
+def test_bad_positions_and_sizes_are_rejected(renderer):
+    pts, tris, uv = square_mesh(0, 0, 1, 1)
+    h = renderer.add_mesh(tris, uv)
+    with pytest.raises(ValueError, match="positions must have shape"):
+        renderer.draw_mesh(h, pts[:-1])
+    with pytest.raises(ValueError, match="needs uv"):
+        renderer.add_mesh(tris, texture=np.zeros((2, 2, 3), np.uint8))
+    with pytest.raises(ValueError, match="size must be two integers"):
+        renderer.resize((0, 10))

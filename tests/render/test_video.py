@@ -1,0 +1,125 @@
+"""Video writers: frame counts, and nothing half-written when a run is interrupted."""
+
+import os
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from deforma.render.video import GifWriter, check_output, open_writer, output_kind
+
+
+def moving_frames(n, size=(64, 48)):
+    """Frames with a white square moving right, so every frame differs."""
+    w, h = size
+    for k in range(n):
+        f = np.full((h, w, 3), (40, 60, 90), np.uint8)
+        f[10:30, 2 * k : 2 * k + 12] = 255
+        yield f
+
+
+def test_mp4_has_the_frames_written(tmp_path):
+    import imageio_ffmpeg
+
+    out = tmp_path / "a.mp4"
+    with open_writer(out, fps=24) as w:
+        for f in moving_frames(17):
+            w.write(f)
+    frames = list(imageio_ffmpeg.read_frames(str(out)))
+    meta, frames = frames[0], frames[1:]
+    assert len(frames) == 17
+    assert tuple(meta["size"]) == (64, 48)
+    assert meta["fps"] == pytest.approx(24)
+    assert sorted(os.listdir(tmp_path)) == ["a.mp4"]   # no temporary file left
+
+
+def test_mp4_pads_odd_sizes(tmp_path):
+    import imageio_ffmpeg
+
+    out = tmp_path / "odd.mp4"
+    with open_writer(out, fps=10) as w:
+        for f in moving_frames(3, size=(63, 47)):
+            w.write(f)
+    meta = next(imageio_ffmpeg.read_frames(str(out)))
+    assert tuple(meta["size"]) == (64, 48)
+
+
+def test_gif_has_the_frames_and_the_timing(tmp_path):
+    out = tmp_path / "a.gif"
+    with open_writer(out, fps=30) as w:
+        for f in moving_frames(20):
+            w.write(f)
+    im = Image.open(out)
+    assert im.n_frames == 20
+    total = 0
+    for k in range(im.n_frames):
+        im.seek(k)
+        total += im.info["duration"]
+    assert total == pytest.approx(20 / 30 * 1000, abs=10)
+    im.seek(5)
+    rgb = np.asarray(im.convert("RGB"))
+    assert rgb[20, 15].tolist() == [255, 255, 255] and rgb[40, 5].tolist() == [40, 60, 90]
+
+
+def test_gif_durations_average_to_the_frame_rate():
+    d = GifWriter.__new__(GifWriter)
+    d.fps = 30.0
+    ms = d.durations_ms(30)
+    assert sum(ms) == 1000 and set(ms) == {30, 40}
+
+
+def test_png_folder_gets_numbered_frames(tmp_path):
+    out = tmp_path / "frames"
+    with open_writer(str(out) + "/", fps=10) as w:
+        for f in moving_frames(4):
+            w.write(f)
+    assert sorted(os.listdir(out)) == [f"frame_{k:05d}.png" for k in range(4)]
+    assert np.asarray(Image.open(out / "frame_00003.png")).shape == (48, 64, 3)
+
+
+@pytest.mark.parametrize("name", ["a.mp4", "a.gif"])
+def test_interrupted_write_leaves_the_old_file_and_no_temporary(tmp_path, name):
+    out = tmp_path / name
+    out.write_bytes(b"old")
+    with pytest.raises(KeyboardInterrupt):
+        with open_writer(out, fps=10) as w:
+            for k, f in enumerate(moving_frames(40)):
+                w.write(f)
+                if k == 30:
+                    raise KeyboardInterrupt
+    assert out.read_bytes() == b"old"
+    assert sorted(os.listdir(tmp_path)) == [name]
+
+
+def test_output_kinds():
+    assert output_kind("x.MP4") == "mp4"
+    assert output_kind("x.gif") == "gif"
+    assert output_kind("frames/") == "png"
+    assert output_kind("frames") == "png"
+    with pytest.raises(ValueError, match="allowed: .mp4, .gif, or a folder"):
+        output_kind("x.avi")
+
+
+def test_check_output_errors(tmp_path, monkeypatch):
+    with pytest.raises(ValueError, match="does not exist"):
+        check_output(tmp_path / "missing" / "a.mp4")
+    with pytest.raises(ValueError, match="does not exist"):
+        check_output(tmp_path / "missing" / "frames/")
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(ValueError, match="not a folder"):
+        check_output(str(tmp_path / "file") + "/")
+    with pytest.raises(ValueError, match="is a folder"):
+        (tmp_path / "d.mp4").mkdir()
+        check_output(tmp_path / "d.mp4")
+    # root may write anywhere, so a read-only folder is simulated through os.access
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    with pytest.raises(ValueError, match="not writable"):
+        check_output(tmp_path / "a.gif")
+
+
+def test_frames_must_keep_one_size(tmp_path):
+    with pytest.raises(ValueError, match="first frame's size"):
+        with open_writer(tmp_path / "a.gif", fps=10) as w:
+            w.write(np.zeros((8, 8, 3), np.uint8))
+            w.write(np.zeros((8, 9, 3), np.uint8))
+    assert not (tmp_path / "a.gif").exists()
