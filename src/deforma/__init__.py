@@ -14,6 +14,7 @@ Examples
 
 from . import mesh
 from .mesh.delaunay import delaunay
+from .physics import Rect, SimulationUnstable, World
 
-__all__ = ["delaunay", "mesh"]
+__all__ = ["Rect", "SimulationUnstable", "World", "delaunay", "mesh"]
 __version__ = "0.1.0"

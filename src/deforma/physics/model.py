@@ -1,0 +1,184 @@
+"""Constant topology and parameters of the soft bodies: spring pairs, rest lengths, masses.
+
+A :class:`Model` is everything a step reads but never writes. It concatenates all bodies
+of a world into flat arrays (global vertex and spring indices) so that one kernel call
+advances every body; ``body_vertex_offsets`` / ``body_spring_offsets`` say where each body
+starts. Parameters (mass, stiffness, damping) can change live, topology only by rebuilding.
+
+Units: metres, kilograms, newtons per metre (stiffness), newton-seconds per metre (damping).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class BodyTopology:
+    """The constant shape of one body, in body-local vertex indices.
+
+    Attributes
+    ----------
+    rest_positions : (N, 2) float64
+        Vertex positions in metres at rest (the mesh, as placed in the world).
+    springs : (E, 2) int32
+        Unique vertex pairs joined by a spring.
+    spring_rest_length : (E,) float64
+        Rest length of each spring in metres (its length in ``rest_positions``).
+    triangles : (M, 3) int32
+        Triangles for picking and drawing; may be empty (a chain of springs).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = BodyTopology.from_arrays([[0, 0], [1, 0], [0, 1]], [[0, 1], [1, 2], [0, 2]])
+    >>> t.spring_rest_length.round(3).tolist()
+    [1.0, 1.0, 1.414]
+    """
+
+    rest_positions: np.ndarray
+    springs: np.ndarray
+    spring_rest_length: np.ndarray
+    triangles: np.ndarray
+
+    @classmethod
+    def from_arrays(cls, vertices, springs, triangles=None) -> "BodyTopology":
+        """Validate vertices and spring pairs and measure rest lengths.
+
+        Raises
+        ------
+        ValueError
+            If shapes are wrong, values are not finite, an index is out of range, a spring
+            joins a vertex to itself or has zero rest length.
+        """
+        x = np.array(vertices, dtype=np.float64)
+        if x.ndim != 2 or x.shape[1] != 2 or x.shape[0] < 2:
+            raise ValueError(f"vertices must be an (N, 2) array with N >= 2, got shape {x.shape}")
+        if not np.all(np.isfinite(x)):
+            raise ValueError("vertices must be finite (no NaN or inf)")
+        s = np.asarray(springs)
+        if s.ndim != 2 or s.shape[1] != 2 or s.shape[0] < 1:
+            raise ValueError(f"springs/edges must be an (E, 2) integer array with E >= 1, got shape {s.shape}")
+        if not np.issubdtype(s.dtype, np.integer):
+            raise ValueError(f"springs/edges must hold integers, got dtype {s.dtype}")
+        if s.min() < 0 or s.max() >= len(x):
+            raise ValueError(f"spring vertex indices must lie in [0, {len(x) - 1}]")
+        s = np.sort(s.astype(np.int32), axis=1)
+        s = np.unique(s, axis=0)
+        if np.any(s[:, 0] == s[:, 1]):
+            raise ValueError("a spring must join two different vertices")
+        rest = np.linalg.norm(x[s[:, 1]] - x[s[:, 0]], axis=1)
+        if np.any(rest <= 0.0):
+            raise ValueError("every spring must have a positive rest length (two vertices coincide)")
+        if triangles is None:
+            t = np.zeros((0, 3), np.int32)
+        else:
+            t = np.ascontiguousarray(triangles, dtype=np.int32).reshape(-1, 3)
+            if t.size and (t.min() < 0 or t.max() >= len(x)):
+                raise ValueError(f"triangle vertex indices must lie in [0, {len(x) - 1}]")
+        return cls(x, np.ascontiguousarray(s), rest, t)
+
+    @property
+    def n_vertices(self) -> int:
+        """Number of vertices."""
+        return len(self.rest_positions)
+
+    @property
+    def n_springs(self) -> int:
+        """Number of springs."""
+        return len(self.springs)
+
+
+class Model:
+    """All bodies' constant arrays, concatenated, as the kernels read them.
+
+    Attributes
+    ----------
+    vertex_mass, vertex_inv_mass : (N,) float64
+        Mass of each vertex in kg (a body's total mass / its vertex count) and its inverse.
+    spring_i, spring_j : (E,) int32
+        Global vertex indices of each spring's ends.
+    spring_rest_length : (E,) float64
+        Rest lengths in metres.
+    spring_stiffness : (E,) float64
+        Spring constants ``ks`` in N/m.
+    spring_damping : (E,) float64
+        Damping constants ``kd`` in N*s/m (acting on the relative velocity along the spring).
+    adj_ptr : (N + 1,) int64
+        CSR row pointers: the springs at vertex ``i`` are ``adj_spring[adj_ptr[i]:adj_ptr[i+1]]``.
+    adj_spring : (2E,) int32
+        Spring index per adjacency entry.
+    adj_sign : (2E,) float64
+        +1 where the vertex is the spring's ``i`` end, -1 where it is the ``j`` end; lets a
+        per-vertex gather sum spring forces computed once per spring, without write races.
+    body_vertex_offsets, body_spring_offsets : (B + 1,) int64
+        Where each body's vertices and springs start.
+
+    Examples
+    --------
+    >>> t = BodyTopology.from_arrays([[0, 0], [1, 0], [0, 1]], [[0, 1], [1, 2], [0, 2]])
+    >>> m = Model([t], masses=[3.0], stiffness=[100.0], damping=[0.0])
+    >>> m.vertex_mass.tolist(), m.adj_ptr.tolist()
+    ([1.0, 1.0, 1.0], [0, 2, 4, 6])
+    """
+
+    def __init__(self, topologies, *, masses, stiffness, damping):
+        self.topologies = list(topologies)
+        nv = [t.n_vertices for t in self.topologies]
+        ne = [t.n_springs for t in self.topologies]
+        self.body_vertex_offsets = np.zeros(len(nv) + 1, np.int64)
+        self.body_spring_offsets = np.zeros(len(ne) + 1, np.int64)
+        np.cumsum(nv, out=self.body_vertex_offsets[1:])
+        np.cumsum(ne, out=self.body_spring_offsets[1:])
+        n, e = int(self.body_vertex_offsets[-1]), int(self.body_spring_offsets[-1])
+
+        self.spring_i = np.empty(e, np.int32)
+        self.spring_j = np.empty(e, np.int32)
+        self.spring_rest_length = np.empty(e, np.float64)
+        for b, t in enumerate(self.topologies):
+            s0, s1 = self.body_spring_offsets[b], self.body_spring_offsets[b + 1]
+            v0 = self.body_vertex_offsets[b]
+            self.spring_i[s0:s1] = t.springs[:, 0] + v0
+            self.spring_j[s0:s1] = t.springs[:, 1] + v0
+            self.spring_rest_length[s0:s1] = t.spring_rest_length
+        self.vertex_mass = np.empty(n, np.float64)
+        self.vertex_inv_mass = np.empty(n, np.float64)
+        self.spring_stiffness = np.empty(e, np.float64)
+        self.spring_damping = np.empty(e, np.float64)
+        for b in range(len(self.topologies)):
+            self.set_body_parameters(b, mass=masses[b], stiffness=stiffness[b], damping=damping[b])
+
+        # CSR adjacency: each spring appears once under each of its two ends.
+        ends = np.concatenate([self.spring_i, self.spring_j])
+        ids = np.concatenate([np.arange(e, dtype=np.int32)] * 2)
+        signs = np.concatenate([np.ones(e), -np.ones(e)])
+        order = np.argsort(ends, kind="stable")
+        self.adj_ptr = np.zeros(n + 1, np.int64)
+        np.cumsum(np.bincount(ends, minlength=n), out=self.adj_ptr[1:])
+        self.adj_spring = np.ascontiguousarray(ids[order])
+        self.adj_sign = np.ascontiguousarray(signs[order])
+
+    @property
+    def n_vertices(self) -> int:
+        """Total number of vertices over all bodies."""
+        return len(self.vertex_mass)
+
+    @property
+    def n_springs(self) -> int:
+        """Total number of springs over all bodies."""
+        return len(self.spring_i)
+
+    def set_body_parameters(self, body: int, *, mass: float, stiffness: float, damping: float) -> None:
+        """Write body ``body``'s total mass (kg), stiffness (N/m) and damping (N*s/m) into the arrays.
+
+        The caller validates the values; this only spreads them over vertices and springs.
+        """
+        v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
+        s0, s1 = self.body_spring_offsets[body], self.body_spring_offsets[body + 1]
+        m = mass / (v1 - v0)
+        self.vertex_mass[v0:v1] = m
+        self.vertex_inv_mass[v0:v1] = 1.0 / m
+        self.spring_stiffness[s0:s1] = stiffness
+        self.spring_damping[s0:s1] = damping

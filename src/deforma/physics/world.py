@@ -1,0 +1,751 @@
+"""The World: soft bodies, colliders, gravity and friction, stepped in time.
+
+A world owns one :class:`~deforma.physics.model.Model` (constant arrays of all bodies) and
+one :class:`~deforma.physics.state.State` (positions and velocities of all bodies), hands
+both to its integrator every step and checks the result. Bodies are thin handles whose
+``positions`` / ``velocities`` are views into the world's arrays.
+
+Units are SI (m, kg, s, N); y points up; angles are degrees.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .colliders import Rect, pack_rects
+from .integrators import make_integrator
+from .model import BodyTopology, Model
+from .state import State
+
+
+class SimulationUnstable(RuntimeError):
+    """A step produced a non-finite or runaway state; the world was put back as before it.
+
+    Attributes
+    ----------
+    body : Body
+        The first body with a bad vertex.
+    step : int
+        Index of the failed step (``world.step_count`` when it started).
+    hint : str
+        What to change, e.g. "dt/substeps 0.01 s exceeds the stable estimate 0.002 s: ...".
+    """
+
+    def __init__(self, message: str, *, body, step: int, hint: str):
+        super().__init__(message)
+        self.body = body
+        self.step = step
+        self.hint = hint
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Energies in joules: kinetic ``sum m v^2 / 2``, spring ``sum ks (L - l)^2 / 2`` and
+    gravitational ``-sum m g . x`` (zero at the origin)."""
+
+    kinetic: float
+    spring: float
+    gravitational: float
+
+    @property
+    def total(self) -> float:
+        """Sum of the three, in joules."""
+        return self.kinetic + self.spring + self.gravitational
+
+
+def _finite(value, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def _positive(value, name: str, unit: str) -> float:
+    v = _finite(value, name)
+    if v <= 0:
+        raise ValueError(f"{name} must be > 0 {unit}, got {value!r}")
+    return v
+
+
+def _non_negative(value, name: str, unit: str) -> float:
+    v = _finite(value, name)
+    if v < 0:
+        raise ValueError(f"{name} must be >= 0 {unit}, got {value!r}")
+    return v
+
+
+def _pair(value, name: str) -> tuple[float, float]:
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a pair of numbers (x, y), got {value!r}") from None
+    if a.shape != (2,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be a pair of finite numbers (x, y), got {value!r}")
+    return float(a[0]), float(a[1])
+
+
+class Body:
+    """A soft body in a world: a handle onto its slice of the world's arrays.
+
+    Made by :meth:`World.add_body`, not directly. ``mass`` (kg, total), ``stiffness``
+    (N/m per spring) and ``damping`` (N*s/m per spring) can be set live; setting ``None``
+    makes the body follow the world's value again.
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World()
+    >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]), position=(0, 2))
+    >>> b.positions.shape, b.mass, b.n_springs
+    ((3, 2), 1.0, 3)
+    """
+
+    def __init__(self, world: "World", index: int, mesh, topology: BodyTopology, overrides: dict):
+        self._world = world
+        self._index = index
+        self.mesh = mesh
+        self.topology = topology
+        self._overrides = overrides
+
+    def _check(self) -> "World":
+        if self._world is None:
+            raise ValueError("this body was removed from its world")
+        return self._world
+
+    @property
+    def world(self) -> "World":
+        """The world the body lives in."""
+        return self._check()
+
+    @property
+    def index(self) -> int:
+        """Position of the body in ``world.bodies``."""
+        self._check()
+        return self._index
+
+    @property
+    def vertex_slice(self) -> slice:
+        """Rows of the world's state arrays that belong to this body."""
+        off = self._check()._model.body_vertex_offsets
+        return slice(int(off[self._index]), int(off[self._index + 1]))
+
+    @property
+    def positions(self) -> np.ndarray:
+        """(N, 2) vertex positions in metres: a view into the world's state, writable."""
+        return self._check()._state.x[self.vertex_slice]
+
+    @positions.setter
+    def positions(self, value):
+        self.positions[...] = self._checked_array(value, "positions")
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """(N, 2) vertex velocities in m/s: a view into the world's state, writable."""
+        return self._check()._state.v[self.vertex_slice]
+
+    @velocities.setter
+    def velocities(self, value):
+        self.velocities[...] = self._checked_array(value, "velocities")
+
+    def _checked_array(self, value, name):
+        a = np.asarray(value, dtype=np.float64)
+        n = self.n_vertices
+        if a.shape not in ((n, 2), (2,)) or not np.all(np.isfinite(a)):
+            raise ValueError(f"{name} must be finite with shape ({n}, 2) or (2,), got shape {a.shape}")
+        return a
+
+    @property
+    def n_vertices(self) -> int:
+        """Number of vertices (masses)."""
+        return self.topology.n_vertices
+
+    @property
+    def n_springs(self) -> int:
+        """Number of springs (unique mesh edges)."""
+        return self.topology.n_springs
+
+    @property
+    def triangles(self) -> np.ndarray:
+        """(M, 3) int32 triangles in body-local vertex indices (may be empty)."""
+        return self.topology.triangles
+
+    @property
+    def springs(self) -> np.ndarray:
+        """(E, 2) int32 spring vertex pairs in body-local indices."""
+        return self.topology.springs
+
+    @property
+    def center_of_mass(self) -> np.ndarray:
+        """(2,) centre of mass in metres (all vertices weigh the same)."""
+        return self.positions.mean(axis=0)
+
+    def _param(self, name):
+        v = self._overrides[name]
+        return getattr(self._check(), name) if v is None else v
+
+    def _set_param(self, name, value, check):
+        self._overrides[name] = None if value is None else check(value)
+        self._check()._apply_body_parameters(self._index)
+
+    mass = property(lambda self: self._param("mass"),
+                    lambda self, v: self._set_param("mass", v, lambda x: _positive(x, "mass", "kg")),
+                    doc="Total mass in kg, spread evenly over the vertices (the original's mass / N).")
+    stiffness = property(lambda self: self._param("stiffness"),
+                         lambda self, v: self._set_param("stiffness", v,
+                                                         lambda x: _non_negative(x, "stiffness", "N/m")),
+                         doc="Spring constant ks of every spring, N/m.")
+    damping = property(lambda self: self._param("damping"),
+                       lambda self, v: self._set_param("damping", v,
+                                                       lambda x: _non_negative(x, "damping", "N*s/m")),
+                       doc="Spring damping kd of every spring, N*s/m.")
+
+    def __repr__(self) -> str:
+        if self._world is None:
+            return "Body(removed)"
+        return f"Body({self.n_vertices} vertices, {self.n_springs} springs, mass {self.mass} kg)"
+
+
+class Grab:
+    """A mouse grab: vertices of one body pulled toward ``target`` while held.
+
+    Made by :meth:`World.grab`. ``vertices`` are body-local indices (empty when the point
+    was off every body, then the grab does nothing).
+    """
+
+    def __init__(self, world, body, vertices, target, strength):
+        self._world = world
+        self.body = body
+        self.vertices = np.asarray(vertices, dtype=np.int64)
+        self.target = target
+        self.strength = strength
+        self.active = True
+
+    def __repr__(self) -> str:
+        state = "active" if self.active else "released"
+        return f"Grab({len(self.vertices)} vertices, target={self.target}, strength={self.strength} N/m, {state})"
+
+
+class _StepInputs:
+    """What the integrator reads besides the model and the state (see integrators.StepInputs)."""
+
+    __slots__ = ("gravity", "rects", "grab_slot", "grab_pull", "max_speed")
+
+
+class World:
+    """Soft bodies, rotated-rectangle colliders, gravity and Coulomb friction.
+
+    Parameters
+    ----------
+    gravity : (float, float), optional
+        Acceleration of gravity in m/s^2.
+    dt : float, optional
+        Time advanced by one :meth:`step`, seconds (> 0).
+    substeps : int, optional
+        Integration substeps per step (>= 1); each is ``dt / substeps`` long.
+    mass : float, optional
+        Default total mass of a body in kg (> 0); each vertex weighs ``mass / N``.
+    stiffness : float, optional
+        Default spring constant in N/m (>= 0).
+    damping : float, optional
+        Default spring damping in N*s/m (>= 0).
+    friction, static_friction : float, optional
+        Default dynamic and static Coulomb coefficients of colliders (>= 0).
+    grab_strength : float, optional
+        Default mouse pull in N/m per held vertex (> 0).
+    max_speed : float, optional
+        A vertex faster than this (m/s) means the simulation ran away (> 0; ``inf`` to
+        check only for NaN/inf).
+    integrator : str, optional
+        Time integrator by name; see ``deforma.physics.available_integrators()``.
+
+    Every parameter is also a settable attribute, validated the same way, and takes effect
+    at the next step (bodies and colliders that do not override it follow the world).
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World(dt=1 / 600, stiffness=500.0)
+    >>> m = deforma.mesh.Mesh([[0, 0], [1, 0], [1, 1], [0, 1]], [[0, 1, 2], [0, 2, 3]])
+    >>> body = w.add_body(m, position=(0, 1))
+    >>> _ = w.add_collider(deforma.Rect((0, -0.25), (10, 0.5), 0.0))
+    >>> for _ in range(600):
+    ...     w.step()
+    >>> bool(abs(body.center_of_mass[1] - 0.5) < 0.01)  # resting on the ground
+    True
+    """
+
+    def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps=1, mass=1.0, stiffness=1000.0,
+                 damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
+                 integrator="symplectic-euler"):
+        self._inputs = _StepInputs()
+        self._bodies: list[Body] = []
+        self._colliders: list[Rect] = []
+        self._packed_colliders: list | None = None
+        self._grabs: list[Grab] = []
+        self._grabs_dirty = True
+        self._model = Model([], masses=[], stiffness=[], damping=[])
+        self._state = State.empty()
+        self.time = 0.0
+        self.step_count = 0
+        self.gravity = gravity
+        self.dt = dt
+        self.substeps = substeps
+        self.mass = mass
+        self.stiffness = stiffness
+        self.damping = damping
+        self.friction = friction
+        self.static_friction = static_friction
+        self.grab_strength = grab_strength
+        self.max_speed = max_speed
+        self.integrator = integrator
+
+    # -- parameters -------------------------------------------------------------------------
+    @property
+    def gravity(self) -> tuple[float, float]:
+        """Acceleration of gravity (m/s^2) as (x, y)."""
+        return self._inputs.gravity
+
+    @gravity.setter
+    def gravity(self, value):
+        self._inputs.gravity = _pair(value, "gravity")
+
+    @property
+    def dt(self) -> float:
+        """Seconds advanced per :meth:`step`."""
+        return self._dt
+
+    @dt.setter
+    def dt(self, value):
+        self._dt = _positive(value, "dt", "s")
+
+    @property
+    def substeps(self) -> int:
+        """Substeps per step."""
+        return self._substeps
+
+    @substeps.setter
+    def substeps(self, value):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+            raise ValueError(f"substeps must be an integer >= 1, got {value!r}")
+        self._substeps = int(value)
+
+    def _world_param(name, unit, check):  # noqa: N805 - a property factory used in the class body
+        def get(self):
+            return getattr(self, "_" + name)
+
+        def set_(self, value):
+            setattr(self, "_" + name, check(value, name, unit))
+            if name in ("mass", "stiffness", "damping"):
+                for b in range(len(self._bodies)):
+                    self._apply_body_parameters(b)
+            else:
+                self._packed_colliders = None
+        return property(get, set_, doc=f"World default {name} ({unit}).")
+
+    mass = _world_param("mass", "kg", _positive)
+    stiffness = _world_param("stiffness", "N/m", _non_negative)
+    damping = _world_param("damping", "N*s/m", _non_negative)
+    friction = _world_param("friction", "(dimensionless)", _non_negative)
+    static_friction = _world_param("static_friction", "(dimensionless)", _non_negative)
+    del _world_param
+
+    @property
+    def grab_strength(self) -> float:
+        """Default mouse pull in N/m per held vertex."""
+        return self._grab_strength
+
+    @grab_strength.setter
+    def grab_strength(self, value):
+        self._grab_strength = _positive(value, "grab_strength", "N/m")
+
+    @property
+    def max_speed(self) -> float:
+        """Speed (m/s) above which a vertex counts as runaway."""
+        return self._inputs.max_speed
+
+    @max_speed.setter
+    def max_speed(self, value):
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"max_speed must be a number of m/s, got {value!r}") from None
+        if not v > 0:
+            raise ValueError(f"max_speed must be > 0 m/s (inf allowed), got {value!r}")
+        self._inputs.max_speed = v
+
+    @property
+    def integrator(self) -> str:
+        """Name of the time integrator."""
+        return self._integrator.name
+
+    @integrator.setter
+    def integrator(self, name):
+        self._integrator = make_integrator(name)
+
+    # -- bodies -----------------------------------------------------------------------------
+    @property
+    def bodies(self) -> list[Body]:
+        """The bodies, in the order added (a new list; use add_body / remove_body to change)."""
+        return list(self._bodies)
+
+    def add_body(self, mesh, *, position=None, mass=None, stiffness=None, damping=None) -> Body:
+        """Make a soft body from a mesh: a mass per vertex, a spring per unique edge.
+
+        Parameters
+        ----------
+        mesh : deforma.mesh.Mesh
+            Or any object with ``vertices`` (N, 2) and ``edges`` (E, 2) (and optionally
+            ``triangles``), e.g. a chain of springs. Rest lengths come from the vertices.
+        position : (float, float), optional
+            Where the mesh's bounding-box centre goes, metres; ``None`` keeps its coordinates.
+        mass, stiffness, damping : float, optional
+            Total mass (kg), spring constant (N/m) and damping (N*s/m); ``None`` follows the world.
+
+        Returns
+        -------
+        Body
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [2, 0], [0, 2]], [[0, 1, 2]]), position=(5, 5))
+        >>> b.positions.min(axis=0).tolist(), b.positions.max(axis=0).tolist()
+        ([4.0, 4.0], [6.0, 6.0])
+        """
+        try:
+            vertices, edges = mesh.vertices, mesh.edges
+        except AttributeError:
+            raise ValueError(f"mesh must be a deforma.mesh.Mesh (or have .vertices and .edges), "
+                             f"got {type(mesh).__name__}") from None
+        x = np.array(vertices, dtype=np.float64)
+        if x.ndim == 2 and x.shape[1] == 2 and len(x) and position is not None:
+            x += np.asarray(_pair(position, "position")) - (x.min(axis=0) + x.max(axis=0)) / 2
+        topo = BodyTopology.from_arrays(x, edges, getattr(mesh, "triangles", None))
+        overrides = {
+            "mass": None if mass is None else _positive(mass, "mass", "kg"),
+            "stiffness": None if stiffness is None else _non_negative(stiffness, "stiffness", "N/m"),
+            "damping": None if damping is None else _non_negative(damping, "damping", "N*s/m"),
+        }
+        body = Body(self, len(self._bodies), mesh, topo, overrides)
+        xs = [self._state.x, topo.rest_positions]
+        vs = [self._state.v, np.zeros_like(topo.rest_positions)]
+        self._bodies.append(body)
+        self._rebuild(np.concatenate(xs), np.concatenate(vs))
+        return body
+
+    def remove_body(self, body: Body) -> None:
+        """Take a body out of the world (its grabs are released).
+
+        Raises
+        ------
+        ValueError
+            If ``body`` is not a body of this world.
+        """
+        b = self._own_body(body)
+        keep = np.ones(self._model.n_vertices, bool)
+        keep[body.vertex_slice] = False
+        x, v = self._state.x[keep], self._state.v[keep]
+        for g in self._grabs:
+            if g.body is body:
+                g.active = False
+        self._grabs = [g for g in self._grabs if g.active]
+        del self._bodies[b]
+        body._world = None
+        for k, other in enumerate(self._bodies):
+            other._index = k
+        self._rebuild(x, v)
+
+    def _own_body(self, body) -> int:
+        if not isinstance(body, Body) or body._world is not self:
+            raise ValueError(f"unknown body {body!r}: pass one returned by this world's add_body")
+        return body._index
+
+    def _rebuild(self, x, v):
+        tops = [b.topology for b in self._bodies]
+        self._model = Model(tops, masses=[b.mass for b in self._bodies],
+                            stiffness=[b.stiffness for b in self._bodies],
+                            damping=[b.damping for b in self._bodies])
+        self._state = State(x, v, self._model.body_vertex_offsets)
+        self._grabs_dirty = True
+
+    def _apply_body_parameters(self, b: int) -> None:
+        body = self._bodies[b]
+        self._model.set_body_parameters(b, mass=body.mass, stiffness=body.stiffness, damping=body.damping)
+
+    # -- colliders --------------------------------------------------------------------------
+    @property
+    def colliders(self) -> list[Rect]:
+        """The collider list itself: append, remove or replace Rects freely."""
+        return self._colliders
+
+    def add_collider(self, rect: Rect) -> Rect:
+        """Add a rotated rectangle; returns it.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> w.add_collider(deforma.Rect((0, 0), (10, 0.5), 15.0)).angle
+        15.0
+        """
+        if not isinstance(rect, Rect):
+            raise ValueError(f"collider must be a deforma.Rect, got {type(rect).__name__}")
+        self._colliders.append(rect)
+        return rect
+
+    def _pack_colliders(self):
+        for r in self._colliders:
+            if not isinstance(r, Rect):
+                raise ValueError(f"world.colliders may hold only deforma.Rect, found {type(r).__name__}")
+        self._inputs.rects = pack_rects(self._colliders, friction=self.friction,
+                                        static_friction=self.static_friction)
+        self._packed_colliders = list(self._colliders)
+
+    # -- interaction ------------------------------------------------------------------------
+    def explode(self, strength: float, *, center=None) -> None:
+        """Add velocity to every vertex: ``strength`` m/s upward (the original's space key).
+
+        Parameters
+        ----------
+        strength : float
+            Speed added, m/s (negative pushes down / inward).
+        center : (float, float), optional
+            If given, push radially away from this point instead, ``strength`` m/s each.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
+        >>> w.explode(5.0)
+        >>> b.velocities[:, 1].tolist()
+        [5.0, 5.0, 5.0]
+        """
+        s = _finite(strength, "strength")
+        v, x = self._state.v, self._state.x
+        if center is None:
+            v[:, 1] += s
+            return
+        d = x - np.asarray(_pair(center, "center"))
+        n = np.linalg.norm(d, axis=1)
+        ok = n > 0
+        v[ok] += s * d[ok] / n[ok, None]
+
+    def grab(self, point, *, strength=None, radius=None) -> Grab:
+        """Take hold of the body under ``point`` (the mouse press).
+
+        Picks the vertices of the triangle under the point, plus, with ``radius``, every
+        vertex of that body within ``radius`` metres. The topmost (last added) body wins.
+        A point off every body gives an empty grab that does nothing. A body without
+        triangles (a spring chain) is picked by ``radius`` alone.
+
+        Parameters
+        ----------
+        point : (float, float)
+            Metres.
+        strength : float, optional
+            Pull in N/m per held vertex: force ``strength * (target - x)``; default
+            ``world.grab_strength``.
+        radius : float, optional
+            Metres (> 0).
+
+        Returns
+        -------
+        Grab
+            Pass it to :meth:`drag` and :meth:`release`. The target starts at ``point``.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
+        >>> len(w.grab((0.2, 0.2)).vertices), len(w.grab((5.0, 5.0)).vertices)
+        (3, 0)
+        """
+        p = np.asarray(_pair(point, "point"))
+        s = self.grab_strength if strength is None else _positive(strength, "strength", "N/m")
+        r = None if radius is None else _positive(radius, "radius", "m")
+        for body in reversed(self._bodies):
+            x = body.positions
+            picked = np.zeros(0, np.int64)
+            t = body.triangles
+            if len(t):
+                a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
+
+                def cross(o, q):
+                    return (q[:, 0] - o[:, 0]) * (p[1] - o[:, 1]) - (q[:, 1] - o[:, 1]) * (p[0] - o[:, 0])
+                d1, d2, d3 = cross(a, b), cross(b, c), cross(c, a)
+                inside = ((d1 >= 0) & (d2 >= 0) & (d3 >= 0)) | ((d1 <= 0) & (d2 <= 0) & (d3 <= 0))
+                hit = np.flatnonzero(inside)
+                if len(hit):
+                    picked = t[hit[0]].astype(np.int64)
+            if r is not None and (len(picked) or not len(t)):
+                near = np.flatnonzero(np.linalg.norm(x - p, axis=1) <= r)
+                picked = np.union1d(picked, near)
+            if len(picked):
+                g = Grab(self, body, np.unique(picked), (float(p[0]), float(p[1])), s)
+                break
+        else:
+            g = Grab(self, None, [], (float(p[0]), float(p[1])), s)
+        self._grabs.append(g)
+        self._grabs_dirty = True
+        return g
+
+    def _own_grab(self, g) -> None:
+        if not isinstance(g, Grab) or g._world is not self:
+            raise ValueError(f"unknown grab {g!r}: pass one returned by this world's grab()")
+
+    def drag(self, g: Grab, target) -> None:
+        """Move the pull target of an active grab to ``target`` (metres)."""
+        self._own_grab(g)
+        if not g.active:
+            raise ValueError("this grab was released; grab again")
+        g.target = _pair(target, "target")
+        self._grabs_dirty = True
+
+    def release(self, g: Grab) -> None:
+        """Let go (the mouse release); releasing twice is harmless."""
+        self._own_grab(g)
+        if g.active:
+            g.active = False
+            self._grabs.remove(g)
+            self._grabs_dirty = True
+
+    def _rebuild_grabs(self):
+        n = self._model.n_vertices
+        slot = np.full(n, -1, np.int32)
+        rows = [(b.vertex_slice.start + g.vertices, g.strength, g.target) for g in self._grabs
+                if len(g.vertices) for b in [g.body]]
+        if rows:
+            idx = np.concatenate([r[0] for r in rows])
+            st = np.concatenate([np.full(len(r[0]), r[1]) for r in rows])
+            tg = np.concatenate([np.tile(r[2], (len(r[0]), 1)) for r in rows])
+            uniq, inv = np.unique(idx, return_inverse=True)
+            pull = np.zeros((len(uniq), 3))
+            np.add.at(pull[:, 0], inv, st)
+            np.add.at(pull[:, 1], inv, st * tg[:, 0])
+            np.add.at(pull[:, 2], inv, st * tg[:, 1])
+            slot[uniq] = np.arange(len(uniq), dtype=np.int32)
+        else:
+            pull = np.zeros((0, 3))
+        self._inputs.grab_slot = slot
+        self._inputs.grab_pull = pull
+        self._grabs_dirty = False
+
+    # -- stepping ---------------------------------------------------------------------------
+    def step(self) -> None:
+        """Advance the world by ``dt`` seconds (``substeps`` substeps).
+
+        Raises
+        ------
+        SimulationUnstable
+            If a vertex ends non-finite or faster than ``max_speed``; the state is then put
+            back to what it was before this step.
+        """
+        if self._packed_colliders is None or self._packed_colliders != self._colliders:
+            self._pack_colliders()
+        if self._grabs_dirty:
+            self._rebuild_grabs()
+        if self._model.n_vertices:
+            bad = self._integrator.advance(self._model, self._state, self._inputs,
+                                           self._dt / self._substeps, self._substeps)
+            if bad:
+                self._fail()
+        self.time += self._dt
+        self.step_count += 1
+
+    def _fail(self):
+        x, v = self._state.x, self._state.v
+        speed = np.hypot(v[:, 0], v[:, 1])
+        bad = ~(np.isfinite(x).all(axis=1) & (speed <= self.max_speed))
+        first = int(np.argmax(bad))
+        b = int(np.searchsorted(self._model.body_vertex_offsets, first, side="right") - 1)
+        body = self._bodies[b]
+        self._state.restore()
+        h = self._dt / self._substeps
+        stable = self.stable_dt()
+        what = "non-finite positions or velocities" if not np.isfinite(speed[first]) \
+            else f"a vertex faster than max_speed {self.max_speed:g} m/s"
+        if h > stable:
+            need = math.ceil(self._dt / stable)
+            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s: "
+                    f"lower dt or raise substeps to at least {need}")
+        else:
+            hint = (f"dt/substeps {h:.3g} s is within the stable estimate {stable:.3g} s, so a large "
+                    f"force ran away (grab strength, explosion, stiffness): lower it, raise damping "
+                    f"or substeps, or raise max_speed if such speeds are intended")
+        raise SimulationUnstable(f"body {b} became unstable at step {self.step_count} ({what}); {hint}",
+                                 body=body, step=self.step_count, hint=hint)
+
+    # -- diagnostics ------------------------------------------------------------------------
+    def stable_dt(self) -> float:
+        """Estimate of the largest stable explicit (sub)step in seconds for the current bodies.
+
+        Bounds the fastest spring mode by Gershgorin's theorem, ``omega^2 <= max_i
+        2 sum(ks)_i / m_i`` and ``gamma <= max_i 2 sum(kd)_i / m_i`` over the springs (and
+        grabs) at each vertex, and returns the step at which semi-implicit Euler on
+        ``x'' = -omega^2 x - gamma x'`` turns unstable, ``(sqrt(gamma^2 + 4 omega^2) - gamma)
+        / omega^2`` (``2 / omega`` without damping). Compare it with ``dt / substeps``.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(mass=2.0, stiffness=100.0, damping=0.0)
+        >>> _ = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
+        >>> round(w.stable_dt(), 4)  # 2 / sqrt(2 * 200 / (2 / 3))
+        0.0816
+        """
+        m = self._model
+        if m.n_vertices == 0:
+            return math.inf
+        ks = np.bincount(m.spring_i, m.spring_stiffness, m.n_vertices) + \
+            np.bincount(m.spring_j, m.spring_stiffness, m.n_vertices)
+        kd = np.bincount(m.spring_i, m.spring_damping, m.n_vertices) + \
+            np.bincount(m.spring_j, m.spring_damping, m.n_vertices)
+        if self._grabs_dirty:
+            self._rebuild_grabs()
+        held = self._inputs.grab_slot >= 0
+        ks[held] += self._inputs.grab_pull[self._inputs.grab_slot[held], 0]
+        w2 = float(np.max(2 * ks * m.vertex_inv_mass))
+        gamma = float(np.max(2 * kd * m.vertex_inv_mass))
+        if w2 == 0:
+            return math.inf if gamma == 0 else 2 / gamma
+        return (math.sqrt(gamma * gamma + 4 * w2) - gamma) / w2
+
+    def energy(self, body: Body | None = None) -> Energy:
+        """Kinetic, spring and gravitational energy in joules, of one body or all.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(mass=3.0)
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]), position=None)
+        >>> b.velocities[:] = (2.0, 0.0)
+        >>> w.energy().kinetic  # 3 kg at 2 m/s
+        6.0
+        """
+        m, s = self._model, self._state
+        if body is None:
+            vs, es = slice(None), slice(None)
+        else:
+            b = self._own_body(body)
+            vs = body.vertex_slice
+            es = slice(int(m.body_spring_offsets[b]), int(m.body_spring_offsets[b + 1]))
+        x, v, mass = s.x[vs], s.v[vs], m.vertex_mass[vs]
+        kinetic = 0.5 * float(np.sum(mass * np.einsum("ij,ij->i", v, v)))
+        si, sj = m.spring_i[es], m.spring_j[es]
+        stretch = np.linalg.norm(s.x[sj] - s.x[si], axis=1) - m.spring_rest_length[es]
+        spring = 0.5 * float(np.sum(m.spring_stiffness[es] * stretch * stretch))
+        gravitational = -float(np.sum(mass * (x @ np.asarray(self.gravity))))
+        return Energy(kinetic, spring, gravitational)
+
+    def __repr__(self) -> str:
+        return (f"World({len(self._bodies)} bodies, {self._model.n_vertices} vertices, "
+                f"{len(self._colliders)} colliders, t={self.time:.4g} s)")

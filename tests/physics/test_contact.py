@@ -1,0 +1,144 @@
+"""Collisions and Coulomb friction against rotated rectangles: known answers."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import deforma
+from physics_meshes import grid_mesh
+
+G = 9.81
+
+
+def slope_world(angle, *, mu_s=0.5, mu_d=0.3, dt=1 / 2000, damping=20.0, rect_coefficients=False):
+    """A 20 cm x 10 cm block resting on the upper face of a rectangle tilted by ``angle``."""
+    a = math.radians(angle)
+    n = np.array([-math.sin(a), math.cos(a)])
+    t = np.array([math.cos(a), math.sin(a)])
+    if rect_coefficients:  # the world's coefficients would let it slide; the collider's must win
+        w = deforma.World(dt=dt, friction=0.0, static_friction=0.0, stiffness=2e4, damping=damping)
+        w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle, friction=mu_d, static_friction=mu_s))
+    else:
+        w = deforma.World(dt=dt, friction=mu_d, static_friction=mu_s, stiffness=2e4, damping=damping)
+        w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle))
+    b = w.add_body(grid_mesh(0.2, 0.1, 6, 3, angle=angle, center=tuple(0.05 * n)))
+    return w, b, n, t
+
+
+def place_gently(w, n, t, seconds=0.3):
+    """Load the block as a hand setting it down would: normal weight at once, the pull along
+    the slope ramped up, so no dynamic overshoot exceeds what the block carries at rest."""
+    g = np.array([0.0, -G])
+    while w.time < seconds:
+        lam = min(w.time / seconds, 1.0)
+        w.gravity = tuple((g @ n) * n + lam * (g @ t) * t)
+        w.step()
+    w.gravity = tuple(g)
+
+
+@pytest.mark.parametrize("rect_coefficients", [False, True])
+def test_block_stays_on_slope_below_static_friction(rect_coefficients):
+    # tan 20 deg = 0.36 < static 0.5, but > dynamic 0.3: any slip would run away
+    w, b, n, t = slope_world(20.0, rect_coefficients=rect_coefficients)
+    place_gently(w, n, t)
+    for _ in range(int(0.5 / w.dt)):  # settle
+        w.step()
+    s0, t0 = b.center_of_mass @ t, w.time
+    for _ in range(int(1.0 / w.dt)):
+        w.step()
+    creep = abs(b.center_of_mass @ t - s0) / (w.time - t0)
+    assert creep < 1e-3  # m/s: truly stays
+    assert np.abs(b.velocities).max() < 1e-3
+
+
+def test_block_dropped_on_gentle_slope_stays():
+    # tan 15 deg = 0.27 is below even the dynamic coefficient: no gentle placing needed
+    w, b, n, t = slope_world(15.0)
+    for _ in range(int(0.5 / w.dt)):
+        w.step()
+    s0 = b.center_of_mass @ t
+    for _ in range(int(0.5 / w.dt)):
+        w.step()
+    assert abs(b.center_of_mass @ t - s0) / 0.5 < 1e-3
+
+
+@pytest.mark.parametrize("angle, mu_s, mu_d", [(35.0, 0.5, 0.3), (30.0, 0.4, 0.1), (25.0, 0.0, 0.0)])
+def test_block_slides_with_acceleration_g_sin_minus_mu_cos(angle, mu_s, mu_d):
+    w, b, n, t = slope_world(angle, mu_s=mu_s, mu_d=mu_d, damping=2.0)
+    times, along = [], []
+    for _ in range(int(1.0 / w.dt)):
+        w.step()
+        times.append(w.time)
+        along.append(b.center_of_mass @ t)
+    times, along = np.array(times), np.array(along)
+    late = times > 0.3
+    accel = -2 * np.polyfit(times[late], along[late], 2)[0]  # down the slope is -t
+    a = math.radians(angle)
+    assert accel == pytest.approx(G * (math.sin(a) - mu_d * math.cos(a)), rel=0.03)
+    # it slides on the surface, neither sinking in nor lifting off
+    assert np.abs(b.positions @ n).min() < 1e-6
+    assert (b.positions @ n).min() > 0
+
+
+def test_dropped_body_comes_to_rest_on_a_plane_without_sinking_or_jitter():
+    w = deforma.World(dt=1 / 1000, substeps=8, stiffness=2e4, damping=20.0, friction=0.3, static_friction=0.5)
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
+    b = w.add_body(grid_mesh(0.4, 0.2, 9, 5), position=(0.0, 0.5))
+    b.velocities[:] = (0.3, 0.0)
+    for _ in range(int(1.5 / w.dt)):
+        w.step()
+    heights = []
+    for _ in range(int(0.3 / w.dt)):
+        w.step()
+        heights.append(b.center_of_mass[1])
+    y = b.positions[:, 1]
+    assert y.min() > 0.0  # not in the ground
+    assert y.min() < 1e-6  # but on it
+    assert np.ptp(heights) < 1e-5  # no jitter
+    assert np.abs(b.velocities).max() < 1e-3
+    assert heights[-1] == pytest.approx(0.1, abs=0.01)  # sagging a little under its weight
+
+
+def test_vertex_spawned_inside_is_pushed_out_the_shortest_way():
+    w = deforma.World(dt=1 / 1000, gravity=(0, 0))
+    w.add_collider(deforma.Rect((0, 0), (4, 2), 0.0))  # top face at y = 1
+    b = w.add_body(grid_mesh(0.2, 0.1, 3, 2), position=(0.3, 0.9))  # straddling the top face
+    w.step()
+    assert not deforma.Rect((0, 0), (4, 2), 0.0).contains(b.positions).any()
+    assert b.positions[:, 1].min() >= 1.0
+    assert np.abs(b.positions[:, 0] - np.repeat([[0.2, 0.3, 0.4]], 2, axis=0).ravel()).max() < 1e-9
+
+
+def test_moving_a_collider_onto_a_body_pushes_it_out():
+    w = deforma.World(dt=1 / 1000)
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
+    b = w.add_body(grid_mesh(0.2, 0.1, 3, 2), position=(0.0, 0.05))
+    w.step()
+    w.colliders[0] = deforma.Rect((0, -0.47), (10, 1.0), 0.0)  # raised 3 cm into the body
+    w.step()
+    assert b.positions[:, 1].min() >= 0.03
+    w.friction = 0.1  # world coefficients feed colliders that leave them unset
+    w.step()
+    assert not w.colliders[0].contains(b.positions).any()
+
+
+@settings(max_examples=15, deadline=None)
+@given(angles=st.lists(st.floats(-60, 60), min_size=3, max_size=3),
+       offsets=st.lists(st.floats(-0.4, 0.4), min_size=3, max_size=3),
+       vx=st.floats(-3, 3), drop=st.floats(0.2, 1.0))
+def test_no_vertex_is_ever_inside_a_rectangle_after_a_step(angles, offsets, vx, drop):
+    w = deforma.World(dt=1 / 1000, stiffness=3000.0, damping=1.0, friction=0.2, static_friction=0.4)
+    rects = [deforma.Rect((offsets[0], -0.2), (3.0, 0.2), angles[0] / 4),
+             deforma.Rect((offsets[1] + 0.5, 0.0), (0.6, 0.3), angles[1]),   # overlaps the floor
+             deforma.Rect((offsets[2] - 0.6, 0.1), (0.4, 0.05), angles[2])]
+    for r in rects:
+        w.add_collider(r)
+    b = w.add_body(grid_mesh(0.3, 0.15, 6, 4), position=(0.0, 0.3 + drop))
+    b.velocities[:] = (vx, -2.0)
+    for _ in range(400):
+        w.step()
+        for r in rects:
+            assert not r.contains(b.positions).any()

@@ -1,0 +1,198 @@
+"""World API: interaction (explode, grab), safety (instability, validation), bookkeeping."""
+
+import math
+
+import numpy as np
+import pytest
+
+import deforma
+from deforma.physics import available_integrators
+from physics_meshes import Chain, grid_mesh
+
+
+def test_explode_lifts_the_body():
+    w = deforma.World(dt=1 / 1000)
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
+    b = w.add_body(grid_mesh(0.2, 0.1, 4, 3), position=(0, 0.05))
+    for _ in range(200):
+        w.step()
+    y0 = b.center_of_mass[1]
+    w.explode(3.0)
+    assert b.velocities[:, 1].mean() == pytest.approx(3.0, abs=0.05)
+    top = y0
+    for _ in range(400):
+        w.step()
+        top = max(top, b.center_of_mass[1])
+    assert top - y0 == pytest.approx(3.0 ** 2 / (2 * 9.81), rel=0.1)  # rises about v^2 / 2g
+
+
+def test_radial_explosion_pushes_away_from_the_centre_and_keeps_momentum():
+    w = deforma.World(gravity=(0, 0))
+    b = w.add_body(grid_mesh(0.4, 0.4, 5, 5), position=(1.0, 1.0))
+    w.explode(2.0, center=(1.0, 1.0))
+    d = b.positions - (1.0, 1.0)
+    radial = np.einsum("ij,ij->i", b.velocities, d)
+    r = np.linalg.norm(d, axis=1)
+    assert np.all(radial[r > 0] > 0)
+    assert np.allclose(np.linalg.norm(b.velocities[r > 0], axis=1), 2.0)
+    assert np.abs(b.velocities.sum(axis=0)).max() < 1e-9  # symmetric grid around the centre
+
+
+def test_dragging_pulls_the_body_toward_the_target_and_release_stops_it():
+    w = deforma.World(gravity=(0, 0), dt=1 / 1000, stiffness=2000.0, damping=2.0)
+    b = w.add_body(grid_mesh(0.2, 0.2, 5, 5), position=(0, 0))
+    g = w.grab((0.01, 0.01), strength=20.0, radius=0.06)
+    assert g.body is b and 3 <= len(g.vertices) < b.n_vertices
+    w.drag(g, (1.0, 0.0))
+    for _ in range(300):
+        w.step()
+    assert b.center_of_mass[0] > 0.05
+    assert abs(b.center_of_mass[1]) < 0.02
+    w.release(g)
+    w.release(g)  # twice is harmless
+    p0 = b.velocities.sum(axis=0).copy()
+    for _ in range(100):
+        w.step()
+    assert np.abs(b.velocities.sum(axis=0) - p0).max() < 1e-9  # no pull any more
+    with pytest.raises(ValueError, match="released"):
+        w.drag(g, (0, 0))
+
+
+def test_grab_picks_the_triangle_under_the_point_or_nothing():
+    w = deforma.World()
+    b = w.add_body(grid_mesh(1.0, 1.0, 3, 3), position=(0, 0))
+    g = w.grab((0.1, 0.2))
+    assert len(g.vertices) == 3 and g.body is b
+    tri = b.positions[g.vertices]
+    assert np.all(tri.min(axis=0) <= (0.1, 0.2)) and np.all(tri.max(axis=0) >= (0.1, 0.2))
+    off = w.grab((3.0, 3.0), radius=0.5)
+    assert off.body is None and len(off.vertices) == 0
+    w.step()  # an empty grab does nothing and breaks nothing
+    assert len(w.grab((0.0, 0.0), radius=10.0).vertices) == 9
+    chain = w.add_body(Chain([[5, 0], [6, 0]], [[0, 1]]), position=None)
+    assert len(w.grab((5.0, 0.0)).vertices) == 0  # no triangles: only a radius picks
+    assert w.grab((5.0, 0.0), radius=0.1).body is chain
+
+
+def test_absurd_dt_raises_and_keeps_the_state_before_the_failing_step():
+    w = deforma.World(dt=0.05, stiffness=5000.0, gravity=(0, -9.81))
+    b = w.add_body(grid_mesh(0.2, 0.1, 4, 3), position=(0, 0))
+    b.positions[0] += 0.01
+    with pytest.raises(deforma.SimulationUnstable) as info:
+        for _ in range(1000):
+            before_x, before_v = b.positions.copy(), b.velocities.copy()
+            w.step()
+    e = info.value
+    assert e.body is b and e.step == w.step_count
+    assert "dt" in str(e) and "stable estimate" in e.hint and "substeps" in e.hint
+    assert np.array_equal(b.positions, before_x) and np.array_equal(b.velocities, before_v)
+    # the world stays usable: reset the body, shorten the substeps below the estimate, go on
+    w.substeps = math.ceil(w.dt / w.stable_dt())
+    b.positions = b.topology.rest_positions
+    b.velocities = (0.0, 0.0)
+    for _ in range(20):
+        w.step()
+    assert np.all(np.isfinite(b.positions))
+
+
+def test_stable_dt_is_the_true_limit_for_two_masses_on_a_spring():
+    # Gershgorin's bound is exact here: omega^2 = k / mu = 2 k / m_vertex
+    w = deforma.World(gravity=(0, 0), mass=2.0, stiffness=100.0, damping=0.0, max_speed=1e6)
+    b = w.add_body(Chain([[0, 0], [1, 0]], [[0, 1]]), position=None)
+    assert w.stable_dt() == pytest.approx(2 / math.sqrt(2 * 100 / 1.0))
+    for factor, stable in ((0.95, True), (1.05, False)):
+        w.dt = factor * w.stable_dt()
+        b.positions[:] = [[0, 0], [1.01, 0]]
+        b.velocities[:] = 0
+        try:
+            for _ in range(3000):
+                w.step()
+            ok = True
+        except deforma.SimulationUnstable:
+            ok = False
+        assert ok is stable
+
+
+def test_positions_and_velocities_are_views_into_one_contiguous_state():
+    w = deforma.World()
+    a = w.add_body(grid_mesh(0.2, 0.1, 3, 2), position=(0, 0))
+    b = w.add_body(grid_mesh(0.2, 0.1, 4, 2), position=(1, 0))
+    assert np.shares_memory(a.positions, w._state.x) and np.shares_memory(b.velocities, w._state.v)
+    assert (a.vertex_slice, b.vertex_slice) == (slice(0, 6), slice(6, 14))
+    b.positions[0] = (5.0, 5.0)
+    assert tuple(w._state.x[6]) == (5.0, 5.0)
+    w.remove_body(a)
+    assert w.bodies == [b] and b.index == 0 and tuple(b.positions[0]) == (5.0, 5.0)
+    with pytest.raises(ValueError, match="unknown body"):
+        w.remove_body(a)
+    with pytest.raises(ValueError, match="removed"):
+        a.positions
+
+
+def test_body_parameters_follow_the_world_unless_overridden():
+    w = deforma.World(mass=2.0, stiffness=100.0)
+    a = w.add_body(grid_mesh(0.2, 0.1, 3, 2))
+    b = w.add_body(grid_mesh(0.2, 0.1, 3, 2), stiffness=50.0, mass=6.0)
+    w.stiffness = 300.0
+    assert (a.stiffness, b.stiffness) == (300.0, 50.0)
+    assert w._model.spring_stiffness[: a.n_springs].tolist() == [300.0] * a.n_springs
+    assert w._model.vertex_mass[a.n_vertices:].tolist() == [1.0] * b.n_vertices
+    b.stiffness = None
+    assert b.stiffness == 300.0
+    assert w.energy(a).kinetic == 0.0
+
+
+def test_energy_components_have_the_textbook_values():
+    w = deforma.World(gravity=(0, -10.0), mass=2.0, stiffness=100.0)
+    b = w.add_body(Chain([[0, 1], [1, 1]], [[0, 1]]), position=None)
+    b.positions[1] = (1.5, 1.0)
+    b.velocities[:] = (3.0, 0.0)
+    e = w.energy()
+    assert (e.kinetic, e.spring, e.gravitational) == pytest.approx((9.0, 12.5, 20.0))
+    assert e.total == pytest.approx(41.5)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(dt=0), "dt must be > 0"), (dict(dt=-1e-3), "dt must be > 0"), (dict(dt=float("nan")), "dt must be finite"),
+    (dict(mass=-1), "mass must be > 0"), (dict(stiffness=-5), "stiffness must be >= 0"),
+    (dict(damping="x"), "damping must be a number"), (dict(substeps=0), "substeps"),
+    (dict(substeps=2.5), "substeps"), (dict(gravity=(0, float("nan"))), "gravity"),
+    (dict(friction=-0.1), "friction must be >= 0"), (dict(max_speed=0), "max_speed"),
+    (dict(integrator="rk4"), "unknown integrator 'rk4'; available: symplectic-euler"),
+])
+def test_world_arguments_are_validated(kwargs, match):
+    with pytest.raises(ValueError, match=match) as info:
+        deforma.World(**kwargs)
+    assert "\n" not in str(info.value)
+
+
+def test_other_arguments_are_validated():
+    w = deforma.World()
+    m = grid_mesh(0.2, 0.1, 3, 2)
+    bad = [
+        lambda: w.add_body(m, position=(0, float("nan"))),
+        lambda: w.add_body(m, mass=-1.0),
+        lambda: w.add_body("not a mesh"),
+        lambda: w.add_body(Chain([[0, 0], [0, 0]], [[0, 1]])),
+        lambda: w.add_collider((0, 0, 1, 1)),
+        lambda: deforma.Rect((0, 0), (1, -1), 0.0),
+        lambda: deforma.Rect((0, float("inf")), (1, 1), 0.0),
+        lambda: deforma.Rect((0, 0), (1, 1), 0.0, friction=-1),
+        lambda: w.energy(object()),
+        lambda: w.explode(float("nan")),
+        lambda: w.grab((0, 0), strength=0),
+        lambda: w.grab((0, 0), radius=-1),
+        lambda: w.drag(deforma.World().grab((0, 0)), (1, 1)),
+    ]
+    for f in bad:
+        with pytest.raises(ValueError) as info:
+            f()
+        assert "\n" not in str(info.value)
+    w.colliders.append("junk")
+    with pytest.raises(ValueError, match="only deforma.Rect"):
+        w.step()
+
+
+def test_integrator_registry_names_the_choices():
+    assert "symplectic-euler" in available_integrators()
+    assert deforma.World(integrator="symplectic-euler").integrator == "symplectic-euler"
