@@ -102,6 +102,8 @@ def turns(q):
     f = np.roll(e, -1, axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         s = (e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]) / (np.hypot(*e.T) * np.hypot(*f.T))
+    if np.hypot(*e.T).min() < 1e-6 * np.ptp(q, axis=0).max():
+        return np.zeros(4)  # corners too close to tell apart: not a clear quad
     return np.nan_to_num(s)
 
 
