@@ -95,35 +95,23 @@ def make_integrator(name: str) -> Integrator:
 
 
 @njit(cache=True, inline="always")
-def _vertex_update(i, x, v, x_start, v_start, save, fe, adj_ptr, adj_spring, adj_sign, inv_mass,
-                   gx, gy, grab_slot, grab_pull, rects, h, vmax2):
-    x0 = x[i, 0]
-    y0 = x[i, 1]
-    vx = v[i, 0]
-    vy = v[i, 1]
-    if save:
-        x_start[i, 0] = x0
-        x_start[i, 1] = y0
-        v_start[i, 0] = vx
-        v_start[i, 1] = vy
-    fx, fy = gather_spring_force(fe, adj_ptr, adj_spring, adj_sign, i)
-    px_, py_ = grab_force(x0, y0, grab_slot[i], grab_pull)
-    w = inv_mass[i]
-    vx += h * ((fx + px_) * w + gx)
-    vy += h * ((fy + py_) * w + gy)
-    px = x0 + h * vx
-    py = y0 + h * vy
-    if rects.shape[0] > 0:
-        px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
-    x[i, 0] = px
-    x[i, 1] = py
-    v[i, 0] = vx
-    v[i, 1] = vy
-    # written so that NaN fails the test too; x - x is NaN for inf and NaN
+def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, h):
+    vx += h * (fx * inv_mass + gx)
+    vy += h * (fy * inv_mass + gy)
+    return x0 + h * vx, y0 + h * vy, vx, vy
+
+
+@njit(cache=True, inline="always")
+def _is_bad(px, py, vx, vy, vmax2):
+    # written so that NaN fails the test too; p - p is NaN for inf and NaN
     if vx * vx + vy * vy <= vmax2 and (px - px) == 0.0 and (py - py) == 0.0:
         return 0
     return 1
 
+
+# The per-vertex loop bodies below are spelled out in both drivers on purpose: moving them
+# into a helper that takes the dozen arrays costs an atomic reference-count update per array
+# per vertex (Numba does not prune them across the helper's branches), 10x the useful work.
 
 @njit(cache=True)
 def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest, ks, kd,
@@ -134,12 +122,22 @@ def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest
     Saves the start state into ``x_start`` / ``v_start``; stops early and returns the
     number of vertices that ended non-finite or faster than ``sqrt(vmax2)`` m/s.
     """
+    collide = rects.shape[0] > 0
     for sub in range(substeps):
         spring_forces_serial(x, v, spring_i, spring_j, rest, ks, kd, fe)
+        save = sub == 0
         bad = 0
         for i in range(x.shape[0]):
-            bad += _vertex_update(i, x, v, x_start, v_start, sub == 0, fe, adj_ptr, adj_spring, adj_sign,
-                                  inv_mass, gx, gy, grab_slot, grab_pull, rects, h, vmax2)
+            x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
+            if save:
+                x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
+            fx, fy = gather_spring_force(fe, adj_ptr, adj_spring, adj_sign, i)
+            qx, qy = grab_force(x0, y0, grab_slot[i], grab_pull)
+            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx + qx, fy + qy, inv_mass[i], gx, gy, h)
+            if collide:
+                px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
+            x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
+            bad += _is_bad(px, py, vx, vy, vmax2)
         if bad:
             return bad
     return 0
@@ -150,19 +148,26 @@ def symplectic_euler_parallel(x, v, x_start, v_start, fe, spring_i, spring_j, re
                               adj_ptr, adj_spring, adj_sign, inv_mass, gx, gy, grab_slot, grab_pull,
                               rects, h, substeps, vmax2):
     """:func:`symplectic_euler_serial` on all cores (same arguments, same result)."""
+    collide = rects.shape[0] > 0
     for sub in range(substeps):
         for e in prange(spring_i.shape[0]):
             a = spring_i[e]
             b = spring_j[e]
-            fx, fy = spring_force(x[a, 0], x[a, 1], x[b, 0], x[b, 1], v[a, 0], v[a, 1], v[b, 0], v[b, 1],
-                                  rest[e], ks[e], kd[e])
-            fe[e, 0] = fx
-            fe[e, 1] = fy
-        bad = 0
+            fe[e, 0], fe[e, 1] = spring_force(x[a, 0], x[a, 1], x[b, 0], x[b, 1], v[a, 0], v[a, 1],
+                                              v[b, 0], v[b, 1], rest[e], ks[e], kd[e])
         save = sub == 0
+        bad = 0
         for i in prange(x.shape[0]):
-            bad += _vertex_update(i, x, v, x_start, v_start, save, fe, adj_ptr, adj_spring, adj_sign,
-                                  inv_mass, gx, gy, grab_slot, grab_pull, rects, h, vmax2)
+            x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
+            if save:
+                x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
+            fx, fy = gather_spring_force(fe, adj_ptr, adj_spring, adj_sign, i)
+            qx, qy = grab_force(x0, y0, grab_slot[i], grab_pull)
+            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx + qx, fy + qy, inv_mass[i], gx, gy, h)
+            if collide:
+                px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
+            x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
+            bad += _is_bad(px, py, vx, vy, vmax2)
         if bad:
             return bad
     return 0
