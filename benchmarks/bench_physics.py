@@ -220,6 +220,8 @@ def _per_step(fn, steps, repeat):
 def run(quick: bool) -> list[Row]:
     sides = (32, 100) if quick else (32, 100, 316)
     repeat = 3 if quick else 7
+    # threads that must meet at a barrier suffer most from other busy processes: say so
+    print(f"physics: load average at start {os.getloadavg()[0]:.2f}", file=sys.stderr)
     rows: list[Row] = []
     taichi_cases = []
     for n in sides:
@@ -271,6 +273,7 @@ def run(quick: bool) -> list[Row]:
     except Exception as err:  # noqa: BLE001 - a missing or broken optional peer is reported, not fatal
         print(f"physics: taichi unavailable ({err}); its rows are skipped", file=sys.stderr)
         return rows
+    print(f"physics: load average before Taichi {os.getloadavg()[0]:.2f}", file=sys.stderr)
     for nv, t_deforma, steps, arrays, h in taichi_cases:
         tstep = TaichiStep(*arrays)
         t_taichi = _per_step(lambda: tstep.step(h), steps, repeat)

@@ -169,6 +169,7 @@ def test_world_arguments_are_validated(kwargs, match):
 def test_other_arguments_are_validated():
     w = deforma.World()
     m = grid_mesh(0.2, 0.1, 3, 2)
+    body = w.add_body(m)
     bad = [
         lambda: w.add_body(m, position=(0, float("nan"))),
         lambda: w.add_body(m, mass=-1.0),
@@ -183,6 +184,8 @@ def test_other_arguments_are_validated():
         lambda: w.grab((0, 0), strength=0),
         lambda: w.grab((0, 0), radius=-1),
         lambda: w.drag(deforma.World().grab((0, 0)), (1, 1)),
+        lambda: setattr(body, "positions", (0.0, 0.0)),
+        lambda: setattr(body, "velocities", np.full((6, 2), np.nan)),
     ]
     for f in bad:
         with pytest.raises(ValueError) as info:

@@ -29,8 +29,8 @@ from typing import Callable, Protocol
 import numpy as np
 from numba import njit, prange
 
-from .colliders import collide_point
-from .forces import gather_spring_force, grab_force, spring_force, spring_forces_serial
+from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point
+from .forces import spring_force, spring_forces_serial
 
 # Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
 PARALLEL_MIN_VERTICES = 512
@@ -109,9 +109,10 @@ def _is_bad(px, py, vx, vy, vmax2):
     return 1
 
 
-# The per-vertex loop bodies below are spelled out in both drivers on purpose: moving them
-# into a helper that takes the dozen arrays costs an atomic reference-count update per array
-# per vertex (Numba does not prune them across the helper's branches), 10x the useful work.
+# The per-vertex loop bodies below are spelled out in both drivers on purpose, helpers that
+# take arrays included: every array passed to a compiled helper per vertex costs atomic
+# reference-count updates that Numba does not always prune (a helper taking the dozen
+# arrays made the step 10x slower). Scalar-only helpers are free.
 
 @njit(cache=True)
 def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest, ks, kd,
@@ -122,7 +123,7 @@ def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest
     Saves the start state into ``x_start`` / ``v_start``; stops early and returns the
     number of vertices that ended non-finite or faster than ``sqrt(vmax2)`` m/s.
     """
-    collide = rects.shape[0] > 0
+    n_rects = rects.shape[0]
     for sub in range(substeps):
         spring_forces_serial(x, v, spring_i, spring_j, rest, ks, kd, fe)
         save = sub == 0
@@ -131,10 +132,22 @@ def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest
             x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
             if save:
                 x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
-            fx, fy = gather_spring_force(fe, adj_ptr, adj_spring, adj_sign, i)
-            qx, qy = grab_force(x0, y0, grab_slot[i], grab_pull)
-            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx + qx, fy + qy, inv_mass[i], gx, gy, h)
-            if collide:
+            fx = 0.0
+            fy = 0.0
+            for k in range(adj_ptr[i], adj_ptr[i + 1]):  # forces.gather_spring_force
+                e = adj_spring[k]
+                fx += adj_sign[k] * fe[e, 0]
+                fy += adj_sign[k] * fe[e, 1]
+            g = grab_slot[i]
+            if g >= 0:  # forces.grab_force
+                fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
+                fy += grab_pull[g, 2] - grab_pull[g, 0] * y0
+            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass[i], gx, gy, h)
+            near = False
+            for r in range(n_rects):  # broad phase: bounding boxes
+                if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
+                    near = True
+            if near:
                 px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
             x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
             bad += _is_bad(px, py, vx, vy, vmax2)
@@ -148,7 +161,7 @@ def symplectic_euler_parallel(x, v, x_start, v_start, fe, spring_i, spring_j, re
                               adj_ptr, adj_spring, adj_sign, inv_mass, gx, gy, grab_slot, grab_pull,
                               rects, h, substeps, vmax2):
     """:func:`symplectic_euler_serial` on all cores (same arguments, same result)."""
-    collide = rects.shape[0] > 0
+    n_rects = rects.shape[0]
     for sub in range(substeps):
         for e in prange(spring_i.shape[0]):
             a = spring_i[e]
@@ -161,10 +174,22 @@ def symplectic_euler_parallel(x, v, x_start, v_start, fe, spring_i, spring_j, re
             x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
             if save:
                 x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
-            fx, fy = gather_spring_force(fe, adj_ptr, adj_spring, adj_sign, i)
-            qx, qy = grab_force(x0, y0, grab_slot[i], grab_pull)
-            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx + qx, fy + qy, inv_mass[i], gx, gy, h)
-            if collide:
+            fx = 0.0
+            fy = 0.0
+            for k in range(adj_ptr[i], adj_ptr[i + 1]):  # forces.gather_spring_force
+                e = adj_spring[k]
+                fx += adj_sign[k] * fe[e, 0]
+                fy += adj_sign[k] * fe[e, 1]
+            g = grab_slot[i]
+            if g >= 0:  # forces.grab_force
+                fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
+                fy += grab_pull[g, 2] - grab_pull[g, 0] * y0
+            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass[i], gx, gy, h)
+            near = False
+            for r in range(n_rects):  # broad phase: bounding boxes
+                if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
+                    near = True
+            if near:
                 px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
             x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
             bad += _is_bad(px, py, vx, vy, vmax2)

@@ -142,7 +142,7 @@ class Body:
 
     @positions.setter
     def positions(self, value):
-        self.positions[...] = self._checked_array(value, "positions")
+        self.positions[...] = self._checked_array(value, "positions", shapes=((self.n_vertices, 2),))
 
     @property
     def velocities(self) -> np.ndarray:
@@ -151,13 +151,17 @@ class Body:
 
     @velocities.setter
     def velocities(self, value):
-        self.velocities[...] = self._checked_array(value, "velocities")
+        # a single (vx, vy) sets every vertex: the usual way to launch a body
+        self.velocities[...] = self._checked_array(value, "velocities", shapes=((self.n_vertices, 2), (2,)))
 
-    def _checked_array(self, value, name):
-        a = np.asarray(value, dtype=np.float64)
-        n = self.n_vertices
-        if a.shape not in ((n, 2), (2,)) or not np.all(np.isfinite(a)):
-            raise ValueError(f"{name} must be finite with shape ({n}, 2) or (2,), got shape {a.shape}")
+    def _checked_array(self, value, name, *, shapes):
+        try:
+            a = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be an array of numbers, got {type(value).__name__}") from None
+        if a.shape not in shapes or not np.all(np.isfinite(a)):
+            allowed = " or ".join(str(s) for s in shapes)
+            raise ValueError(f"{name} must be finite with shape {allowed}, got shape {a.shape}")
         return a
 
     @property
