@@ -15,6 +15,7 @@ Examples
 from . import mesh
 from .mesh.delaunay import delaunay
 from .physics import Rect, SimulationUnstable, World
+from .scene import load_scene, save_scene
 
-__all__ = ["Rect", "SimulationUnstable", "World", "delaunay", "mesh"]
+__all__ = ["Rect", "SimulationUnstable", "World", "delaunay", "load_scene", "mesh", "save_scene"]
 __version__ = "0.1.0"

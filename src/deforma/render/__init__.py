@@ -14,6 +14,7 @@ Examples
 
 from .renderer import Camera, MeshHandle, Renderer, collider_corners, create_headless_context
 from .video import FrameWriter, open_writer
+from .world_view import WorldView
 
 __all__ = ["Camera", "FrameWriter", "MeshHandle", "Renderer", "collider_corners", "create_headless_context",
-           "open_writer"]
+           "open_writer", "WorldView"]

@@ -264,6 +264,13 @@ class MeshHandle:
         edges = np.ascontiguousarray(edges, dtype=np.int32)
         self._edge_ibo = ctx.buffer(edges.tobytes())
         self.wire_vao = ctx.vertex_array(renderer._flat_prog, [(self._pos, "2f", "in_pos")], self._edge_ibo)
+        # the outline (edges of exactly one triangle) gives a flat-coloured body a crisp border
+        e = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
+        uniq, counts = np.unique(e, axis=0, return_counts=True)
+        outline = np.ascontiguousarray(uniq[counts == 1], dtype=np.int32)
+        self._outline_ibo = ctx.buffer(outline.tobytes()) if len(outline) else None
+        self.outline_vao = None if self._outline_ibo is None else ctx.vertex_array(
+            renderer._flat_prog, [(self._pos, "2f", "in_pos")], self._outline_ibo)
         self.texture = None
         if texture is not None:
             self.texture = renderer._make_texture(texture)
@@ -277,7 +284,8 @@ class MeshHandle:
         self._pos.write(self._scratch)
 
     def release(self) -> None:
-        for obj in (self.body_vao, self.wire_vao, self._pos, self._uv, self._ibo, self._edge_ibo, self.texture):
+        for obj in (self.body_vao, self.wire_vao, self.outline_vao, self._pos, self._uv, self._ibo,
+                    self._edge_ibo, self._outline_ibo, self.texture):
             if obj is not None:
                 obj.release()
 
@@ -543,11 +551,16 @@ class Renderer:
             handle.texture.use(0)
             p["u_tex"].value = 0
         handle.body_vao.render(moderngl.TRIANGLES)
+        f = self._flat_prog
         if wireframe:
-            f = self._flat_prog
             self._set_camera(f)
             f["u_color"].value = _as_rgba(wire_color) if wire_color is not None else WIREFRAME_COLOR
             handle.wire_vao.render(moderngl.LINES)
+        elif handle.texture is None and handle.outline_vao is not None:
+            self._set_camera(f)
+            r, g, b, a = handle.color
+            f["u_color"].value = (0.6 * r, 0.6 * g, 0.6 * b, a)
+            handle.outline_vao.render(moderngl.LINES)
 
     def finish(self) -> None:
         """Resolve multisampling into the readable framebuffer (called by :meth:`read`)."""

@@ -224,7 +224,8 @@ class GifWriter(FrameWriter):
     def _quantize(self, frame):
         from PIL import Image
 
-        return Image.fromarray(frame).quantize(palette=self._palette, dither=Image.Dither.NONE)
+        # error diffusion hides the banding a 256-colour palette gives smooth gradients
+        return Image.fromarray(frame).quantize(palette=self._palette, dither=Image.Dither.FLOYDSTEINBERG)
 
     def _build_palette(self):
         from PIL import Image

@@ -1,0 +1,361 @@
+"""The ``deforma`` command: run scenes headless into videos, draw meshes, list what is built in.
+
+``deforma run demo -o demo.mp4``    simulate the demo scene and write a video
+``deforma mesh bunny -o mesh.png``  a picture of a triangulation with its figures
+``deforma scenes``                  the built-in scenes and textures
+
+User mistakes (unknown scene, invalid file, output folder missing, unstable simulation) give
+one line on stderr and a non-zero exit code; ``--debug`` shows the traceback instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["main"]
+
+#: Exit codes: 1 a user error (scene, output, options), 3 the simulation became unstable,
+#: 4 rendering unavailable (no OpenGL), 130 interrupted (Ctrl-C).
+EXIT_ERROR, EXIT_UNSTABLE, EXIT_NO_GL, EXIT_INTERRUPTED = 1, 3, 4, 130
+
+
+class CliError(Exception):
+    """A one-line message for the user, with an exit code."""
+
+    def __init__(self, message: str, code: int = EXIT_ERROR):
+        super().__init__(message)
+        self.code = code
+
+
+# -- argument types -------------------------------------------------------------------------------
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels like 1280x720, got {text!r}") from None
+    if not (16 <= w <= 7680 and 16 <= h <= 4320):
+        raise argparse.ArgumentTypeError(f"width must be in [16, 7680] and height in [16, 4320] pixels, got {text!r}")
+    return w, h
+
+
+def _positive(kind, *, hi=None):
+    def parse(text):
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a {'number' if kind is float else 'whole number'}, "
+                                             f"got {text!r}") from None
+        if not (v > 0 and math.isfinite(v)) or (hi is not None and v > hi):
+            limit = f" and <= {hi:g}" if hi is not None else ""
+            raise argparse.ArgumentTypeError(f"must be > 0{limit}, got {text!r}")
+        return v
+    return parse
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="deforma", description="Deformable 2D objects: run scenes, draw meshes.")
+    p.add_argument("--debug", action="store_true", help="show the full traceback on errors")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    r = sub.add_parser("run", help="simulate a scene headless; write a video, PNG frames and/or states",
+                       description="Simulate a scene headless and write a video (MP4 or GIF), PNG frames "
+                                   "and/or the states (positions per frame, mesh, parameters) as .npz.")
+    r.add_argument("scene", metavar="SCENE", help="built-in scene name (see `deforma scenes`) or a .toml file")
+    r.add_argument("--seconds", type=_positive(float, hi=3600), help="simulated time (default: the scene's run.seconds)")
+    r.add_argument("--fps", type=_positive(float, hi=240), help="frames per second (default: the scene's run.fps)")
+    r.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="picture size (default 1280x720)")
+    r.add_argument("-o", "--output", metavar="OUT", help="out.mp4, out.gif, or a folder/ for PNG frames")
+    r.add_argument("--states", metavar="OUT.npz", help="save positions per frame, meshes and parameters")
+    r.add_argument("--wireframe", action="store_true", help="draw the springs over the bodies")
+    r.add_argument("--samples", type=int, default=4, choices=(0, 4), help="multisampling for smooth edges (default 4)")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    m = sub.add_parser("mesh", help="a picture of a triangulation with its figures (points, triangles, min angle)",
+                       description="Triangulate a built-in texture, an image file or a box (SOURCE = box) and "
+                                   "draw the triangles over the picture, like the original's figures 2-4.")
+    m.add_argument("source", metavar="SOURCE", help="bunny, donut, armadillo, an image path, or box")
+    m.add_argument("--resolution", type=_positive(int), default=4, help="image: sample every n-th pixel (default 4)")
+    m.add_argument("--detect-edges", action=argparse.BooleanOptionalAction, default=True,
+                   help="image: add points along the outline (default on)")
+    m.add_argument("--edge-step", type=_positive(int), default=2, help="image: every n-th outline pixel (default 2)")
+    m.add_argument("--detail", type=int, default=8, help="box: n*n interior points (default 8)")
+    m.add_argument("--edges", action=argparse.BooleanOptionalAction, default=False,
+                   help="box: points on the sides too (default off, as in the original)")
+    m.add_argument("--width", type=_positive(int, hi=8000), default=800, help="picture width in pixels (default 800)")
+    m.add_argument("-o", "--output", required=True, metavar="OUT.png", help="the picture to write")
+
+    sub.add_parser("scenes", help="list the built-in scenes and textures")
+    return p
+
+
+# -- run ----------------------------------------------------------------------------------------------
+def _check_states_path(path: str) -> None:
+    p = Path(path)
+    if p.suffix.lower() != ".npz":
+        raise CliError(f"{path}: states are written as .npz; give a name ending in .npz")
+    folder = p.parent
+    if not folder.is_dir():
+        raise CliError(f"{path}: the folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise CliError(f"{path}: the folder {str(folder)!r} is not writable")
+
+
+def _write_atomic(path: Path, write) -> None:
+    """Call ``write(file)`` on a temporary file beside ``path``, then rename it into place."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".partial{path.suffix}", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _save_states(path: str, world, scene, times, frames) -> None:
+    import tomli_w
+
+    from .scene.schema import scene_to_dict
+
+    arrays = {"time": np.asarray(times), "fps": np.float64(scene.run.fps), "dt": np.float64(world.dt)}
+    for i, b in enumerate(world.bodies):
+        arrays[f"body{i}_positions"] = np.stack([f[i] for f in frames])
+        arrays[f"body{i}_triangles"] = np.asarray(b.triangles)
+        arrays[f"body{i}_springs"] = np.asarray(b.springs)
+        arrays[f"body{i}_rest"] = np.asarray(b.topology.rest_positions)
+        uv = getattr(b.mesh, "uv", None)
+        if uv is not None:
+            arrays[f"body{i}_uv"] = np.asarray(uv)
+    arrays["colliders"] = np.array([[*c.center, *c.size, c.angle] for c in world.colliders],
+                                   dtype=np.float64).reshape(-1, 5)
+    arrays["scene_toml"] = np.array(tomli_w.dumps(scene_to_dict(scene, base_dir=Path(path).parent.resolve())))
+    _write_atomic(Path(path), lambda f: np.savez_compressed(f, **arrays))
+
+
+def _progress(total: int, enabled: bool, label: str):
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is a dependency; degrade to no bar
+        return None
+    # disable=None: tqdm draws only on a terminal, never into logs or pipes
+    return tqdm(total=total, unit="frame", desc=label, disable=None if enabled else True, leave=False,
+                dynamic_ncols=True)
+
+
+def cmd_run(a) -> int:
+    from dataclasses import replace
+
+    from . import scene as scenes
+    from .physics import SimulationUnstable
+
+    scene = scenes.load(a.scene)  # SceneError is a one-line ValueError
+    seconds = a.seconds if a.seconds is not None else scene.run.seconds
+    fps = a.fps if a.fps is not None else scene.run.fps
+    scene = replace(scene, run=replace(scene.run, seconds=float(seconds), fps=float(fps)))
+    # check every output before any work, so a typo does not cost a whole simulation
+    if a.output:
+        from .render.video import check_output
+
+        check_output(a.output)
+    if a.states:
+        _check_states_path(a.states)
+    world = scene.build()
+    n_frames = max(1, int(round(seconds * fps)))
+
+    view = writer = None
+    if a.output:
+        from .render import Renderer, WorldView, open_writer
+
+        try:
+            renderer = Renderer.headless(a.size, samples=a.samples)
+        except RuntimeError as e:
+            raise CliError(str(e), EXIT_NO_GL) from None
+        view = WorldView(renderer, world)
+        if a.wireframe:
+            view.wireframe = True
+        writer = open_writer(a.output, fps=fps)
+
+    events = sorted(scene.event, key=lambda e: e.time)
+    times, frames = [], []
+    label = Path(a.scene).stem if a.scene.endswith(".toml") else a.scene
+    bar = _progress(n_frames, not a.quiet, label)
+    t_wall = time.perf_counter()
+    try:
+        for k in range(n_frames):
+            t_frame = k / fps
+            # step until the world's clock reaches this frame (dt need not divide 1/fps)
+            while world.time < t_frame - 0.5 * world.dt:
+                while events and events[0].time <= world.time + 0.5 * world.dt:
+                    e = events.pop(0)
+                    world.explode(e.strength if e.strength is not None else scene.interaction.explosive_force)
+                world.step()
+            if writer is not None:
+                writer.write(view.draw())
+            if a.states:
+                times.append(world.time)
+                frames.append([b.positions.copy() for b in world.bodies])
+            if bar is not None:
+                bar.update(1)
+        if writer is not None:
+            writer.close()
+        if a.states:
+            _save_states(a.states, world, scene, times, frames)
+    except SimulationUnstable as e:
+        raise CliError(f"{a.scene}: simulation became unstable at t = {world.time:.3f} s: {e}; "
+                       f"nothing was written", EXIT_UNSTABLE) from None
+    finally:
+        if bar is not None:
+            bar.close()
+        if writer is not None:
+            writer.abort()  # no-op after close(); discards the temporary file otherwise
+    wall = time.perf_counter() - t_wall
+    outputs = [o for o in (a.output, a.states) if o]
+    sim = world.time
+    print(f"{label}: {n_frames} frames, {sim:.2f} s simulated in {wall:.2f} s wall "
+          f"({sim / wall if wall > 0 else float('inf'):.2f}x real time)"
+          + (f" -> {', '.join(outputs)}" if outputs else ""))
+    return 0
+
+
+# -- mesh ---------------------------------------------------------------------------------------------
+def _mesh_picture(mesh, picture, width: int, caption: str):
+    """Triangles over the picture (or a plain background for a box), with a caption bar."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    ss = 2  # draw at twice the size and shrink: smooth lines without an antialiasing library
+    v = mesh.vertices
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    span = np.maximum(hi - lo, 1e-12)
+    margin = 0.06
+    aspect = span[1] / span[0]
+    W = width * ss
+    inner_w = W * (1 - 2 * margin)
+    inner_h = inner_w * aspect
+    H = int(round(inner_h + 2 * margin * W))
+    pad = margin * W
+    scale = inner_w / span[0]
+
+    def to_px(p):
+        return np.c_[pad + (p[:, 0] - lo[0]) * scale, pad + (hi[1] - p[:, 1]) * scale]
+
+    img = Image.new("RGB", (W, H), (246, 244, 239))
+    if picture is not None:
+        # place the picture so that its uv square maps where the vertices' uv say
+        uv = mesh.uv
+        A = np.c_[uv, np.ones(len(uv))]
+        coef, *_ = np.linalg.lstsq(A, v, rcond=None)  # v ~ uv @ coef[:2] + coef[2]
+        corners = np.array([[0, 1, 1], [1, 1, 1]]) @ coef  # uv (0,1) top-left, (1,1) top-right
+        origin = np.array([0, 0, 1]) @ coef
+        tl, tr, bl = to_px(corners[:1]), to_px(corners[1:]), to_px(origin[None])
+        pw, ph = int(round(tr[0, 0] - tl[0, 0])), int(round(bl[0, 1] - tl[0, 1]))
+        if pw > 0 and ph > 0:
+            pic = Image.fromarray(picture).convert("RGBA").resize((pw, ph), Image.LANCZOS)
+            faded = Image.new("RGBA", pic.size, (246, 244, 239, 255))
+            faded.alpha_composite(pic)
+            img.paste(faded.convert("RGB"), (int(round(tl[0, 0])), int(round(tl[0, 1]))))
+    draw = ImageDraw.Draw(img)
+    px = to_px(v)
+    line = (31, 58, 104)
+    for i, j in mesh.edges:
+        draw.line([tuple(px[i]), tuple(px[j])], fill=line, width=ss)
+    r = 2.2 * ss
+    for x, y in px:
+        draw.ellipse([x - r, y - r, x + r, y + r], fill=(214, 69, 65))
+    img = img.resize((width, int(round(H / ss))), Image.LANCZOS)
+    bar_h = 34
+    out = Image.new("RGB", (img.width, img.height + bar_h), (255, 255, 255))
+    out.paste(img, (0, 0))
+    d = ImageDraw.Draw(out)
+    try:
+        font = ImageFont.load_default(size=16)
+    except TypeError:  # Pillow < 10.1
+        font = ImageFont.load_default()
+    d.text((12, img.height + 8), caption, fill=(30, 30, 30), font=font)
+    return out
+
+
+def cmd_mesh(a) -> int:
+    from . import mesh as meshes
+    from .scene.assets import builtin_textures, load_texture, resolve_texture
+
+    out = Path(a.output)
+    if out.suffix.lower() != ".png":
+        raise CliError(f"{a.output}: the picture is written as PNG; give a name ending in .png")
+    if not out.parent.is_dir():
+        raise CliError(f"{a.output}: the folder {str(out.parent)!r} does not exist")
+    if not os.access(out.parent, os.W_OK | os.X_OK):
+        raise CliError(f"{a.output}: the folder {str(out.parent)!r} is not writable")
+    t0 = time.perf_counter()
+    if a.source == "box":
+        m = meshes.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=a.detail, edges=a.edges)
+        picture = None
+        what = f"box, detail {a.detail}{', edges' if a.edges else ''}"
+    else:
+        ref = resolve_texture(a.source, base_dir=Path.cwd())
+        m = meshes.from_image(ref, resolution=a.resolution, detect_edges=a.detect_edges, edge_step=a.edge_step)
+        picture = m.texture if getattr(m, "texture", None) is not None else load_texture(ref)
+        name = a.source if a.source in builtin_textures() else Path(a.source).name
+        what = (f"{name}, resolution {a.resolution}"
+                + (f", edges every {a.edge_step} px" if a.detect_edges else ", no edge detection"))
+    seconds = time.perf_counter() - t0
+    min_angle = float(m.min_angle) if hasattr(m, "min_angle") else float("nan")
+    caption = (f"{what}: {len(m.vertices)} points, {len(m.triangles)} triangles, "
+               f"min angle {min_angle:.1f}\N{DEGREE SIGN}")
+    img = _mesh_picture(m, picture, a.width, caption)
+    _write_atomic(out, lambda f: img.save(f, format="PNG"))
+    print(f"{caption} (meshed in {seconds:.2f} s) -> {a.output}")
+    return 0
+
+
+# -- scenes -------------------------------------------------------------------------------------------
+def cmd_scenes(a) -> int:
+    from . import scene as scenes
+
+    print("built-in scenes (deforma run NAME):")
+    names = scenes.builtin_scenes()
+    width = max((len(n) for n in names), default=0)
+    for name in names:
+        try:
+            desc = scenes.load(name).scene.description
+        except ValueError as e:  # a broken built-in must not hide the others
+            desc = f"(cannot load: {e})"
+        print(f"  {name:<{width}}  {desc}")
+    print("built-in textures (texture = or source = in a scene, deforma mesh NAME):")
+    print("  " + (", ".join(scenes.builtin_textures()) or "(none installed)"))
+    return 0
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``deforma`` command; returns the exit code."""
+    parser = _parser()
+    a = parser.parse_args(argv)
+    commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes}
+    try:
+        return commands[a.command](a)
+    except KeyboardInterrupt:
+        if a.debug:
+            raise
+        print("deforma: interrupted; no partial output was left", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except CliError as e:
+        if a.debug:
+            raise
+        print(f"deforma: error: {e}", file=sys.stderr)
+        return e.code
+    except (ValueError, OSError) as e:
+        if a.debug:
+            raise
+        print(f"deforma: error: {e}", file=sys.stderr)
+        return EXIT_ERROR
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

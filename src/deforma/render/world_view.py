@@ -1,0 +1,93 @@
+"""Draw a whole :class:`deforma.World` with the looks its scene gives it (textures, colours, camera).
+
+Shared by ``deforma run`` and the viewer: it uploads each body's triangles, uv and texture
+once and then, per frame, only the positions.
+"""
+
+from __future__ import annotations
+
+from .renderer import Camera, Renderer, _as_rgba
+
+__all__ = ["BODY_PALETTE", "WorldView"]
+
+#: Colours for bodies that name neither a colour nor a texture, in order of the bodies.
+BODY_PALETTE = ("#e07a5f", "#3d9970", "#f2a541", "#5b8def", "#b56576", "#81b29a")
+
+
+class WorldView:
+    """A renderer bound to a world: ``view.draw()`` paints the world's current state.
+
+    Parameters
+    ----------
+    renderer : Renderer
+    world : deforma.World
+    scene : deforma.scene.Scene, optional
+        Camera, background, wireframe and each body's colour/texture. Default: the scene the
+        world was built from (``deforma.scene.scene_of(world)``).
+
+    Examples
+    --------
+    >>> import deforma
+    >>> from deforma.render import Renderer, WorldView
+    >>> world = deforma.load_scene("sample")
+    >>> view = WorldView(Renderer.headless((320, 180)), world)
+    >>> view.draw().shape
+    (180, 320, 3)
+    """
+
+    def __init__(self, renderer: Renderer, world, scene=None):
+        from ..scene import scene_of
+
+        self.renderer = renderer
+        self.world = world
+        self.scene = scene if scene is not None else scene_of(world)
+        cam = self.scene.camera
+        renderer.camera = Camera(cam.center, cam.size)
+        renderer.background_top = _as_rgba(cam.background[0])[:3]
+        renderer.background_bottom = _as_rgba(cam.background[1])[:3]
+        self.wireframe = cam.wireframe
+        self.collider_colors = None
+        self._handles = []
+        self._bodies = []
+        self.sync()
+
+    def sync(self) -> None:
+        """Pick up bodies and colliders added or removed since the last call."""
+        from ..scene import load_texture, scene_of
+
+        current = scene_of(self.world)
+        colors = [c.color for c in current.collider]
+        self.collider_colors = colors if any(colors) else None
+        self._n_colliders = len(self.world.colliders)
+        bodies = self.world.bodies
+        if [id(b) for b in bodies] == [id(b) for b in self._bodies]:
+            return
+        for h in self._handles:
+            self.renderer.remove_mesh(h)
+        self._handles = []
+        for k, (b, spec) in enumerate(zip(bodies, current.body)):
+            # a texture named in the scene wins; else the picture an image mesh carries
+            if spec.texture is not None:
+                image = load_texture(spec.texture)
+            else:
+                image = getattr(b.mesh, "texture", None)
+                if image is None and spec.shape == "image":
+                    image = load_texture(spec.source)
+            color = spec.color
+            if image is None and color is None:
+                color = BODY_PALETTE[k % len(BODY_PALETTE)]
+            uv = getattr(b.mesh, "uv", None)
+            self._handles.append(self.renderer.add_mesh(b.triangles, uv, texture=image, color=color,
+                                                        edges=b.springs))
+        self._bodies = bodies
+
+    def draw(self, *, read: bool = True):
+        """Paint the world's current state; returns the picture (H, W, 3) uint8 when ``read``."""
+        bodies = self.world.bodies
+        if len(bodies) != len(self._bodies) or any(a is not b for a, b in zip(bodies, self._bodies)) \
+                or len(self.world.colliders) != self._n_colliders:
+            self.sync()
+        r = self.renderer
+        r.render([(h, b.positions) for h, b in zip(self._handles, self._bodies)], self.world.colliders,
+                 wireframe=self.wireframe, collider_colors=self.collider_colors)
+        return r.read() if read else None

@@ -1,0 +1,26 @@
+"""Scene files (TOML) <-> worlds; built-in scenes and textures.
+
+A scene holds everything needed to reproduce a run: the bodies and how their meshes were
+made, the physics parameters, the colliders, the camera and how long to run. See
+``docs/scenes.md`` for every key.
+
+Examples
+--------
+>>> import deforma
+>>> world = deforma.load_scene("demo")           # a built-in name or a path to a .toml file
+>>> scene = deforma.scene.scene_of(world)        # camera, colours, run length, ...
+>>> scene.run.seconds > 0
+True
+"""
+
+from .assets import builtin_scenes, builtin_textures, load_texture
+from .build import body_specs, build, load, load_scene, make_mesh, save_scene, scene_of
+from .schema import (BoxBody, CameraSettings, ColliderSpec, Event, ImageBody, InteractionSettings, MeshBody,
+                     PhysicsSettings, RunSettings, Scene, SceneError, SceneInfo, parse_scene)
+
+__all__ = [
+    "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
+    "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "body_specs", "build",
+    "builtin_scenes", "builtin_textures", "load", "load_scene", "load_texture", "make_mesh", "parse_scene",
+    "save_scene", "scene_of",
+]

@@ -1,0 +1,257 @@
+"""Scene <-> World: build a world from a scene, read the scene back from a (changed) world.
+
+The world does not know where its meshes came from, so the scene layer remembers it: each
+world built here is registered (weakly) with its scene and the spec of every body and
+collider. :func:`scene_of` then reads the world's current parameters and puts them together
+with what only the scene knows (mesh recipes, colours, camera, run length).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import weakref
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from .assets import scene_path
+from .schema import (BoxBody, ColliderSpec, ImageBody, InteractionSettings, MeshBody, PhysicsSettings, Scene,
+                     SceneError, parse_scene, scene_to_dict)
+
+try:  # Python >= 3.11
+    import tomllib
+except ImportError:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = ["build", "load", "load_scene", "make_mesh", "save_scene", "scene_of"]
+
+
+@dataclass
+class _Record:
+    scene: Scene
+    bodies: list      # [(weakref to Body, body spec)]
+    colliders: list   # [(Rect, ColliderSpec)]
+
+
+_REGISTRY: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def load(name_or_path) -> Scene:
+    """Read and validate a scene: a built-in name (``deforma scenes`` lists them) or a ``.toml`` path.
+
+    Raises
+    ------
+    SceneError
+        Unknown name, unreadable file, invalid TOML or an invalid value; one line naming the
+        file, the key and what is allowed.
+
+    Examples
+    --------
+    >>> import deforma.scene
+    >>> s = deforma.scene.load("sample")
+    >>> s.scene.name, len(s.body), len(s.collider)
+    ('sample', 1, 1)
+    """
+    try:
+        path = scene_path(name_or_path)
+    except ValueError as e:
+        raise SceneError(str(e)) from None
+    shown = str(name_or_path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except OSError as e:
+        raise SceneError(f"{shown}: cannot read the file ({e.strerror or e})") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{shown}: not a text file (a scene is TOML in UTF-8)") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"{shown}: invalid TOML: {e}") from None
+    scene = parse_scene(data, source=shown, base_dir=path.resolve().parent)
+    return replace(scene, path=str(path.resolve()))
+
+
+def make_mesh(spec):
+    """The :class:`deforma.mesh.Mesh` a body spec describes (before it is placed)."""
+    from .. import mesh as meshes
+
+    if isinstance(spec, BoxBody):
+        return meshes.box(spec.corners, detail=spec.detail, edges=spec.edges)
+    if isinstance(spec, ImageBody):
+        # a built-in name or an absolute path: from_image takes either
+        return meshes.from_image(spec.source, resolution=spec.resolution, detect_edges=spec.detect_edges,
+                                 edge_step=spec.edge_step, scale=spec.scale)
+    if isinstance(spec, MeshBody):
+        return meshes.Mesh(np.array(spec.vertices, float), np.array(spec.triangles, np.int32),
+                           None if spec.uv is None else np.array(spec.uv, float))
+    raise TypeError(f"not a body spec: {spec!r}")
+
+
+def build(scene: Scene):
+    """A new :class:`deforma.World` holding the scene's bodies and colliders.
+
+    Raises
+    ------
+    SceneError
+        If the world or a mesh rejects a value (e.g. a concave box); the message names the
+        scene file and the body.
+    """
+    from ..physics import Rect, World
+
+    source = scene.path or "<scene>"
+    p = scene.physics
+    try:
+        world = World(gravity=p.gravity, dt=p.dt, substeps=p.substeps, mass=p.mass, stiffness=p.stiffness,
+                      damping=p.damping, friction=p.friction, static_friction=p.static_friction,
+                      grab_strength=scene.interaction.mouse_strength, max_speed=p.max_speed,
+                      integrator=p.integrator)
+    except ValueError as e:
+        raise SceneError(f"{source}: physics: {e}") from None
+    bodies = []
+    for i, spec in enumerate(scene.body):
+        try:
+            m = make_mesh(spec)
+            b = world.add_body(m, position=spec.position, mass=spec.mass, stiffness=spec.stiffness,
+                               damping=spec.damping)
+        except ValueError as e:
+            raise SceneError(f"{source}: body[{i}]: {e}") from None
+        bodies.append((weakref.ref(b), spec))
+    colliders = []
+    for c in scene.collider:
+        r = world.add_collider(Rect(c.center, c.size, c.angle, friction=c.friction,
+                                    static_friction=c.static_friction))
+        colliders.append((r, c))
+    _REGISTRY[world] = _Record(scene, bodies, colliders)
+    return world
+
+
+def load_scene(name_or_path):
+    """A :class:`deforma.World` from a built-in scene name or a ``.toml`` file.
+
+    Parameters
+    ----------
+    name_or_path : str or path
+        ``"sample"``, ``"demo"``, ... (``deforma scenes`` lists them) or a scene file.
+
+    Returns
+    -------
+    World
+        Ready to step; :func:`deforma.scene.scene_of` gives its camera, colours and run length.
+
+    Raises
+    ------
+    SceneError
+        A ``ValueError`` naming the file, the key path and what is allowed.
+
+    Examples
+    --------
+    >>> import deforma
+    >>> world = deforma.load_scene("sample")
+    >>> len(world.bodies), len(world.colliders)
+    (1, 1)
+    """
+    return build(load(name_or_path))
+
+
+def scene_of(world) -> Scene:
+    """The scene of ``world`` as it is now: its current parameters, bodies and colliders.
+
+    Bodies made from a scene keep their recipe (box or image parameters, colour, texture);
+    other bodies are written as ``shape = "mesh"`` with their rest vertices. Positions are
+    the starting positions: a scene describes a setup, not a moment of a run.
+    """
+    rec = _REGISTRY.get(world)
+    scene = rec.scene if rec is not None else Scene()
+    physics = PhysicsSettings(
+        dt=float(world.dt), substeps=int(world.substeps), gravity=tuple(float(g) for g in world.gravity),
+        damping=float(world.damping), mass=float(world.mass), stiffness=float(world.stiffness),
+        friction=float(world.friction), static_friction=float(world.static_friction),
+        max_speed=float(world.max_speed), integrator=world.integrator,
+    )
+    interaction = InteractionSettings(explosive_force=scene.interaction.explosive_force,
+                                      mouse_strength=float(world.grab_strength))
+    known = {}
+    if rec is not None:
+        for ref, spec in rec.bodies:
+            b = ref()
+            if b is not None:
+                known[id(b)] = spec
+    bodies = []
+    for b in world.bodies:
+        spec = known.get(id(b))
+        if spec is None:
+            m = b.mesh
+            uv = getattr(m, "uv", None)
+            spec = MeshBody(vertices=tuple(map(tuple, b.topology.rest_positions.tolist())),
+                            triangles=tuple(map(tuple, np.asarray(b.triangles).tolist())),
+                            uv=None if uv is None else tuple(map(tuple, np.asarray(uv).tolist())))
+        overrides = {}
+        for name in ("mass", "stiffness", "damping"):
+            expected = getattr(spec, name)
+            expected = getattr(world, name) if expected is None else expected
+            actual = float(getattr(b, name))
+            if actual != expected:
+                overrides[name] = actual
+        bodies.append(replace(spec, **overrides) if overrides else spec)
+    colour_of = {id(r): c for r, c in (rec.colliders if rec is not None else [])}
+    colliders = []
+    for r in world.colliders:
+        old = colour_of.get(id(r))
+        colliders.append(ColliderSpec(center=tuple(map(float, r.center)), size=tuple(map(float, r.size)),
+                                      angle=float(r.angle), friction=r.friction, static_friction=r.static_friction,
+                                      color=None if old is None else old.color))
+    return replace(scene, physics=physics, interaction=interaction, body=tuple(bodies), collider=tuple(colliders))
+
+
+def body_specs(world) -> list:
+    """The scene spec of each of ``world.bodies`` (a MeshBody for bodies not made from a scene)."""
+    return list(scene_of(world).body)
+
+
+def save_scene(world, path) -> Path:
+    """Write ``world`` (or a :class:`Scene`) to a TOML scene file that :func:`load_scene` reads back.
+
+    Every key is written, defaults included. The file appears whole or not at all (it is
+    written beside the target and renamed).
+
+    Parameters
+    ----------
+    world : World or Scene
+    path : str or path
+        Target ``.toml`` file; its folder must exist.
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Examples
+    --------
+    >>> import deforma, tempfile, os
+    >>> w = deforma.load_scene("sample")
+    >>> w.stiffness = 2000.0
+    >>> p = deforma.save_scene(w, os.path.join(tempfile.mkdtemp(), "stiff.toml"))
+    >>> deforma.load_scene(p).stiffness
+    2000.0
+    """
+    import tomli_w
+
+    scene = world if isinstance(world, Scene) else scene_of(world)
+    target = Path(path)
+    if target.suffix.lower() != ".toml":
+        raise ValueError(f"{path}: a scene file must end in .toml")
+    if not target.parent.is_dir():
+        raise ValueError(f"{path}: the folder {str(target.parent)!r} does not exist")
+    doc = scene_to_dict(scene, base_dir=target.parent.resolve())
+    text = "# deforma scene: see docs/scenes.md for every key\n" + tomli_w.dumps(doc)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".partial.toml", dir=target.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return target

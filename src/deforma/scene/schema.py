@@ -1,0 +1,543 @@
+"""The scene file format: frozen dataclasses that map one-to-one onto TOML tables.
+
+Each field carries its kind, allowed range, unit and a sentence of documentation in its
+metadata; :func:`parse_scene` validates a TOML document against them and
+:func:`scene_to_dict` writes one back. ``docs/scenes.md`` describes every key.
+
+A file looks like::
+
+    [scene]
+    name = "sample"
+
+    [run]
+    seconds = 4.0
+    fps = 30
+
+    [camera]
+    center = [0.0, 1.5]
+    size = [8.0, 4.5]
+
+    [physics]
+    dt = 0.0016667
+    stiffness = 1000.0
+
+    [[body]]
+    shape = "box"
+    corners = [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]]
+    detail = 6
+    position = [0.0, 2.5]
+    color = "#e07a5f"
+
+    [[collider]]
+    center = [0.0, 0.0]
+    size = [8.0, 0.4]
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+from dataclasses import MISSING, dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
+    "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "parse_scene", "scene_to_dict",
+]
+
+
+class SceneError(ValueError):
+    """A scene file or name that cannot be used; the message names the file, the key and what is allowed."""
+
+
+class _Problem(Exception):
+    """Internal: a problem at a key path, turned into one SceneError by parse_scene."""
+
+    def __init__(self, path: str, message: str):
+        super().__init__(message)
+        self.path = path
+        self.message = message
+
+
+def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, choices=None, unit="",
+         doc="") -> Any:
+    """A dataclass field with what the validator and the docs need to know about it.
+
+    ``kind`` is one of float, int, bool, str, vec2, size2, quad, color, colors2, file, points,
+    triangles. ``lo``/``hi`` bound numbers (``lo_open`` makes the lower bound exclusive).
+    """
+    meta = dict(kind=kind, lo=lo, hi=hi, lo_open=lo_open, choices=choices, unit=unit, doc=doc)
+    if default is MISSING:
+        return field(metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+@dataclass(frozen=True)
+class SceneInfo:
+    """``[scene]``: what the scene is."""
+
+    name: str = spec("str", "", doc="Short name, shown by `deforma scenes` and in window titles.")
+    description: str = spec("str", "", doc="One sentence on what the scene shows.")
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """``[run]``: how long `deforma run` simulates and how many frames per second it records."""
+
+    seconds: float = spec("float", 5.0, lo=0.0, hi=3600.0, lo_open=True, unit="s",
+                          doc="Simulated time to run (`--seconds` overrides).")
+    fps: float = spec("float", 30.0, lo=1.0, hi=240.0, unit="frames/s",
+                      doc="Frames per second of videos and state files (`--fps` overrides).")
+
+
+@dataclass(frozen=True)
+class CameraSettings:
+    """``[camera]``: the part of the world in the picture."""
+
+    center: tuple = spec("vec2", (0.0, 2.0), unit="m", doc="World point at the centre of the picture.")
+    size: tuple = spec("size2", (16.0, 9.0), unit="m",
+                       doc="Width and height that must be visible; the view grows along one axis to "
+                           "match the picture's aspect ratio.")
+    wireframe: bool = spec("bool", False, doc="Draw every spring over the bodies.")
+    background: tuple = spec("colors2", ("#dbe8f5", "#f7f2e8"),
+                             doc="Top and bottom colours of the background gradient.")
+
+
+@dataclass(frozen=True)
+class PhysicsSettings:
+    """``[physics]``: the world's parameters (the original inspector's Physics Settings)."""
+
+    dt: float = spec("float", 1 / 600, lo=0.0, hi=0.1, lo_open=True, unit="s",
+                     doc="Time advanced per step; smaller is more accurate and slower.")
+    substeps: int = spec("int", 1, lo=1, hi=1000, doc="Integration substeps per step, each dt/substeps long.")
+    gravity: tuple = spec("vec2", (0.0, -9.81), unit="m/s^2", doc="Acceleration of gravity.")
+    damping: float = spec("float", 0.5, lo=0.0, unit="N*s/m", doc="Spring damping kd.")
+    mass: float = spec("float", 1.0, lo=0.0, lo_open=True, unit="kg",
+                       doc="Total mass of a body; each vertex weighs mass / N.")
+    stiffness: float = spec("float", 1000.0, lo=0.0, unit="N/m", doc="Spring constant ks.")
+    friction: float = spec("float", 0.3, lo=0.0, doc="Dynamic Coulomb friction coefficient of colliders.")
+    static_friction: float = spec("float", 0.5, lo=0.0, doc="Static Coulomb friction coefficient of colliders.")
+    max_speed: float = spec("float", 1000.0, lo=0.0, lo_open=True, unit="m/s",
+                            doc="A vertex faster than this means the simulation became unstable.")
+    integrator: str = spec("str", "symplectic-euler", doc="Time integrator by name.")
+
+
+@dataclass(frozen=True)
+class InteractionSettings:
+    """``[interaction]``: the space key and the mouse."""
+
+    explosive_force: float = spec("float", 5.0, lo=0.0, unit="m/s",
+                                  doc="Upward speed the space key (or an `explode` event) adds to every vertex.")
+    mouse_strength: float = spec("float", 50.0, lo=0.0, lo_open=True, unit="N/m",
+                                 doc="Pull toward the pointer per held vertex.")
+
+
+_BODY_COMMON_DOC = {
+    "position": "Where the mesh's bounding-box centre is placed; omit to keep the mesh's own coordinates.",
+    "color": "Flat colour, '#rrggbb' or '#rrggbbaa'; with a texture it tints it.",
+    "texture": "A picture mapped with the mesh's uv: a built-in texture name or an image path "
+               "(relative to the scene file).",
+}
+
+
+@dataclass(frozen=True)
+class BoxBody:
+    """``[[body]]`` with ``shape = "box"``: a quadrilateral filled with points (the original's Square)."""
+
+    shape: str = spec("str", "box", choices=("box", "image", "mesh"), doc="Which kind of body.")
+    corners: tuple = spec("quad", ((-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)), unit="m",
+                          doc="Four corners in order around a convex quadrilateral.")
+    detail: int = spec("int", 8, lo=0, hi=1000, doc="n: n*n points inside, spread evenly.")
+    edges: bool = spec("bool", True, doc="Also put n points on each side.")
+    position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
+    color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
+    texture: str | None = spec("file", None, doc=_BODY_COMMON_DOC["texture"])
+    mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
+    stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
+    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
+
+
+@dataclass(frozen=True)
+class ImageBody:
+    """``[[body]]`` with ``shape = "image"``: a body traced from a picture (the original's textures)."""
+
+    shape: str = spec("str", "image", choices=("box", "image", "mesh"), doc="Which kind of body.")
+    source: str = spec("file", "bunny", doc="Built-in texture name (bunny, donut, armadillo) or an image path.")
+    resolution: int = spec("int", 4, lo=1, hi=10000, unit="px", doc="Sample every n-th pixel; smaller gives more points.")
+    detect_edges: bool = spec("bool", True, doc="Add points along the outline so the mesh follows the picture.")
+    edge_step: int = spec("int", 2, lo=1, hi=10000, unit="px", doc="Take every n-th outline pixel.")
+    scale: float = spec("float", 0.01, lo=0.0, lo_open=True, unit="m/px", doc="Metres per pixel.")
+    position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
+    color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
+    texture: str | None = spec("file", None, doc="A different picture to draw; by default the source itself.")
+    mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
+    stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
+    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
+
+
+@dataclass(frozen=True)
+class MeshBody:
+    """``[[body]]`` with ``shape = "mesh"``: any mesh given by its arrays (what save_scene writes for
+    bodies that were not made from a box or an image)."""
+
+    shape: str = spec("str", "mesh", choices=("box", "image", "mesh"), doc="Which kind of body.")
+    vertices: tuple = spec("points", (), unit="m", doc="Vertex positions, [[x, y], ...].")
+    triangles: tuple = spec("triangles", (), doc="Vertex indices per triangle, [[i, j, k], ...].")
+    uv: tuple | None = spec("points", None, doc="Texture coordinates in [0, 1], one per vertex.")
+    position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
+    color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
+    texture: str | None = spec("file", None, doc=_BODY_COMMON_DOC["texture"])
+    mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
+    stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
+    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
+
+
+BODY_KINDS = {"box": BoxBody, "image": ImageBody, "mesh": MeshBody}
+
+
+@dataclass(frozen=True)
+class ColliderSpec:
+    """``[[collider]]``: a fixed rotated rectangle (the original's Collision Settings)."""
+
+    center: tuple = spec("vec2", (0.0, 0.0), unit="m", doc="Centre of the rectangle.")
+    size: tuple = spec("size2", (10.0, 0.5), unit="m", doc="Width and height before rotation.")
+    angle: float = spec("float", 0.0, lo=-360.0, hi=360.0, unit="degrees", doc="Counter-clockwise rotation.")
+    friction: float | None = spec("float", None, lo=0.0, doc="Overrides physics.friction for this collider.")
+    static_friction: float | None = spec("float", None, lo=0.0,
+                                         doc="Overrides physics.static_friction for this collider.")
+    color: str | None = spec("color", None, doc="Fill colour, '#rrggbb'.")
+
+
+@dataclass(frozen=True)
+class Event:
+    """``[[event]]``: something that happens at a moment of a headless run (the keys a person would press)."""
+
+    time: float = spec("float", 1.0, lo=0.0, unit="s", doc="When, in simulated seconds from the start.")
+    action: str = spec("str", "explode", choices=("explode",), doc="What happens: `explode` is the space key.")
+    strength: float | None = spec("float", None, unit="m/s",
+                                  doc="Speed added; by default interaction.explosive_force.")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A whole scene file. Build the world with :meth:`build`.
+
+    ``path`` is where it was read from (None for a scene made in code), used to resolve
+    relative texture paths; it is not written to the file.
+    """
+
+    scene: SceneInfo = SceneInfo()
+    run: RunSettings = RunSettings()
+    camera: CameraSettings = CameraSettings()
+    physics: PhysicsSettings = PhysicsSettings()
+    interaction: InteractionSettings = InteractionSettings()
+    body: tuple = ()
+    collider: tuple = ()
+    event: tuple = ()
+    path: str | None = field(default=None, compare=False)
+
+    def build(self):
+        """A new :class:`deforma.World` with this scene's bodies and colliders (see ``deforma.scene.build``)."""
+        from .build import build
+
+        return build(self)
+
+
+SECTIONS = {"scene": SceneInfo, "run": RunSettings, "camera": CameraSettings, "physics": PhysicsSettings,
+            "interaction": InteractionSettings}
+ARRAYS = {"body": None, "collider": ColliderSpec, "event": Event}
+
+
+# -- validation --------------------------------------------------------------------------------
+def _suggest(key: str, allowed) -> str:
+    close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.6)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    return f"unknown key; {hint}allowed: {', '.join(allowed)}"
+
+
+def _number(value, path, *, integer=False):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise _Problem(path, f"expected {'an integer' if integer else 'a number'}, got {_show(value)}")
+    if integer and not isinstance(value, int):
+        if isinstance(value, float) and value.is_integer():
+            return int(value)
+        raise _Problem(path, f"expected an integer, got {_show(value)}")
+    if not math.isfinite(value):
+        raise _Problem(path, f"expected a finite number, got {_show(value)}")
+    return value if integer else float(value)
+
+
+def _show(value) -> str:
+    kind = {bool: "boolean", int: "integer", float: "number", str: "string", list: "array", dict: "table"}
+    name = kind.get(type(value), type(value).__name__)
+    text = repr(value)
+    if len(text) > 40:
+        text = text[:37] + "..."
+    return f"{name} {text}"
+
+
+def _range_text(meta) -> str:
+    lo, hi = meta["lo"], meta["hi"]
+    unit = f" {meta['unit']}" if meta["unit"] else ""
+    if lo is not None and hi is not None:
+        return f"in {'(' if meta['lo_open'] else '['}{lo:g}, {hi:g}]{unit}"
+    if lo is not None:
+        return f"{'>' if meta['lo_open'] else '>='} {lo:g}{unit}"
+    if hi is not None:
+        return f"<= {hi:g}{unit}"
+    return ""
+
+
+def _check_range(x, meta, path):
+    lo, hi = meta["lo"], meta["hi"]
+    bad = (lo is not None and (x <= lo if meta["lo_open"] else x < lo)) or (hi is not None and x > hi)
+    if bad:
+        raise _Problem(path, f"must be {_range_text(meta)}, got {x:g}")
+
+
+def _pair(value, path, what):
+    if not isinstance(value, list) or len(value) != 2:
+        raise _Problem(path, f"expected {what} [x, y], got {_show(value)}")
+    return tuple(_number(v, f"{path}[{i}]") for i, v in enumerate(value))
+
+
+def _color(value, path):
+    ok = isinstance(value, str) and value.startswith("#") and len(value) in (7, 9)
+    if ok:
+        try:
+            int(value[1:], 16)
+        except ValueError:
+            ok = False
+    if not ok:
+        raise _Problem(path, f"expected a colour '#rrggbb' or '#rrggbbaa', got {_show(value)}")
+    return value.lower()
+
+
+def _convert(value, meta, path, ctx):
+    kind = meta["kind"]
+    if kind in ("float", "int"):
+        x = _number(value, path, integer=kind == "int")
+        _check_range(x, meta, path)
+        return x
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise _Problem(path, f"expected true or false, got {_show(value)}")
+        return value
+    if kind == "str":
+        if not isinstance(value, str):
+            raise _Problem(path, f"expected a string, got {_show(value)}")
+        if meta["choices"] and value not in meta["choices"]:
+            close = difflib.get_close_matches(value, meta["choices"], n=1)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise _Problem(path, f"unknown value {value!r}; {hint}allowed: {', '.join(meta['choices'])}")
+        return value
+    if kind == "vec2":
+        return _pair(value, path, "two numbers")
+    if kind == "size2":
+        p = _pair(value, path, "two numbers")
+        if min(p) <= 0:
+            raise _Problem(path, f"both must be > 0 {meta['unit']}, got [{p[0]:g}, {p[1]:g}]")
+        return p
+    if kind == "quad":
+        if not isinstance(value, list) or len(value) != 4:
+            raise _Problem(path, f"expected four corners [[x, y], ...], got {_show(value)}")
+        return tuple(_pair(v, f"{path}[{i}]", "two numbers") for i, v in enumerate(value))
+    if kind == "points":
+        if not isinstance(value, list) or len(value) < 3:
+            raise _Problem(path, f"expected at least three points [[x, y], ...], got {_show(value)}")
+        return tuple(_pair(v, f"{path}[{i}]", "two numbers") for i, v in enumerate(value))
+    if kind == "triangles":
+        if not isinstance(value, list) or len(value) < 1:
+            raise _Problem(path, f"expected triangles [[i, j, k], ...], got {_show(value)}")
+        out = []
+        for i, t in enumerate(value):
+            if not isinstance(t, list) or len(t) != 3:
+                raise _Problem(f"{path}[{i}]", f"expected three vertex indices, got {_show(t)}")
+            out.append(tuple(_number(v, f"{path}[{i}][{k}]", integer=True) for k, v in enumerate(t)))
+        return tuple(out)
+    if kind == "color":
+        return _color(value, path)
+    if kind == "colors2":
+        if not isinstance(value, list) or len(value) != 2:
+            raise _Problem(path, f"expected two colours ['#rrggbb', '#rrggbb'], got {_show(value)}")
+        return tuple(_color(v, f"{path}[{i}]") for i, v in enumerate(value))
+    if kind == "file":
+        if not isinstance(value, str) or not value:
+            raise _Problem(path, f"expected a built-in texture name or an image path, got {_show(value)}")
+        return ctx["resolve"](value, path)
+    raise AssertionError(kind)  # pragma: no cover
+
+
+def _table(cls, data, path, ctx, *, skip=()):
+    if not isinstance(data, dict):
+        raise _Problem(path, f"expected a table, got {_show(data)}")
+    known = {f.name: f for f in fields(cls) if f.metadata}
+    for key in data:
+        if key not in known and key not in skip:
+            raise _Problem(f"{path}.{key}" if path else key, _suggest(key, list(known)))
+    values = {}
+    for name, f in known.items():
+        if name in data:
+            values[name] = _convert(data[name], f.metadata, f"{path}.{name}", ctx)
+    return cls(**values)
+
+
+def _body(data, path, ctx):
+    if not isinstance(data, dict):
+        raise _Problem(path, f"expected a table, got {_show(data)}")
+    shape = data.get("shape", "box")
+    if shape not in BODY_KINDS:
+        close = difflib.get_close_matches(str(shape), list(BODY_KINDS), n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise _Problem(f"{path}.shape", f"unknown value {shape!r}; {hint}allowed: {', '.join(BODY_KINDS)}")
+    cls = BODY_KINDS[shape]
+    body = _table(cls, data, path, ctx)
+    if isinstance(body, MeshBody):
+        n = len(body.vertices)
+        if n == 0 or not body.triangles:
+            raise _Problem(path, "a mesh body needs vertices and triangles")
+        for i, t in enumerate(body.triangles):
+            if min(t) < 0 or max(t) >= n:
+                raise _Problem(f"{path}.triangles[{i}]", f"indices must lie in [0, {n - 1}], got {list(t)}")
+        if body.uv is not None and len(body.uv) != n:
+            raise _Problem(f"{path}.uv", f"expected one (u, v) per vertex ({n}), got {len(body.uv)}")
+    return body
+
+
+def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
+    """Validate a TOML document (as a dict) and make a :class:`Scene`.
+
+    Parameters
+    ----------
+    data : dict
+        What ``tomllib`` read.
+    source : str, keyword-only
+        The file name used in error messages.
+    base_dir : path, keyword-only
+        Folder that relative texture paths are resolved against; default the current folder.
+
+    Raises
+    ------
+    SceneError
+        On the first problem: ``"<source>: <key path>: <what is wrong>; allowed: ..."``.
+
+    Examples
+    --------
+    >>> s = parse_scene({"physics": {"dt": 0.001}, "collider": [{"size": [4, 1]}]})
+    >>> s.physics.dt, s.collider[0].size
+    (0.001, (4.0, 1.0))
+    >>> parse_scene({"physics": {"stifness": 10}}, source="my.toml")
+    Traceback (most recent call last):
+    ...
+    deforma.scene.schema.SceneError: my.toml: physics.stifness: unknown key; did you mean 'stiffness'? allowed: dt, substeps, gravity, damping, mass, stiffness, friction, static_friction, max_speed, integrator
+    """
+    from .assets import resolve_texture
+
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+
+    def resolve(value, path):
+        try:
+            return resolve_texture(value, base_dir=base)
+        except ValueError as e:
+            raise _Problem(path, str(e)) from None
+
+    ctx = {"resolve": resolve}
+    try:
+        if not isinstance(data, dict):
+            raise _Problem("", f"expected a table, got {_show(data)}")
+        allowed = list(SECTIONS) + list(ARRAYS)
+        for key in data:
+            if key not in allowed:
+                raise _Problem(key, _suggest(key, allowed))
+        values = {}
+        for name, cls in SECTIONS.items():
+            if name in data:
+                values[name] = _table(cls, data[name], name, ctx)
+        for name, cls in ARRAYS.items():
+            if name in data:
+                items = data[name]
+                if not isinstance(items, list):
+                    raise _Problem(name, f"expected an array of tables ([[{name}]]), got {_show(items)}")
+                out = []
+                for i, item in enumerate(items):
+                    p = f"{name}[{i}]"
+                    out.append(_body(item, p, ctx) if name == "body" else _table(cls, item, p, ctx))
+                values[name] = tuple(out)
+    except _Problem as e:
+        where = f"{e.path}: " if e.path else ""
+        raise SceneError(f"{source}: {where}{e.message}") from None
+    return Scene(**values, path=None)
+
+
+# -- writing -----------------------------------------------------------------------------------
+def _plain(value):
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _record(obj, *, base_dir, always=()) -> dict:
+    from .assets import texture_reference
+
+    out = {}
+    defaults = type(obj)()
+    for f in fields(obj):
+        if not f.metadata:
+            continue
+        v = getattr(obj, f.name)
+        if v is None:
+            continue
+        if f.name not in always and v == getattr(defaults, f.name):
+            continue
+        if f.metadata["kind"] == "file":
+            v = texture_reference(v, base_dir=base_dir)
+        out[f.name] = _plain(v)
+    return out
+
+
+def scene_to_dict(scene: Scene, *, base_dir=None, full: bool = True) -> dict:
+    """The TOML document for ``scene`` (a dict for ``tomli_w``).
+
+    With ``full`` every key is written, defaults included, so a file states everything; else
+    only what differs from the defaults. Relative texture paths are written relative to
+    ``base_dir`` (the folder of the file being written).
+    """
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+    doc = {}
+    for name in SECTIONS:
+        section = getattr(scene, name)
+        keep = [f.name for f in fields(section)] if full else ()
+        rec = _record(section, base_dir=base, always=keep)
+        if rec:
+            doc[name] = rec
+    for name in ARRAYS:
+        items = getattr(scene, name)
+        if items:
+            recs = []
+            for it in items:
+                keep = [f.name for f in fields(it)] if full else ()
+                rec = _record(it, base_dir=base, always=keep)
+                if isinstance(it, (BoxBody, ImageBody, MeshBody)):
+                    rec = {"shape": it.shape, **{k: v for k, v in rec.items() if k != "shape"}}
+                recs.append(rec)
+            doc[name] = recs
+    return doc
+
+
+def _is_relative_to(p: Path, base: Path) -> bool:
+    try:
+        p.relative_to(base)
+        return True
+    except ValueError:
+        return False
+
+
+def relative_path(target: str, base_dir: Path) -> str:
+    """``target`` relative to ``base_dir`` when that is short and sensible, else absolute."""
+    try:
+        rel = os.path.relpath(target, base_dir)
+    except ValueError:  # different drives on Windows
+        return target
+    return rel if rel.count("..") <= 3 else target

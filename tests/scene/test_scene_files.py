@@ -1,0 +1,188 @@
+"""Scene files: validation with one clear error, and a round trip that loses nothing."""
+
+import os
+import textwrap
+
+import numpy as np
+import pytest
+
+import deforma
+from deforma import scene as scenes
+from deforma.scene import SceneError
+
+
+def write(tmp_path, text, name="s.toml"):
+    p = tmp_path / name
+    p.write_text(textwrap.dedent(text))
+    return p
+
+
+def test_defaults_fill_what_a_file_leaves_out(tmp_path):
+    s = scenes.load(write(tmp_path, """
+        [physics]
+        stiffness = 250.0
+        [[body]]
+        detail = 3
+    """))
+    assert s.physics.stiffness == 250.0
+    assert s.physics.dt == scenes.PhysicsSettings().dt
+    assert s.body[0] == scenes.BoxBody(detail=3)
+    world = s.build()
+    assert world.stiffness == 250.0 and len(world.bodies) == 1 and len(world.bodies[0].positions) == 3 * 3 + 4 + 4 * 3
+
+
+def test_a_scene_builds_the_world_it_describes(tmp_path):
+    s = scenes.load(write(tmp_path, """
+        [physics]
+        dt = 0.001
+        substeps = 3
+        gravity = [1.0, -5.0]
+        damping = 0.7
+        mass = 2.5
+        stiffness = 321.0
+        friction = 0.25
+        static_friction = 0.75
+        [interaction]
+        mouse_strength = 80.0
+        [[body]]
+        shape = "box"
+        corners = [[0, 0], [2, 0], [2, 1], [0, 1]]
+        detail = 2
+        edges = false
+        position = [5.0, 6.0]
+        mass = 4.0
+        [[collider]]
+        center = [1, 2]
+        size = [3, 0.5]
+        angle = 12.5
+        friction = 0.9
+    """))
+    w = s.build()
+    assert (w.dt, w.substeps, w.gravity, w.damping, w.mass, w.stiffness, w.friction, w.static_friction) == \
+        (0.001, 3, (1.0, -5.0), 0.7, 2.5, 321.0, 0.25, 0.75)
+    assert w.grab_strength == 80.0
+    (b,) = w.bodies
+    assert b.mass == 4.0 and b.stiffness == 321.0
+    lo, hi = b.positions.min(axis=0), b.positions.max(axis=0)
+    np.testing.assert_allclose((lo + hi) / 2, [5.0, 6.0])
+    np.testing.assert_allclose(hi - lo, [2.0, 1.0])
+    (c,) = w.colliders
+    assert (c.center, c.size, c.angle, c.friction, c.static_friction) == ((1.0, 2.0), (3.0, 0.5), 12.5, 0.9, None)
+
+
+@pytest.mark.parametrize("name", sorted(scenes.builtin_scenes()))
+def test_builtin_scene_round_trip_loses_nothing(tmp_path, name):
+    first = scenes.load(name)
+    path = deforma.scene.save_scene(first.build(), tmp_path / f"{name}.toml")
+    again = scenes.load(path)
+    assert again == first
+    # and writing it again gives the same bytes
+    path2 = deforma.scene.save_scene(again.build(), tmp_path / "again.toml")
+    assert path2.read_text() == path.read_text()
+
+
+def test_live_changes_are_saved(tmp_path):
+    w = scenes.load_scene("sample")
+    w.stiffness = 1234.0
+    w.gravity = (0.0, -3.0)
+    w.bodies[0].damping = 9.0
+    w.add_collider(deforma.Rect((3, 1), (1, 1), 45.0, static_friction=0.8))
+    w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]), position=(7, 7))
+    p = scenes.save_scene(w, tmp_path / "changed.toml")
+    w2 = scenes.load_scene(p)
+    assert w2.stiffness == 1234.0 and w2.gravity == (0.0, -3.0)
+    assert w2.bodies[0].damping == 9.0 and w2.bodies[0].stiffness == 1234.0
+    c = w2.colliders[-1]
+    assert (c.center, c.size, c.angle, c.static_friction) == ((3.0, 1.0), (1.0, 1.0), 45.0, 0.8)
+    # a body made in code is saved as its mesh, placed where it was
+    np.testing.assert_allclose(w2.bodies[1].positions, w.bodies[1].topology.rest_positions)
+    np.testing.assert_array_equal(w2.bodies[1].triangles, w.bodies[1].triangles)
+
+
+def test_relative_texture_paths_follow_the_file(tmp_path):
+    from PIL import Image
+
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    Image.new("RGB", (8, 8), (200, 10, 10)).save(tmp_path / "a" / "tex.png")
+    s = scenes.load(write(tmp_path / "a", """
+        [[body]]
+        texture = "tex.png"
+    """))
+    assert s.body[0].texture == str((tmp_path / "a" / "tex.png").resolve())
+    p = scenes.save_scene(s, tmp_path / "b" / "moved.toml")
+    assert 'texture = "../a/tex.png"' in p.read_text()
+    assert scenes.load(p) == s
+
+
+def test_save_scene_writes_atomically_and_checks_the_target(tmp_path):
+    w = scenes.load_scene("sample")
+    with pytest.raises(ValueError, match="must end in .toml"):
+        scenes.save_scene(w, tmp_path / "x.txt")
+    with pytest.raises(ValueError, match="does not exist"):
+        scenes.save_scene(w, tmp_path / "nope" / "x.toml")
+    scenes.save_scene(w, tmp_path / "x.toml")
+    assert sorted(os.listdir(tmp_path)) == ["x.toml"]
+
+
+BAD = [
+    ("[physics]\nstifness = 3.0\n", "physics.stifness: unknown key; did you mean 'stiffness'?"),
+    ("[phisics]\ndt = 0.1\n", "phisics: unknown key; did you mean 'physics'?"),
+    ("[[body]]\ndetial = 3\n", "body[0].detial: unknown key; did you mean 'detail'?"),
+    ("[[body]]\nshape = 'image'\ndetail = 3\n", "body[0].detail: unknown key"),
+    ("[physics]\ndt = 'fast'\n", "physics.dt: expected a number, got string 'fast'"),
+    ("[physics]\ndt = -0.01\n", "physics.dt: must be in (0, 0.1] s, got -0.01"),
+    ("[physics]\nsubsteps = 1.5\n", "physics.substeps: expected an integer, got number 1.5"),
+    ("[physics]\nsubsteps = 0\n", "physics.substeps: must be in [1, 1000], got 0"),
+    ("[physics]\ngravity = [0, 'down']\n", "physics.gravity[1]: expected a number"),
+    ("[physics]\ngravity = 9.81\n", "physics.gravity: expected two numbers [x, y]"),
+    ("[physics]\nfriction = -1\n", "physics.friction: must be >= 0, got -1"),
+    ("[[body]]\ndetail = -2\n", "body[0].detail: must be in [0, 1000], got -2"),
+    ("[[body]]\nedges = 1\n", "body[0].edges: expected true or false, got integer 1"),
+    ("[[body]]\ncorners = [[0, 0], [1, 0], [1, 1]]\n", "body[0].corners: expected four corners"),
+    ("[[body]]\nshape = 'circle'\n", "body[0].shape: unknown value 'circle'; allowed: box, image, mesh"),
+    ("[[body]]\ncolor = 'red'\n", "body[0].color: expected a colour '#rrggbb'"),
+    ("[[body]]\ntexture = 'missing.png'\n", "body[0].texture: no such file"),
+    ("[[body]]\nshape = 'image'\nsource = 'bunyy'\n", "body[0].source: unknown texture 'bunyy'"),
+    ("[[collider]]\nsize = [1, 0]\n", "collider[0].size: both must be > 0"),
+    ("[[collider]]\nangle = 720\n", "collider[0].angle: must be in [-360, 360] degrees"),
+    ("[[event]]\naction = 'explod'\n", "event[0].action: unknown value 'explod'; did you mean 'explode'?"),
+    ("body = 3\n", "body: expected an array of tables ([[body]])"),
+    ("[run]\nfps = 0\n", "run.fps: must be in [1, 240] frames/s, got 0"),
+    ("[physics\ndt = 1\n", "invalid TOML"),
+    ("[[body]]\nshape = 'box'\ncorners = [[0, 0], [1, 1], [1, 0], [0, 1]]\n", "body[0]:"),
+    ("[physics]\nintegrator = 'rk99'\n", "physics:"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD)
+def test_invalid_files_give_one_error_naming_file_and_key(tmp_path, text, message):
+    p = write(tmp_path, text, "bad.toml")
+    with pytest.raises(SceneError) as e:
+        scenes.load_scene(p)
+    msg = str(e.value)
+    assert "\n" not in msg
+    assert msg.startswith(f"{p}:") or msg.startswith(f"{p.resolve()}:")
+    assert message in msg
+
+
+def test_unknown_scene_lists_the_builtins():
+    with pytest.raises(SceneError) as e:
+        scenes.load("sampel")
+    msg = str(e.value)
+    assert "unknown scene 'sampel'; did you mean 'sample'?" in msg
+    for name in scenes.builtin_scenes():
+        assert name in msg
+
+
+def test_missing_and_unreadable_files(tmp_path):
+    with pytest.raises(SceneError, match="no such scene file"):
+        scenes.load(tmp_path / "absent.toml")
+    p = tmp_path / "binary.toml"
+    p.write_bytes(b"\xff\xfe\x00garbage")
+    with pytest.raises(SceneError, match="not a text file"):
+        scenes.load(p)
+
+
+def test_scene_error_is_a_value_error():
+    assert issubclass(SceneError, ValueError)

@@ -1,0 +1,218 @@
+"""The `deforma` command: outputs with the right frame counts, and one-line errors."""
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from deforma import scene as scenes
+from deforma.cli import EXIT_ERROR, EXIT_INTERRUPTED, EXIT_UNSTABLE, main
+
+SMALL = ["--size", "96x64", "--quiet"]
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_scenes_lists_builtin_scenes_and_textures(capsys):
+    code, out, err = run(capsys, "scenes")
+    assert code == 0
+    for name in scenes.builtin_scenes():
+        assert f"  {name}  " in out or f"  {name} " in out
+    for name in scenes.builtin_textures():
+        assert name in out
+
+
+def test_run_writes_mp4_with_the_expected_frames(tmp_path, capsys):
+    import imageio_ffmpeg
+
+    out = tmp_path / "s.mp4"
+    code, stdout, err = run(capsys, "run", "sample", "--seconds", "0.5", "--fps", "20", "-o", str(out), *SMALL)
+    assert code == 0, err
+    frames = list(imageio_ffmpeg.read_frames(str(out)))
+    assert len(frames) - 1 == 10 and tuple(frames[0]["size"]) == (96, 64)
+    # the summary line: frames, simulated time, wall time, real-time factor
+    assert stdout.startswith("sample: 10 frames, 0.45 s simulated in ") and "x real time" in stdout
+    assert sorted(os.listdir(tmp_path)) == ["s.mp4"]
+
+
+THROWN = """
+[camera]
+center = [0.0, 3.0]
+size = [16.0, 9.0]
+[[body]]
+detail = 3
+position = [0.0, 1.0]
+[[event]]
+time = 0.0
+strength = 10.0
+"""
+
+
+def test_run_writes_gif_with_the_expected_frames(tmp_path, capsys):
+    # thrown up at 10 m/s, the box moves pixels every frame, so no two frames are alike
+    # (a GIF stores identical neighbours once, with their durations added)
+    scene = tmp_path / "thrown.toml"
+    scene.write_text(THROWN)
+    out = tmp_path / "s.gif"
+    code, _, err = run(capsys, "run", str(scene), "--seconds", "0.4", "--fps", "25", "-o", str(out), *SMALL)
+    assert code == 0, err
+    im = Image.open(out)
+    assert im.n_frames == 10 and im.size == (96, 64)
+    total = 0
+    for k in range(im.n_frames):
+        im.seek(k)
+        total += im.info["duration"]
+    assert total == 400
+
+
+def test_run_writes_png_frames_and_states(tmp_path, capsys):
+    frames = tmp_path / "frames"
+    states = tmp_path / "s.npz"
+    code, _, err = run(capsys, "run", "sample", "--seconds", "0.3", "--fps", "10", "-o", f"{frames}/",
+                       "--states", str(states), *SMALL)
+    assert code == 0, err
+    assert sorted(os.listdir(frames)) == [f"frame_{k:05d}.png" for k in range(3)]
+    d = np.load(states)
+    world = scenes.load_scene("sample")
+    n = len(world.bodies[0].positions)
+    assert d["body0_positions"].shape == (3, n, 2)
+    np.testing.assert_allclose(d["time"], [0.0, 0.1, 0.2], atol=1e-9)
+    np.testing.assert_allclose(d["body0_positions"][0], world.bodies[0].positions)
+    np.testing.assert_array_equal(d["body0_triangles"], world.bodies[0].triangles)
+    assert d["colliders"].shape == (1, 5)
+    # the parameters come along as the scene file itself
+    import tomllib
+
+    doc = tomllib.loads(str(d["scene_toml"]))
+    from dataclasses import replace
+
+    sample = scenes.load("sample")
+    assert scenes.parse_scene(doc) == replace(sample, run=replace(sample.run, seconds=0.3, fps=10.0))
+    # the body fell: the last frame is lower than the first
+    assert d["body0_positions"][-1][:, 1].mean() < d["body0_positions"][0][:, 1].mean() - 0.05
+
+
+def test_run_without_output_only_simulates(capsys):
+    code, out, _ = run(capsys, "run", "sample", "--seconds", "0.2", "--quiet")
+    assert code == 0 and "frames" in out
+
+
+def test_unknown_scene_lists_builtins(capsys):
+    code, out, err = run(capsys, "run", "sampel", "--quiet")
+    assert code == EXIT_ERROR and out == ""
+    assert err.count("\n") == 1 and "unknown scene 'sampel'" in err and "sample" in err and "demo" in err
+
+
+def test_invalid_scene_file_names_the_key(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[physics]\ndt = 'x'\n")
+    code, _, err = run(capsys, "run", str(bad), "--quiet")
+    assert code == EXIT_ERROR and err.count("\n") == 1
+    assert "bad.toml: physics.dt: expected a number" in err
+
+
+def test_missing_output_folder_is_reported_before_simulating(tmp_path, capsys, monkeypatch):
+    import deforma.scene.schema as schema
+
+    built = []
+    monkeypatch.setattr(schema.Scene, "build", lambda self: built.append(1))
+    for out in (tmp_path / "no" / "x.mp4", tmp_path / "no" / "frames/"):
+        code, _, err = run(capsys, "run", "sample", "-o", str(out), "--quiet")
+        assert code == EXIT_ERROR and "does not exist" in err and err.count("\n") == 1
+    code, _, err = run(capsys, "run", "sample", "--states", str(tmp_path / "no" / "s.npz"), "--quiet")
+    assert code == EXIT_ERROR and "does not exist" in err
+    code, _, err = run(capsys, "run", "sample", "-o", str(tmp_path / "x.avi"), "--quiet")
+    assert code == EXIT_ERROR and "allowed: .mp4, .gif" in err
+    assert built == []
+
+
+def test_unwritable_output_folder(tmp_path, capsys, monkeypatch):
+    # root may write anywhere, so a read-only folder is simulated through os.access
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    code, _, err = run(capsys, "run", "sample", "-o", str(tmp_path / "x.gif"), "--quiet")
+    assert code == EXIT_ERROR and "is not writable" in err
+
+
+UNSTABLE = """
+[physics]
+dt = 0.02
+stiffness = 50000.0
+[[body]]
+detail = 4
+position = [0.0, 1.0]
+[[collider]]
+center = [0.0, 0.0]
+size = [5.0, 0.5]
+"""
+
+
+def test_unstable_simulation_fails_cleanly_and_writes_nothing(tmp_path, capsys):
+    p = tmp_path / "boom.toml"
+    p.write_text(UNSTABLE)
+    out, states = tmp_path / "boom.gif", tmp_path / "boom.npz"
+    code, _, err = run(capsys, "run", str(p), "-o", str(out), "--states", str(states), *SMALL)
+    assert code == EXIT_UNSTABLE
+    assert err.count("\n") == 1 and "became unstable" in err and "nothing was written" in err
+    assert sorted(os.listdir(tmp_path)) == ["boom.toml"]
+
+
+def test_interrupted_run_leaves_no_file(tmp_path, capsys, monkeypatch):
+    from deforma.render import world_view
+
+    calls = []
+    real = world_view.WorldView.draw
+
+    def draw(self, **kw):
+        calls.append(1)
+        if len(calls) == 4:
+            raise KeyboardInterrupt
+        return real(self, **kw)
+
+    monkeypatch.setattr(world_view.WorldView, "draw", draw)
+    out = tmp_path / "x.mp4"
+    code, _, err = run(capsys, "run", "sample", "--seconds", "1", "-o", str(out), *SMALL)
+    assert code == EXIT_INTERRUPTED and "interrupted" in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_bad_options_are_usage_errors(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["run", "sample", "--size", "big"])
+    assert e.value.code == 2
+    assert "expected WIDTHxHEIGHT" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["run", "sample", "--fps", "-3"])
+
+
+def test_mesh_picture_of_a_box(tmp_path, capsys):
+    out = tmp_path / "box.png"
+    code, stdout, err = run(capsys, "mesh", "box", "--detail", "3", "--edges", "-o", str(out), "--width", "300")
+    assert code == 0, err
+    # detail 3 with edges: a 5 x 5 grid of points, 2 * 4 * 4 triangles, right angles halved
+    assert "25 points, 32 triangles, min angle 26.6" in stdout
+    im = np.asarray(Image.open(out).convert("RGB"))
+    assert im.shape[1] == 300
+    assert sorted(os.listdir(tmp_path)) == ["box.png"]
+
+
+def test_mesh_rejects_bad_output(tmp_path, capsys):
+    code, _, err = run(capsys, "mesh", "box", "-o", str(tmp_path / "m.jpg"))
+    assert code == EXIT_ERROR and "give a name ending in .png" in err
+
+
+def test_the_installed_command_prints_one_line_and_no_traceback(tmp_path):
+    exe = os.path.join(os.path.dirname(sys.executable), "deforma")
+    r = subprocess.run([exe, "run", "no-such-scene"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == EXIT_ERROR
+    assert r.stderr.startswith("deforma: error: unknown scene") and r.stderr.count("\n") == 1
+    assert "Traceback" not in r.stderr
+    r = subprocess.run([exe, "--debug", "run", "no-such-scene"], capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0 and "Traceback" in r.stderr
