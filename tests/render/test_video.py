@@ -123,3 +123,18 @@ def test_frames_must_keep_one_size(tmp_path):
             w.write(np.zeros((8, 8, 3), np.uint8))
             w.write(np.zeros((8, 9, 3), np.uint8))
     assert not (tmp_path / "a.gif").exists()
+
+
+@pytest.mark.parametrize("name", ["p.mp4", "p.gif", "frames/"])
+def test_outputs_get_normal_file_permissions(tmp_path, name):
+    old = os.umask(0o022)
+    try:
+        with open_writer(tmp_path / name, fps=10) as w:
+            for f in moving_frames(2):
+                w.write(f)
+    finally:
+        os.umask(old)
+    target = tmp_path / name.rstrip("/")
+    files = [target] if target.is_file() else sorted(target.iterdir())
+    for f in files:
+        assert f.stat().st_mode & 0o777 == 0o644, f
