@@ -84,19 +84,34 @@ class Canvas:
         ImageDraw.Draw(m).polygon(self.xy(pts), fill=255)
         return m
 
+    def _draw(self, colour):
+        """A drawing context: straight onto the picture for opaque colours; through a
+        composited layer for translucent ones (ImageDraw replaces pixels, alpha included,
+        so drawing a translucent colour directly would punch see-through holes)."""
+        if colour[3] == 255:
+            return ImageDraw.Draw(self.img), None
+        layer = Image.new("RGBA", self.img.size, (0, 0, 0, 0))
+        return ImageDraw.Draw(layer), layer
+
+    def _done(self, layer):
+        if layer is not None:
+            self.img.alpha_composite(layer)
+
     def fill(self, pts, colour, outline=None, width=0.8):
-        d = ImageDraw.Draw(self.img)
+        d, layer = self._draw(colour)
         d.polygon(self.xy(pts), fill=colour)
+        self._done(layer)
         if outline is not None:
             self.line(np.vstack([pts, pts[:1]]), outline, width)
 
     def line(self, pts, colour, width=0.8):
-        d = ImageDraw.Draw(self.img)
+        d, layer = self._draw(colour)
         xy = self.xy(pts)
         d.line(xy, fill=colour, width=self.w(width), joint="curve")
         r = self.w(width) / 2
         for x, y in (xy[0], xy[-1]):  # round caps
             d.ellipse((x - r, y - r, x + r, y + r), fill=colour)
+        self._done(layer)
 
     def disc(self, cx, cy, r, colour, outline=None, width=0.6):
         self.fill(ellipse_outline(cx, cy, r, r), colour, outline, width)
@@ -127,8 +142,10 @@ class Canvas:
         m = self.mask(pts).filter(ImageFilter.GaussianBlur(self.w(blur)))
         if within is not None:
             m = ImageChops.multiply(m, within)
-        layer = Image.new("RGBA", self.img.size, colour)
-        m = ImageChops.multiply(m, layer.getchannel("A"))
+        # the colour's alpha only weakens the mask: the paint itself is opaque, so the
+        # picture's own alpha (its silhouette) is left alone
+        layer = Image.new("RGBA", self.img.size, tuple(colour[:3]) + (255,))
+        m = m.point(lambda v: v * colour[3] // 255)
         self.img.paste(layer, (0, 0), m)
 
     def layer(self):
@@ -265,11 +282,12 @@ ARM_SHELL = [(14, 64), (16, 50), (24, 38), (36, 30), (50, 27), (64, 30), (75, 38
 ARM_HEAD = [(76, 42), (84, 40), (90, 46), (97, 57), (98, 61), (94, 62), (84, 62), (77, 60)]
 ARM_EAR = [(78, 42), (79, 33), (83, 30), (85, 35), (83, 43)]
 ARM_TAIL = [(18, 58), (10, 66), (5, 76), (3, 86), (5, 86), (9, 76), (16, 68), (22, 64)]
+# Feet stay apart: touching feet would close a hole of background between two legs.
 ARM_LEGS = [
-    [(22, 62), (30, 62), (30, 78), (32, 81), (20, 81), (22, 76)],
-    [(34, 63), (41, 63), (41, 77), (43, 80), (32, 80), (34, 75)],
-    [(58, 63), (66, 63), (66, 78), (68, 81), (56, 81), (58, 76)],
-    [(70, 62), (77, 61), (77, 77), (79, 80), (68, 80), (70, 75)],
+    [(22, 62), (30, 62), (30, 78), (31.5, 81), (20.5, 81), (22, 76)],
+    [(35, 63), (42, 63), (42, 77), (43.5, 80), (34, 80), (35, 75)],
+    [(57, 63), (65, 63), (65, 78), (66.5, 81), (55.5, 81), (57, 76)],
+    [(71, 62), (78, 61), (78, 77), (79.5, 80), (70, 80), (71, 75)],
 ]
 
 

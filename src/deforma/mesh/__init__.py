@@ -2,6 +2,7 @@
 
 from .box import box
 from .delaunay import delaunay
+from .image import from_image
 from .mesh import Mesh
 
-__all__ = ["Mesh", "box", "delaunay"]
+__all__ = ["Mesh", "box", "delaunay", "from_image"]

@@ -1,0 +1,273 @@
+"""Meshes from pictures: they follow the shape (holes, ears, concavities) and reject bad input."""
+
+import numpy as np
+import pytest
+from PIL import Image
+from skimage.measure import find_contours
+
+import deforma
+from deforma.mesh import from_image
+from deforma.mesh.image import BUILTIN_TEXTURES, MAX_PIXELS, foreground_mask
+
+SCALE = 0.01
+
+
+def image_px(mesh):
+    """Vertices back in picture pixels (x right, y down) through the mesh's uv."""
+    h, w = mesh.texture.shape[:2]
+    return np.c_[mesh.uv[:, 0] * w, (1 - mesh.uv[:, 1]) * h]
+
+
+def centroids_on(mask, mesh):
+    c = image_px(mesh)[mesh.triangles].mean(axis=1)
+    return mask[np.floor(c[:, 1]).astype(int), np.floor(c[:, 0]).astype(int)]
+
+
+def covered(mesh, p):
+    """Whether picture point p (x, y in pixels) lies in some triangle."""
+    q = image_px(mesh)[mesh.triangles]
+    a, b, c = q[:, 0], q[:, 1], q[:, 2]
+
+    def side(u, v):
+        return (v[:, 0] - u[:, 0]) * (p[1] - u[:, 1]) - (v[:, 1] - u[:, 1]) * (p[0] - u[:, 0])
+
+    s = np.stack([side(a, b), side(b, c), side(c, a)], axis=1)
+    return bool(((s >= 0).all(axis=1) | (s <= 0).all(axis=1)).any())
+
+
+@pytest.fixture(scope="module")
+def masks():
+    return {n: foreground_mask(n) for n in BUILTIN_TEXTURES}
+
+
+PARAMS = [(4, 2), (8, 4), (3, 6)]
+
+
+@pytest.mark.parametrize("name", BUILTIN_TEXTURES)
+@pytest.mark.parametrize("resolution, edge_step", PARAMS)
+def test_builtin_follows_its_shape(name, resolution, edge_step, masks):
+    m = from_image(name, resolution=resolution, detect_edges=True, edge_step=edge_step, scale=SCALE)
+    fg = masks[name]
+    assert centroids_on(fg, m).all()
+    assert m.area == pytest.approx(fg.sum() * SCALE**2, rel=0.02)
+    assert (m.triangle_areas > 0).all() and m.min_angle > 3.0
+    assert np.array_equal(np.unique(m.triangles), np.arange(len(m.vertices)))  # no stray points
+
+
+@pytest.mark.parametrize("name", BUILTIN_TEXTURES)
+def test_outline_is_made_of_mesh_edges(name):
+    # the mesh boundary runs along the sub-pixel contour (alpha = 0.5) all the way round
+    m = from_image(name, resolution=6, edge_step=3, scale=SCALE)
+    alpha = np.pad(m.texture[..., 3].astype(float), 1)
+    rings = [c[:, ::-1] - 1 + 0.5 for c in find_contours(alpha, 127.5) if len(c) > 20]
+    # contour polylines, densified so that nearest-point distances are distances to the line
+    f = np.linspace(0, 1, 8, endpoint=False)[None, :, None]
+    contour = np.concatenate([(r[:-1, None] + f * (r[1:, None] - r[:-1, None])).reshape(-1, 2) for r in rings])
+    px = image_px(m)
+    loops = np.concatenate(m.boundary)
+
+    def nearest(a, b):
+        d = np.full(len(a), np.inf)
+        for chunk in np.array_split(np.arange(len(b)), max(1, len(b) // 500)):
+            d = np.minimum(d, np.hypot(*(a[:, None, :] - b[None, chunk, :]).transpose(2, 0, 1)).min(axis=1))
+        return d
+
+    assert nearest(px[loops], contour).max() < 0.2  # every boundary vertex is on the outline
+    assert nearest(contour, px[loops]).max() < 3.0 + 1.0  # and the outline is traced everywhere
+    # boundary edges are short: they follow the outline instead of cutting across it
+    e = px[m.boundary_edges]
+    assert np.hypot(*(e[:, 1] - e[:, 0]).T).max() <= 3.0 + 0.5
+
+
+def test_donut_keeps_its_hole(masks):
+    m = from_image("donut", resolution=4, edge_step=2, scale=SCALE)
+    assert len(m.boundary) == 2
+    assert m.euler_characteristic == 0
+    h, w = masks["donut"].shape
+    assert not covered(m, (w / 2, h / 2))
+    outer, hole = (m.vertices[b] for b in m.boundary)
+    # the hole's loop lies inside the outer one and runs the other way
+    assert np.hypot(*hole.T).max() < np.hypot(*outer.T).min()
+
+
+@pytest.mark.parametrize("detect_edges", [True, False])
+def test_bunny_ears_stay_apart(detect_edges, masks):
+    m = from_image("bunny", resolution=4, detect_edges=detect_edges, edge_step=2, scale=SCALE)
+    fg = masks["bunny"]
+    row = int(0.10 * fg.shape[0])  # through both ears, above the head
+    runs = np.flatnonzero(np.diff(fg[row].astype(int)))
+    assert len(runs) == 4, "the texture has two separate ears at this height"
+    gap = np.arange(runs[1] + 2, runs[2])  # background pixels between the ears
+    assert len(gap) > 10
+    for x in gap:
+        assert not covered(m, (x + 0.5, row + 0.5))
+    # and both ears are meshed there
+    for x in (0.5 * (runs[0] + runs[1]), 0.5 * (runs[2] + runs[3])):
+        assert covered(m, (x + 0.5, row + 0.5)) or not detect_edges
+
+
+@pytest.mark.parametrize("name", BUILTIN_TEXTURES)
+def test_grid_only_mesh_covers_no_background(name, masks):
+    m = from_image(name, resolution=6, detect_edges=False, scale=SCALE)
+    fg = masks[name]
+    assert centroids_on(fg, m).all()
+    # no background pixel centre inside any triangle (checked by brute force over a band)
+    px = image_px(m)
+    rows, cols = np.nonzero(~fg)
+    centres = np.c_[cols + 0.5, rows + 0.5]
+    lo, hi = px.min(axis=0), px.max(axis=0)
+    centres = centres[((centres >= lo) & (centres <= hi)).all(axis=1)]
+    q = px[m.triangles]
+    for start in range(0, len(q), 400):
+        t = q[start : start + 400]
+        a, b, c = (t[:, None, k, :] for k in range(3))
+        p = centres[None, :, :]
+
+        def side(u, v):
+            return (v[..., 0] - u[..., 0]) * (p[..., 1] - u[..., 1]) - (v[..., 1] - u[..., 1]) * (p[..., 0] - u[..., 0])
+
+        inside = (side(a, b) >= 0) & (side(b, c) >= 0) & (side(c, a) >= 0)
+        assert not inside.any()
+    assert 0.85 * fg.sum() * SCALE**2 < m.area < fg.sum() * SCALE**2
+    assert m.min_angle >= 10.0
+
+
+def test_full_rectangle_grid_known_answer():
+    # 40 x 60 all foreground, every 5th pixel from pixel 2: 8 rows x 12 columns of points
+    img = np.ones((40, 60), bool)
+    m = from_image(img, resolution=5, detect_edges=False, scale=0.1)
+    assert len(m.vertices) == 96
+    assert m.area == pytest.approx(35 * 55 * 0.1**2, rel=1e-12)
+    assert np.allclose(m.vertices.min(axis=0), [-2.75, -1.75]) and np.allclose(m.vertices.max(axis=0), [2.75, 1.75])
+    xs = np.unique(m.vertices[:, 0].round(9))
+    assert np.allclose(np.diff(xs), 0.5)  # resolution * scale
+
+
+def test_disc_and_notched_shape_known_areas():
+    yy, xx = np.mgrid[0:200, 0:200] + 0.5
+    disc = (xx - 100) ** 2 + (yy - 100) ** 2 < 80**2
+    m = from_image(disc, resolution=5, edge_step=2, scale=1.0)
+    assert m.area == pytest.approx(np.pi * 80**2, rel=0.005)
+    assert len(m.boundary) == 1 and m.euler_characteristic == 1
+    # a C shape: the notch must stay open (concave parts stay concave)
+    c_shape = disc & ~((yy > 90) & (yy < 110) & (xx > 60))
+    m = from_image(c_shape, resolution=5, edge_step=4, scale=1.0)
+    assert m.area == pytest.approx(c_shape.sum(), rel=0.01)
+    assert not covered(m, (150.5, 100.5)) and not covered(m, (100.5, 100.5))
+    assert centroids_on(c_shape, m).all()
+
+
+def test_coordinates_centred_y_up_scaled():
+    a = from_image("bunny", resolution=8, edge_step=4, scale=0.01)
+    b = from_image("bunny", resolution=8, edge_step=4, scale=0.02)
+    assert np.allclose(b.vertices, 2 * a.vertices)
+    lo, hi = a.vertices.min(axis=0), a.vertices.max(axis=0)
+    assert np.allclose(lo + hi, 0, atol=1e-12)  # bounding box centred on the origin
+    assert np.corrcoef(a.vertices[:, 1], a.uv[:, 1])[0, 1] > 0.9999  # y up, v up
+    assert np.corrcoef(a.vertices[:, 0], a.uv[:, 0])[0, 1] > 0.9999
+    # size: the foreground's extent in pixels times metres per pixel
+    fg = foreground_mask("bunny")
+    rows, cols = np.nonzero(fg)
+    assert hi[0] - lo[0] == pytest.approx((cols.max() + 1 - cols.min()) * 0.01, abs=0.02)
+    assert hi[1] - lo[1] == pytest.approx((rows.max() + 1 - rows.min()) * 0.01, abs=0.02)
+    assert a.texture.shape == (384, 384, 4) and a.texture.dtype == np.uint8
+    assert 0 <= a.uv.min() and a.uv.max() <= 1
+
+
+def test_builtin_textures_are_package_data_and_colourful():
+    for name in BUILTIN_TEXTURES:
+        m = from_image(name, resolution=12, edge_step=6)
+        rgba = m.texture
+        assert 256 <= rgba.shape[0] <= 512 and 256 <= rgba.shape[1] <= 512
+        assert rgba[0, 0, 3] == 0  # transparent background
+        opaque = rgba[rgba[..., 3] == 255][:, :3]
+        colours = {tuple(c // 32) for c in opaque}  # a picture, not a silhouette
+        assert len(colours) > 25
+
+
+def test_sources_path_pil_and_arrays(tmp_path):
+    img = Image.new("RGB", (64, 48), (0, 0, 0))
+    img.paste((200, 40, 40), (10, 8, 50, 40))  # a red 40 x 32 rectangle on black
+    area = 40 * 32
+    png = tmp_path / "r.png"
+    img.save(png)
+    jpg = tmp_path / "r.jpg"
+    img.save(jpg, quality=90, subsampling=0)  # black with JPEG noise stays background
+    rgb = np.asarray(img)
+    rgba = np.dstack([rgb, np.where(rgb.max(axis=2) > 0, 255, 0).astype(np.uint8)])
+    sources = [png, str(png), jpg, img, img.convert("RGBA"), rgb, rgba, rgb / 255.0, rgb.max(axis=2) > 0]
+    for src in sources:
+        m = from_image(src, resolution=4, edge_step=2, scale=1.0)
+        assert m.area == pytest.approx(area, rel=0.02), type(src)
+        assert len(m.boundary) == 1
+
+
+def test_transparent_beats_colour():
+    # an opaque black disc on a transparent white background: the disc is the shape
+    yy, xx = np.mgrid[0:100, 0:100] + 0.5
+    disc = (xx - 50) ** 2 + (yy - 50) ** 2 < 30**2
+    rgba = np.zeros((100, 100, 4), np.uint8)
+    rgba[..., :3] = 255
+    rgba[disc] = (0, 0, 0, 255)
+    m = from_image(rgba, resolution=4, edge_step=2, scale=1.0)
+    assert m.area == pytest.approx(np.pi * 30**2, rel=0.01)
+
+
+def one_line_value_error(match, fn, *args, **kwargs):
+    with pytest.raises(ValueError, match=match) as info:
+        fn(*args, **kwargs)
+    assert "\n" not in str(info.value)
+
+
+def test_missing_and_unreadable_files(tmp_path):
+    one_line_value_error("not found.*bunny", from_image, tmp_path / "nope.png")
+    one_line_value_error("not found", from_image, "rabbit")
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(b"this is not a picture")
+    one_line_value_error("cannot read image.*PNG or JPEG", from_image, bad)
+    truncated = tmp_path / "cut.png"
+    Image.new("RGB", (300, 300), (9, 200, 9)).save(truncated)
+    truncated.write_bytes(truncated.read_bytes()[:200])
+    one_line_value_error("cannot read image", from_image, truncated)
+    one_line_value_error("source must be", from_image, 42)
+    one_line_value_error("source must be", from_image, np.zeros((4, 4, 2)))
+
+
+def test_no_foreground():
+    one_line_value_error("no foreground", from_image, np.zeros((50, 50, 3), np.uint8))
+    one_line_value_error("no foreground", from_image, np.zeros((50, 50, 4), np.uint8))
+    one_line_value_error("no foreground", from_image, Image.new("RGBA", (50, 50), (255, 255, 255, 0)))
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"resolution": 0}, r"resolution must be an integer >= 1"),
+        ({"resolution": -3}, r"resolution must be an integer >= 1"),
+        ({"resolution": 2.5}, r"resolution must be an integer >= 1"),
+        ({"edge_step": 0}, r"edge_step must be an integer >= 1"),
+        ({"scale": 0}, r"scale must be .* > 0"),
+        ({"scale": float("inf")}, r"scale must be .* > 0"),
+        ({"detect_edges": "yes"}, "detect_edges must be True or False"),
+        ({"threshold": 1.0}, r"threshold must be a number in \(0, 1\)"),
+        ({"max_points": 0}, r"max_points must be an integer >= 3"),
+    ],
+)
+def test_bad_parameters(kwargs, match):
+    one_line_value_error(match, from_image, "donut", **kwargs)
+
+
+def test_too_many_points_and_too_large_images():
+    one_line_value_error(r"about \d+ points .* at most max_points=1000", from_image, "bunny", resolution=1, max_points=1000)
+    one_line_value_error(f"at most {MAX_PIXELS} allowed", from_image, Image.new("1", (8000, 6000)))
+    one_line_value_error(f"at most {MAX_PIXELS} allowed", from_image, np.zeros((MAX_PIXELS + 1, 1), bool))
+
+
+def test_too_coarse_for_grid_only():
+    yy, xx = np.mgrid[0:40, 0:40]
+    thin = (abs(xx - yy) < 2)  # a diagonal line 3 pixels wide
+    one_line_value_error("resolution=", from_image, thin, resolution=10, detect_edges=False)
+
+
+def test_public_name():
+    assert deforma.mesh.from_image is from_image
