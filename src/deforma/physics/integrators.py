@@ -16,21 +16,25 @@ Semi-implicit (symplectic) Euler, per substep::
     x += h * v
     x, v = collide(x_before, x, v)
 
-It is fused into two passes over memory per substep: springs once per spring, then one
-per-vertex pass that gathers spring forces and adds gravity and the grab pull, integrates,
-collides and checks the result. Both passes run on all cores for bodies big enough to pay
-for the thread start-up (``PARALLEL_MIN_VERTICES``, measured in ``benchmarks/``).
+It is fused into two passes over memory per substep: springs, each thread scattering a
+contiguous run of them into its own force buffer, then one per-vertex pass that sums the
+buffers, adds gravity and the grab pull, integrates, collides and checks the result. Both
+passes use all of Numba's threads for bodies big enough to pay for waking them
+(``PARALLEL_MIN_VERTICES``, measured in ``benchmarks/``).
 """
 
 from __future__ import annotations
 
+import time
 from typing import Callable, Protocol
 
+
+import numba
 import numpy as np
 from numba import njit, prange
 
 from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point
-from .forces import spring_force, spring_forces_serial
+from .forces import spring_force
 
 # Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
 PARALLEL_MIN_VERTICES = 512
@@ -109,23 +113,45 @@ def _is_bad(px, py, vx, vy, vmax2):
     return 1
 
 
-# The per-vertex loop bodies below are spelled out in both drivers on purpose, helpers that
-# take arrays included: every array passed to a compiled helper per vertex costs atomic
-# reference-count updates that Numba does not always prune (a helper taking the dozen
-# arrays made the step 10x slower). Scalar-only helpers are free.
+@njit(cache=True)
+def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, lo, hi, f):
+    """Add the forces (N) of springs ``lo:hi`` to both of their ends in ``f`` (N, 2)."""
+    for e in range(lo, hi):
+        a = spring_i[e]
+        b = spring_j[e]
+        fx, fy = spring_force(x[a, 0], x[a, 1], x[b, 0], x[b, 1], v[a, 0], v[a, 1], v[b, 0], v[b, 1],
+                              rest[e], ks[e], kd[e])
+        f[a, 0] += fx
+        f[a, 1] += fy
+        f[b, 0] -= fx
+        f[b, 1] -= fy
+
+
+# Both drivers below run the same two passes per substep:
+#   1. springs, split into len(chunk_ptr) - 1 contiguous chunks, each scattered into its own
+#      force buffer fbuf[t] (no two threads write the same buffer, so no races);
+#   2. per vertex: sum and re-zero the buffers, add gravity and the grab pull, integrate,
+#      collide, check. One chunk gives the serial step.
+# The per-vertex body is spelled out in both drivers on purpose, helpers that take arrays
+# included: each array passed to a compiled helper per vertex costs atomic reference-count
+# updates that Numba does not always prune (a helper taking a dozen arrays made the step 10x
+# slower). Scalar-only helpers are free.
 
 @njit(cache=True)
-def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest, ks, kd,
-                            adj_ptr, adj_spring, adj_sign, inv_mass, gx, gy, grab_slot, grab_pull,
-                            rects, h, substeps, vmax2):
+def symplectic_euler_serial(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i, spring_j, rest, ks, kd,
+                            inv_mass, gx, gy, grab_slot, grab_pull, rects, h, substeps, vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions, one thread.
 
-    Saves the start state into ``x_start`` / ``v_start``; stops early and returns the
-    number of vertices that ended non-finite or faster than ``sqrt(vmax2)`` m/s.
+    ``fbuf`` (T, N, 2) are zeroed force buffers, one per spring chunk ``chunk_ptr[t]:
+    chunk_ptr[t + 1]``, and are left zeroed. Saves the start state into ``x_start`` /
+    ``v_start``; stops early and returns the number of vertices that ended non-finite or
+    faster than ``sqrt(vmax2)`` m/s.
     """
     n_rects = rects.shape[0]
+    n_chunks = chunk_ptr.shape[0] - 1
     for sub in range(substeps):
-        spring_forces_serial(x, v, spring_i, spring_j, rest, ks, kd, fe)
+        for t in range(n_chunks):
+            scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, chunk_ptr[t], chunk_ptr[t + 1], fbuf[t])
         save = sub == 0
         bad = 0
         for i in range(x.shape[0]):
@@ -134,10 +160,11 @@ def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest
                 x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
             fx = 0.0
             fy = 0.0
-            for k in range(adj_ptr[i], adj_ptr[i + 1]):  # forces.gather_spring_force
-                e = adj_spring[k]
-                fx += adj_sign[k] * fe[e, 0]
-                fy += adj_sign[k] * fe[e, 1]
+            for t in range(n_chunks):
+                fx += fbuf[t, i, 0]
+                fy += fbuf[t, i, 1]
+                fbuf[t, i, 0] = 0.0
+                fbuf[t, i, 1] = 0.0
             g = grab_slot[i]
             if g >= 0:  # forces.grab_force
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
@@ -157,17 +184,15 @@ def symplectic_euler_serial(x, v, x_start, v_start, fe, spring_i, spring_j, rest
 
 
 @njit(cache=True, parallel=True)
-def symplectic_euler_parallel(x, v, x_start, v_start, fe, spring_i, spring_j, rest, ks, kd,
-                              adj_ptr, adj_spring, adj_sign, inv_mass, gx, gy, grab_slot, grab_pull,
-                              rects, h, substeps, vmax2):
-    """:func:`symplectic_euler_serial` on all cores (same arguments, same result)."""
+def symplectic_euler_parallel(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i, spring_j, rest, ks, kd,
+                              inv_mass, gx, gy, grab_slot, grab_pull, rects, h, substeps, vmax2):
+    """:func:`symplectic_euler_serial` with one spring chunk per thread and the vertex
+    pass split across threads (same arguments, same result for the same chunks)."""
     n_rects = rects.shape[0]
+    n_chunks = chunk_ptr.shape[0] - 1
     for sub in range(substeps):
-        for e in prange(spring_i.shape[0]):
-            a = spring_i[e]
-            b = spring_j[e]
-            fe[e, 0], fe[e, 1] = spring_force(x[a, 0], x[a, 1], x[b, 0], x[b, 1], v[a, 0], v[a, 1],
-                                              v[b, 0], v[b, 1], rest[e], ks[e], kd[e])
+        for t in prange(n_chunks):
+            scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, chunk_ptr[t], chunk_ptr[t + 1], fbuf[t])
         save = sub == 0
         bad = 0
         for i in prange(x.shape[0]):
@@ -176,10 +201,11 @@ def symplectic_euler_parallel(x, v, x_start, v_start, fe, spring_i, spring_j, re
                 x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
             fx = 0.0
             fy = 0.0
-            for k in range(adj_ptr[i], adj_ptr[i + 1]):  # forces.gather_spring_force
-                e = adj_spring[k]
-                fx += adj_sign[k] * fe[e, 0]
-                fy += adj_sign[k] * fe[e, 1]
+            for t in range(n_chunks):
+                fx += fbuf[t, i, 0]
+                fy += fbuf[t, i, 1]
+                fbuf[t, i, 0] = 0.0
+                fbuf[t, i, 1] = 0.0
             g = grab_slot[i]
             if g >= 0:  # forces.grab_force
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
@@ -198,12 +224,34 @@ def symplectic_euler_parallel(x, v, x_start, v_start, fe, spring_i, spring_j, re
     return 0
 
 
+def spring_chunks(n_springs: int, n_chunks: int) -> np.ndarray:
+    """(n_chunks + 1,) int64 boundaries splitting ``n_springs`` springs into equal runs.
+
+    Springs are sorted by their first vertex, so each run touches a narrow band of
+    vertices and its force buffer stays in cache.
+
+    Examples
+    --------
+    >>> spring_chunks(10, 3).tolist()
+    [0, 3, 6, 10]
+    """
+    return (np.arange(n_chunks + 1, dtype=np.int64) * n_springs) // n_chunks
+
+
 @register_integrator("symplectic-euler")
 class SymplecticEuler:
     """Semi-implicit Euler (the original's): ``v += h F/m; x += h v``, then collisions.
 
     Stable for ``h`` below roughly ``2 / omega_max`` (see ``World.stable_dt``); energy
     stays bounded without damping.
+
+    Bodies of at least ``PARALLEL_MIN_VERTICES`` vertices split their springs into one
+    chunk per Numba thread, and both the one-thread and the all-threads driver then give
+    bitwise the same result. Which one runs is measured, not assumed: threads that meet at
+    a barrier every pass are fast on an idle machine but can be 100x slower when other
+    processes keep the cores busy, so every ``PROBE_EVERY``-th step times the other driver
+    and the faster one (smoothed) is used. Set ``mode`` to ``"serial"`` or ``"parallel"`` to
+    pin one (benchmarks, tests).
 
     Examples
     --------
@@ -212,17 +260,53 @@ class SymplecticEuler:
     """
 
     name = "symplectic-euler"
+    PROBE_EVERY = 64
 
     def __init__(self):
-        self._fe = np.zeros((0, 2))
+        self._fbuf = np.zeros((0, 0, 2))
+        self._chunks = np.zeros(1, np.int64)
+        self._calls = 0
+        self._seconds = {"serial": None, "parallel": None}  # smoothed time per substep
+        self._warm = set()
+        self.mode = "auto"
 
     def advance(self, model, state, inputs, h, substeps):
-        if self._fe.shape[0] != model.n_springs:
-            self._fe = np.zeros((model.n_springs, 2))
-        kernel = symplectic_euler_parallel if model.n_vertices >= PARALLEL_MIN_VERTICES else symplectic_euler_serial
+        n = model.n_vertices
+        threads = numba.get_num_threads()
+        # the chunking, and so the result, depends on the body size and thread count only
+        n_chunks = threads if n >= PARALLEL_MIN_VERTICES and threads > 1 else 1
+        may_parallel = n_chunks > 1 and self.mode != "serial"
+        if self._fbuf.shape[:2] != (n_chunks, n) or self._chunks[-1] != model.n_springs:
+            # scratch kept between steps: the kernels allocate nothing and leave it zeroed
+            self._fbuf = np.zeros((n_chunks, n, 2))
+            self._chunks = spring_chunks(model.n_springs, n_chunks)
+            self._seconds = {"serial": None, "parallel": None}
+            self._warm = set()
+        if self.mode not in ("auto", "serial", "parallel"):
+            raise ValueError(f"mode must be 'auto', 'serial' or 'parallel', got {self.mode!r}")
+        t = self._seconds
+        if not may_parallel:
+            which = "serial"
+        elif self.mode == "parallel" or t["parallel"] is None:
+            which = "parallel"
+        elif t["serial"] is None:
+            which = "serial"
+        else:
+            self._calls += 1
+            best, other = ("parallel", "serial") if t["parallel"] <= t["serial"] else ("serial", "parallel")
+            which = other if self._calls % self.PROBE_EVERY == 0 else best
+        kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
         gx, gy = inputs.gravity
-        return kernel(state.x, state.v, state.x_start, state.v_start, self._fe,
-                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
-                      model.spring_damping, model.adj_ptr, model.adj_spring, model.adj_sign,
-                      model.vertex_inv_mass, float(gx), float(gy), inputs.grab_slot, inputs.grab_pull,
-                      inputs.rects, float(h), int(substeps), float(inputs.max_speed) ** 2)
+        start = time.perf_counter()
+        bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks,
+                     model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
+                     model.spring_damping, model.vertex_inv_mass, float(gx), float(gy), inputs.grab_slot,
+                     inputs.grab_pull, inputs.rects, float(h), int(substeps), float(inputs.max_speed) ** 2)
+        if may_parallel:
+            took = (time.perf_counter() - start) / substeps
+            if which not in self._warm:  # the first call may compile or start threads
+                self._warm.add(which)
+            else:
+                old = t[which]
+                t[which] = took if old is None else 0.7 * old + 0.3 * took
+        return bad
