@@ -8,9 +8,11 @@ Spring force on vertex ``i`` from ``j`` (the original's formula)::
 and ``f_ji = -f_ij``. Total force = springs + m * g + grab pull, where the grab pull on a
 held vertex is ``strength * (target - x)``.
 
-Springs are computed once per spring into ``fe`` (a parallel loop without conflicts) and
-then gathered per vertex through a CSR adjacency (again conflict-free), instead of the
-usual scatter ``f[i] += ...; f[j] -= ...`` that races when run on several threads.
+Here springs are computed once per spring into ``fe`` (a parallel loop without conflicts)
+and gathered per vertex through a CSR adjacency (again conflict-free), for code that wants
+the whole force vector (``total_forces``). The symplectic Euler step instead scatters one
+contiguous run of springs per thread into private buffers (see ``integrators``), which
+moves fewer bytes.
 
 Kernels take their outputs as arguments and allocate nothing. Units: m, m/s, kg, N.
 """

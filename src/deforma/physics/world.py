@@ -672,11 +672,12 @@ class World:
         first = int(np.argmax(bad))
         b = int(np.searchsorted(self._model.body_vertex_offsets, first, side="right") - 1)
         body = self._bodies[b]
+        finite = bool(np.isfinite(speed[first]) and np.isfinite(x[first]).all())
+        what = f"a vertex faster than max_speed {self.max_speed:g} m/s" if finite \
+            else "non-finite positions or velocities"
         self._state.restore()
         h = self._dt / self._substeps
         stable = self.stable_dt()
-        what = "non-finite positions or velocities" if not np.isfinite(speed[first]) \
-            else f"a vertex faster than max_speed {self.max_speed:g} m/s"
         if h > stable:
             need = math.ceil(self._dt / stable)
             hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s: "
