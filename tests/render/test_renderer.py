@@ -190,3 +190,19 @@ def test_bad_positions_and_sizes_are_rejected(renderer):
         renderer.add_mesh(tris, texture=np.zeros((2, 2, 3), np.uint8))
     with pytest.raises(ValueError, match="size must be two integers"):
         renderer.resize((0, 10))
+
+
+def test_drawing_into_a_given_framebuffer_like_a_window(gl_ctx):
+    # a window passes target=ctx.screen; any framebuffer behaves the same way
+    fbo = gl_ctx.simple_framebuffer((120, 60))
+    r = Renderer(gl_ctx, (120, 60), target=fbo, camera=Camera((0, 0), (4, 2)))
+    pts, tris, uv = square_mesh(-1.0, -0.5, 0.5, 0.5)
+    h = r.add_mesh(tris, uv, color="#ff0000")
+    r.render([(h, pts)])
+    img = r.read()
+    assert img.shape == (60, 120, 3)
+    # 30 px per metre: the fill covers columns [30, 75) and rows [15, 45)
+    assert np.all(img[17:43, 32:73] == RED)
+    assert not body_mask(img)[:, 80:].any()
+    r.release()
+    fbo.release()
