@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 from PIL import Image
+from scipy import ndimage
 from skimage.measure import find_contours
 
 import deforma
@@ -75,8 +76,11 @@ def test_outline_is_made_of_mesh_edges(name):
     assert nearest(px[loops], contour).max() < 0.2  # every boundary vertex is on the outline
     assert nearest(contour, px[loops]).max() < 3.0 + 1.0  # and the outline is traced everywhere
     # boundary edges are short: they follow the outline instead of cutting across it
+    # (edge_step apart, up to 1.5 edge_step where a point next to a sharp feature was merged)
     e = px[m.boundary_edges]
-    assert np.hypot(*(e[:, 1] - e[:, 0]).T).max() <= 3.0 + 0.5
+    lengths = np.hypot(*(e[:, 1] - e[:, 0]).T)
+    assert lengths.max() <= 1.5 * 3.0 + 0.5
+    assert np.median(lengths) == pytest.approx(3.0, abs=0.1)
 
 
 def test_donut_keeps_its_hole(masks):
@@ -111,9 +115,11 @@ def test_grid_only_mesh_covers_no_background(name, masks):
     m = from_image(name, resolution=6, detect_edges=False, scale=SCALE)
     fg = masks[name]
     assert centroids_on(fg, m).all()
-    # no background pixel centre inside any triangle (checked by brute force over a band)
+    # no background pixel centre inside any triangle, by brute force over the background
+    # pixels next to the foreground: a triangle whose corners are all foreground cannot
+    # cover background without covering some of those
     px = image_px(m)
-    rows, cols = np.nonzero(~fg)
+    rows, cols = np.nonzero(~fg & (ndimage.distance_transform_edt(~fg) <= 2.5))
     centres = np.c_[cols + 0.5, rows + 0.5]
     lo, hi = px.min(axis=0), px.max(axis=0)
     centres = centres[((centres >= lo) & (centres <= hi)).all(axis=1)]

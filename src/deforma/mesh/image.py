@@ -6,10 +6,13 @@ How it works (the reasons are in ``docs/mesh.md``):
    transparency) or, without transparency, when its brightest channel is above about 6 %
    (not black, with room for JPEG noise). Specks and pin-holes smaller than a few pixels
    are dropped: they would become tiny separate pieces or tiny holes in the body.
-2. **Outline** (``detect_edges=True``). Sub-pixel contours of the same field at the same
-   level (marching squares, :func:`skimage.measure.find_contours`), so an antialiased
-   edge is located to a fraction of a pixel; one closed ring per outline and per hole. Each
-   ring is resampled every ``edge_step`` pixels of arc length.
+2. **Outline** (``detect_edges=True``). Sub-pixel contours (marching squares,
+   :func:`skimage.measure.find_contours`): of the alpha channel at the threshold, so an
+   antialiased edge is located to a fraction of a pixel, or of the mask itself for pictures
+   without transparency. One closed ring per outline and per hole, resampled every
+   ``edge_step`` pixels of arc length; where a straight segment would stray more than half
+   a pixel from the contour (a narrow notch, a sharp tip) the farthest contour point is
+   added, so concave parts stay concave.
 3. **Interior points.** Every ``resolution``-th pixel in each direction that is foreground.
    With an outline, points closer to it than about half the larger spacing are left out:
    they would be near-duplicates of outline points and would make slivers.
@@ -17,9 +20,11 @@ How it works (the reasons are in ``docs/mesh.md``):
    appear in it: each outline segment missing from the triangulation is split at the
    middle of its arc (the new point lies on the true outline) and interior points inside
    that segment's diametral circle are removed, then the points are triangulated again,
-   for a few rounds. Once every outline segment is an edge, each triangle lies wholly
-   inside or wholly outside the outline, and the ones whose centroid is outside (even-odd
-   over all rings) are dropped. Holes stay holes, concave parts stay concave.
+   for a few rounds (on the built-in pictures none is needed). Once every outline segment
+   is an edge, each triangle lies wholly inside or wholly outside the outline, and the
+   ones whose centroid is outside (even-odd over all rings) are dropped. Holes stay holes.
+   Last, the rare tiny triangle against the outline whose centroid falls in a pixel whose
+   centre is background is dropped too, so every centroid is on a foreground pixel.
 5. **Without an outline** (``detect_edges=False``, the original's behaviour made safe): the
    grid points are triangulated and every triangle that covers a background pixel centre
    is dropped, so the mesh is a slightly shrunken, stair-stepped version of the shape.
@@ -87,7 +92,10 @@ def from_image(
         follows the picture. Without it only grid points are used and triangles that would
         cover background are dropped, which gives a stair-stepped, slightly smaller mesh.
     edge_step : int, keyword-only
-        Spacing of the outline points, in pixels of outline length. At least 1.
+        Spacing of the outline points, in pixels of outline length. At least 1. Sharp
+        features (a narrow notch, a tip) get an extra point where a segment would stray
+        more than half a pixel from the outline; a regular point next to such a feature is
+        merged into it, so spacings range from below ``edge_step`` to ``1.5 * edge_step``.
     scale : float, keyword-only
         Metres per pixel, > 0.
     threshold : float, optional, keyword-only
@@ -370,6 +378,7 @@ class _Ring:
         self.dense = closed
         self.cum = np.concatenate([[0.0], np.cumsum(seg)])
         self.length = float(self.cum[-1])
+        self.step = step
         n = max(3, int(round(self.length / step)))
         self.s = np.arange(n) * (self.length / n)
 
@@ -378,10 +387,32 @@ class _Ring:
 
         Uniform spacing alone cuts across notches narrower than ``edge_step`` and rounds
         off sharp tips; a point at the farthest contour vertex of each such segment (as in
-        Douglas-Peucker) keeps concave parts concave.
+        Douglas-Peucker) keeps concave parts concave. A uniform point left a fraction of a
+        pixel from such a feature point would only make a sliver, so uniform points closer
+        than half a step (along the outline) to a feature point are dropped and the check
+        runs again.
         """
+        uniform = self.s.copy()
+        features = np.zeros(0)
+        for _ in range(4):
+            added = self._split_far(tolerance)
+            if added.size == 0:
+                return
+            features = np.union1d(features, added)
+            gap = np.abs(uniform[:, None] - features[None, :]).min(axis=1)
+            gap = np.minimum(gap, self.length - gap)  # the ring is closed
+            crowded = gap < 0.5 * self.step
+            if not crowded.any():
+                return
+            uniform = uniform[~crowded]
+            self.s = np.union1d(uniform, features)
+        self._split_far(tolerance)  # whatever happened above, end within tolerance
+
+    def _split_far(self, tolerance):
+        """Split until every segment is within tolerance; return the arc positions added."""
         t = self.cum[:-1]
         v = self.dense[:-1]
+        added = []
         for _ in range(64):
             p = self.points()
             n = len(p)
@@ -393,13 +424,15 @@ class _Ring:
             dist = np.where(norm > 0, np.abs(cross) / np.where(norm > 0, norm, 1.0), np.hypot(*(v - a).T))
             far = dist > tolerance
             if not far.any():
-                return
+                break
             # the farthest contour vertex of each offending segment
             order = np.lexsort((dist, j))
             last = np.r_[j[order][1:] != j[order][:-1], True]
             pick = order[last]
             pick = pick[far[pick]]
-            self.s = np.unique(np.concatenate([self.s, t[pick]]))
+            added.append(t[pick])
+            self.s = np.union1d(self.s, t[pick])
+        return np.concatenate(added) if added else np.zeros(0)
 
     def points(self):
         s = self.s
