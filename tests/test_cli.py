@@ -216,3 +216,42 @@ def test_the_installed_command_prints_one_line_and_no_traceback(tmp_path):
     assert "Traceback" not in r.stderr
     r = subprocess.run([exe, "--debug", "run", "no-such-scene"], capture_output=True, text=True, timeout=60)
     assert r.returncode != 0 and "Traceback" in r.stderr
+
+
+@pytest.mark.parametrize("name", ["out.mp4", "out.gif"])
+def test_ctrl_c_on_a_real_run_leaves_no_file(tmp_path, name):
+    import signal
+    import time
+
+    exe = os.path.join(os.path.dirname(sys.executable), "deforma")
+    # a new session, so the signal goes to the whole group as Ctrl-C does (ffmpeg included)
+    p = subprocess.Popen([exe, "run", "sample", "--seconds", "120", "--size", "64x48", "-o", name,
+                          "--states", "s.npz", "--quiet"], cwd=tmp_path, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    deadline = time.time() + 60
+    # wait until frames are being written (the MP4's temporary file exists, or some time passed)
+    while time.time() < deadline and not any(".partial" in f for f in os.listdir(tmp_path)):
+        if name.endswith(".gif") and time.time() > deadline - 57:
+            break
+        time.sleep(0.05)
+    time.sleep(0.5)
+    os.killpg(p.pid, signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == EXIT_INTERRUPTED, err
+    assert err == "deforma: interrupted; no partial output was left\n"
+    assert os.listdir(tmp_path) == []
+
+
+def test_mesh_picture_of_a_builtin_texture(tmp_path, capsys):
+    import deforma
+
+    out = tmp_path / "bunny.png"
+    code, stdout, err = run(capsys, "mesh", "bunny", "--resolution", "16", "--edge-step", "8", "-o", str(out),
+                            "--width", "240")
+    assert code == 0, err
+    m = deforma.mesh.from_image("bunny", resolution=16, edge_step=8)
+    assert f"{len(m.vertices)} points, {len(m.triangles)} triangles, min angle {m.min_angle:.1f}" in stdout
+    img = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    # the picture is drawn under the mesh: the bunny's brown is there, not only the paper colour
+    brownish = (img[..., 0] > img[..., 2] + 40) & (img[..., 0] < 230)
+    assert brownish.mean() > 0.1
