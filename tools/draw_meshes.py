@@ -8,6 +8,7 @@ Run from the repository root::
 
     python tools/draw_meshes.py                 # writes docs/meshes.png
     python tools/draw_meshes.py --out /tmp/meshes.png --resolution 6 --edge-step 3
+    python tools/draw_meshes.py --table         # prints the figures in docs/mesh.md
 """
 
 from __future__ import annotations
@@ -85,13 +86,43 @@ def box_panel(detail):
     return canvas.resize((PANEL, PANEL), Image.LANCZOS), label
 
 
+def table():
+    """Print a Markdown table of mesh figures for the built-ins at a few settings."""
+    import time
+
+    from deforma.mesh.image import foreground_mask
+
+    print("| picture | resolution | edge_step | detect_edges | vertices | triangles | area / foreground | "
+          "boundary loops | V-E+F | min angle | max R/2r | time |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for name in ("bunny", "donut", "armadillo"):
+        fg = int(foreground_mask(name).sum())
+        for r, e, d in ((2, 1, True), (4, 2, True), (8, 4, True), (6, 2, False)):
+            deforma.mesh.from_image(name, resolution=r, edge_step=e, detect_edges=d)  # warm-up (JIT)
+            t = time.perf_counter()
+            m = deforma.mesh.from_image(name, resolution=r, edge_step=e, detect_edges=d, scale=1.0)
+            dt = time.perf_counter() - t
+            print(f"| {name} | {r} | {e if d else '-'} | {d} | {len(m.vertices)} | {len(m.triangles)} | "
+                  f"{m.area / fg:.4f} | {len(m.boundary)} | {m.euler_characteristic} | {m.min_angle:.1f}° | "
+                  f"{m.max_aspect_ratio:.1f} | {dt * 1000:.0f} ms |")
+    for n, e in ((8, False), (8, True), (30, True)):
+        m = deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=n, edges=e)
+        print(f"| box 2x1 | detail {n} | - | edges={e} | {len(m.vertices)} | {len(m.triangles)} | "
+              f"{m.area / 2:.15f} | {len(m.boundary)} | {m.euler_characteristic} | {m.min_angle:.1f}° | "
+              f"{m.max_aspect_ratio:.1f} | |")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=OUT)
     parser.add_argument("--resolution", type=int, default=8)
     parser.add_argument("--edge-step", type=int, default=4)
     parser.add_argument("--detail", type=int, default=8)
+    parser.add_argument("--table", action="store_true", help="print mesh figures instead of drawing")
     args = parser.parse_args(argv)
+    if args.table:
+        table()
+        return
     panels = [image_panel(n, args.resolution, args.edge_step) for n in ("bunny", "donut", "armadillo")]
     panels.append(box_panel(args.detail))
     caption = 28
