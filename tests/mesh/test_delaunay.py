@@ -1,0 +1,168 @@
+"""deforma.delaunay against SciPy on random points and against exact properties on
+degenerate ones (grids, cocircular and collinear sets, duplicates, extreme scales)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.spatial import Delaunay as ScipyDelaunay
+
+import deforma
+from delaunay_checks import canonical, check_delaunay
+
+HYP = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@pytest.mark.parametrize("n, seed", [(3, 0), (4, 1), (10, 2), (100, 3), (2000, 4), (50_000, 5)])
+def test_same_triangles_as_scipy_on_random_points(n, seed):
+    pts = np.random.default_rng(seed).random((n, 2))
+    ours = deforma.delaunay(pts)
+    assert canonical(ours) == canonical(ScipyDelaunay(pts).simplices)
+    if n <= 2000:
+        check_delaunay(pts, ours)
+
+
+def test_same_triangles_as_scipy_on_gaussian_points_with_offset():
+    pts = np.random.default_rng(7).normal(size=(5000, 2)) * 3.0 + (1e4, -2e4)
+    assert canonical(deforma.delaunay(pts)) == canonical(ScipyDelaunay(pts).simplices)
+
+
+def test_public_names():
+    pts = np.random.default_rng(0).random((20, 2))
+    assert np.array_equal(deforma.delaunay(pts), deforma.mesh.delaunay(pts))
+
+
+def test_unit_square_with_centre():
+    pts = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]])
+    tris = deforma.delaunay(pts)
+    assert tris.shape == (4, 3)
+    assert all(4 in t for t in tris)
+    check_delaunay(pts, tris)
+
+
+@pytest.mark.parametrize("w, h", [(2, 2), (3, 2), (7, 5), (30, 30)])
+def test_integer_grid_every_four_points_cocircular(w, h):
+    pts = np.stack(np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float)), -1).reshape(-1, 2)
+    tris = deforma.delaunay(pts)
+    assert len(tris) == 2 * (w - 1) * (h - 1)  # every cell split in two, no slivers
+    check_delaunay(pts, tris)
+
+
+def test_grid_with_non_representable_spacing():
+    # 0.1 is not a double: spacing and differences round, so the exact stages must work
+    pts = np.stack(np.meshgrid(np.arange(12) * 0.1, np.arange(9) * 0.1), -1).reshape(-1, 2)
+    check_delaunay(pts, deforma.delaunay(pts))
+
+
+def test_points_on_one_circle_with_exact_coordinates():
+    # all integer points on the circle x^2 + y^2 = 5^4: every four of them cocircular
+    r2 = 625
+    pts = [(x, y) for x in range(-25, 26) for y in range(-25, 26) if x * x + y * y == r2]
+    pts = np.array(pts, float)
+    assert len(pts) >= 12
+    tris = deforma.delaunay(pts)
+    assert len(tris) == len(pts) - 2
+    check_delaunay(pts, tris)
+
+
+def test_collinear_points_on_the_hull_are_vertices():
+    line = np.c_[np.linspace(0, 1, 11), np.zeros(11)]
+    pts = np.vstack([line, [[0.5, 1.0]]])
+    tris = deforma.delaunay(pts)
+    assert len(tris) == 10
+    check_delaunay(pts, tris)
+
+
+def test_duplicates_reference_the_lowest_index():
+    rng = np.random.default_rng(3)
+    base = rng.random((40, 2))
+    pts = np.vstack([base, base[::3], base[:5]])
+    tris = deforma.delaunay(pts)
+    assert tris.max() < 40
+    assert canonical(tris) == canonical(deforma.delaunay(base))
+    # the lowest index wins even when a duplicate comes first in the input
+    swapped = np.vstack([base[:1], base])
+    assert 1 not in set(deforma.delaunay(swapped).ravel().tolist())
+
+
+@pytest.mark.parametrize("scale", [2.0**-1000, 1e-300, 1e-150, 1e150, 1e300, 2.0**1000])
+def test_extreme_scales(scale):
+    rng = np.random.default_rng(11)
+    pts = rng.random((300, 2))
+    grid = np.stack(np.meshgrid(np.arange(6.0), np.arange(6.0)), -1).reshape(-1, 2)
+    for p in (pts, grid):
+        scaled = p * scale
+        tris = deforma.delaunay(scaled)
+        check_delaunay(scaled, tris, brute_force=False)
+        if np.log2(scale).is_integer():  # power-of-two scaling is exact: same result
+            assert np.array_equal(tris, deforma.delaunay(p))
+
+
+def test_deterministic():
+    pts = np.stack(np.meshgrid(np.arange(20.0), np.arange(20.0)), -1).reshape(-1, 2)
+    assert np.array_equal(deforma.delaunay(pts), deforma.delaunay(pts))
+
+
+@pytest.mark.parametrize(
+    "points, message",
+    [
+        ([[0, 0], [1, 1]], "at least 3 points"),
+        ([[0, 0], [0, 0], [0, 0]], "3 distinct points"),
+        ([[0, 0], [1, 1], [2, 2], [3, 3]], "collinear"),
+        ([[0, 0], [1, 0], [np.nan, 1]], "finite"),
+        ([[0, 0], [1, 0], [np.inf, 1]], "finite"),
+        ([[0, 0, 0], [1, 0, 0], [0, 1, 0]], r"\(N, 2\)"),
+        ([0, 1, 2], r"\(N, 2\)"),
+        ([["a", "b"], ["c", "d"], ["e", "f"]], "numbers"),
+    ],
+)
+def test_bad_input_raises_one_line_value_error(points, message):
+    with pytest.raises(ValueError, match=message) as info:
+        deforma.delaunay(points)
+    assert "\n" not in str(info.value)
+
+
+# -- property-based: degenerate sets ------------------------------------------------------
+
+coords = st.integers(min_value=-6, max_value=6)
+small_int_points = st.lists(st.tuples(coords, coords), min_size=3, max_size=40)
+
+
+@HYP
+@given(small_int_points, st.sampled_from([1.0, 0.1, 2.0**-30, 3.0e7]), st.floats(-1e3, 1e3))
+def test_property_integer_lattice_sets(raw, scale, offset):
+    """Few distinct values per axis: many duplicates, collinear runs and cocircular sets."""
+    pts = np.array(raw, float) * scale + offset
+    u = np.unique(pts, axis=0)
+    if len(u) < 3 or np.linalg.matrix_rank(u[1:] - u[0]) < 2:
+        with pytest.raises(ValueError):
+            deforma.delaunay(pts)
+        return
+    check_delaunay(pts, deforma.delaunay(pts))
+
+
+@HYP
+@given(
+    st.integers(3, 30),
+    st.integers(0, 2**32 - 1),
+    st.sampled_from(["circle", "line+1", "two-lines", "cluster"]),
+)
+def test_property_structured_degenerate_sets(n, seed, kind):
+    rng = np.random.default_rng(seed)
+    if kind == "circle":  # points on a circle (rounded: nearly cocircular) plus its centre
+        t = rng.random(n) * 2 * np.pi
+        pts = np.vstack([np.c_[np.cos(t), np.sin(t)], [[0.0, 0.0]]])
+    elif kind == "line+1":  # a collinear run and one point off it
+        s = rng.random(n)
+        pts = np.vstack([np.c_[s, 2 * s + 1], [[0.3, -5.0]]])
+    elif kind == "two-lines":
+        s = rng.integers(0, 8, n).astype(float)
+        pts = np.vstack([np.c_[s, np.zeros(n)], np.c_[s, np.ones(n)]])
+    else:  # a tight cluster far from the origin: differences round
+        pts = 1e6 + rng.random((n, 2)) * 1e-9
+    u = np.unique(pts, axis=0)
+    if len(u) < 3 or np.linalg.matrix_rank(u[1:] - u[0]) < 2:
+        return
+    check_delaunay(pts, deforma.delaunay(pts))
