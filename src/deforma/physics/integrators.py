@@ -316,7 +316,12 @@ class SymplecticEuler:
                 # a probe of the slow driver can cost 100x a step when the cores are busy, so
                 # probe less often while it keeps losing, and often again once it wins
                 which, self._calls = other, 0
-                self._probe_every = min(2 * self._probe_every, 4096) if best == self._last_best else 16
+                if best != self._last_best:
+                    self._probe_every = 16
+                elif t[other] > 10 * t[best]:  # hopeless (cores taken): look again much later
+                    self._probe_every = 4096
+                else:
+                    self._probe_every = min(2 * self._probe_every, 4096)
                 self._last_best = best
         kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
         gx, gy = inputs.gravity
