@@ -31,8 +31,13 @@ def grid_body(n: int):
 
 
 def run(quick: bool) -> list[Row]:
+    import os
+
     from deforma.render import Camera, Renderer
 
+    # the machine may be shared: llvmpipe's threads slow down a lot when other processes hold
+    # the cores, so the load is printed beside the figures
+    print(f"render: load average at start {os.getloadavg()[0]:.2f}", file=sys.stderr)
     pts, tris, uv = grid_body(101)
     rng = np.random.default_rng(0)
     tex = rng.integers(0, 256, (512, 512, 4), dtype=np.uint8)

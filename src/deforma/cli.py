@@ -352,7 +352,8 @@ def main(argv=None) -> int:
             raise
         print(f"deforma: error: {e}", file=sys.stderr)
         return e.code
-    except (ValueError, OSError) as e:
+    except (ValueError, OSError, RuntimeError) as e:
+        # a missing optional package (imageio-ffmpeg) or a file problem: one line, not a trace
         if a.debug:
             raise
         print(f"deforma: error: {e}", file=sys.stderr)

@@ -526,14 +526,6 @@ def scene_to_dict(scene: Scene, *, base_dir=None, full: bool = True) -> dict:
     return doc
 
 
-def _is_relative_to(p: Path, base: Path) -> bool:
-    try:
-        p.relative_to(base)
-        return True
-    except ValueError:
-        return False
-
-
 def relative_path(target: str, base_dir: Path) -> str:
     """``target`` relative to ``base_dir`` when that is short and sensible, else absolute."""
     try:
