@@ -277,3 +277,41 @@ def test_too_coarse_for_grid_only():
 
 def test_public_name():
     assert deforma.mesh.from_image is from_image
+
+
+def test_narrow_slit_stays_open():
+    # a 2 px slit, 40 px deep, is narrower than edge_step: the outline must still go into it
+    img = np.zeros((120, 120), bool)
+    img[10:110, 10:110] = True
+    img[10:50, 59:61] = False
+    m = from_image(img, resolution=4, edge_step=8, scale=1.0)
+    for y in range(12, 48, 3):
+        assert not covered(m, (60.0, y + 0.5)), y
+    assert m.area == pytest.approx(img.sum(), rel=0.01)
+
+
+def test_outline_recovery_splits_an_encroached_segment():
+    from deforma.mesh.image import _mesh_with_outline, _Ring
+
+    def square(lo, hi):
+        side = np.linspace(0, hi - lo, 81)[:-1]
+        return lo + np.concatenate([np.c_[side, 0 * side], np.c_[(hi - lo) + 0 * side, side],
+                                    np.c_[(hi - lo) - side, (hi - lo) + 0 * side], np.c_[0 * side, (hi - lo) - side]])
+
+    # a 60 px square with a 20 px square hole, outlines sampled every 10 px, and an interior
+    # point 1 px below the middle of the hole's first segment: Delaunay joins that point to
+    # the segment's ends, so the segment is not an edge until it is split
+    outer, hole = _Ring(square(0, 60), 10), _Ring(square(20, 40), 10)
+    assert (len(outer.points()), len(hole.points())) == (24, 8)
+    interior = np.array([[25.0, 19.0], [10.0, 10.0], [50.0, 50.0]])
+    points, tris = _mesh_with_outline([outer, hole], interior)
+    assert len(hole.points()) == 9  # the hole's first segment was split once
+    assert np.allclose(hole.points()[1], [25.0, 20.0])
+    assert not np.any(np.all(points == [25.0, 19.0], axis=1))  # the encroaching point went
+    m = deforma.mesh.Mesh(points, tris)
+    assert m.area == pytest.approx(3600.0 - 400.0)
+    assert len(m.boundary) == 2 and m.euler_characteristic == 0
+    # every outline segment is a boundary edge of the mesh
+    b = {tuple(sorted(e)) for e in m.boundary_edges.tolist()}
+    for start, n in ((0, 24), (24, 9)):
+        assert all(tuple(sorted((start + i, start + (i + 1) % n))) in b for i in range(n))
