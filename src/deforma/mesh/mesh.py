@@ -80,10 +80,9 @@ class Mesh:
         cw = quality.triangle_signed_areas(v, t) < 0
         t[cw] = t[cw][:, [0, 2, 1]]
 
-        keys = np.sort(t, axis=1)
-        if len(np.unique(keys, axis=0)) != len(t):
+        if len(np.unique(_row_keys(np.sort(t, axis=1), len(v)))) != len(t):
             raise ValueError("triangles contain the same triangle twice; each triangle may appear once")
-        _, counts = np.unique(_undirected(t), axis=0, return_counts=True)
+        _, counts = np.unique(_row_keys(_undirected(t), len(v)), return_counts=True)
         if counts.max() > 2:
             raise ValueError(
                 f"an edge is shared by {counts.max()} triangles; a mesh edge may border at most 2"
@@ -115,7 +114,9 @@ class Mesh:
     @cached_property
     def edges(self) -> np.ndarray:
         """(E, 2) int32: each undirected edge once, as (low, high) index pairs, sorted."""
-        return np.unique(_undirected(self.triangles), axis=0).astype(np.int32)
+        e = _undirected(self.triangles)
+        _, first = np.unique(_row_keys(e, len(self.vertices)), return_index=True)
+        return np.ascontiguousarray(e[first], dtype=np.int32)  # key order = (low, high) order
 
     @cached_property
     def boundary_edges(self) -> np.ndarray:
@@ -126,8 +127,8 @@ class Mesh:
         """
         t = self.triangles
         directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
-        keys = np.sort(directed, axis=1)
-        _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+        keys = _row_keys(np.sort(directed, axis=1), len(self.vertices))
+        _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
         return np.ascontiguousarray(directed[counts[inverse.ravel()] == 1], dtype=np.int32)
 
     @cached_property
@@ -203,6 +204,22 @@ class Mesh:
             f"Mesh({len(self.vertices)} vertices, {len(self.triangles)} triangles, "
             f"area {self.area:.4g} m^2, min angle {self.min_angle:.1f} deg)"
         )
+
+
+def _row_keys(rows: np.ndarray, n: int) -> np.ndarray:
+    """One int64 per row of indices in [0, n), ordered as the rows are lexicographically.
+
+    np.unique over int64 keys is many times faster than np.unique(axis=0) over rows.
+    """
+    rows = rows.astype(np.int64)
+    if rows.shape[1] == 2 or n < 2_000_000:  # n**3 < 2**63
+        key = rows[:, 0]
+        for k in range(1, rows.shape[1]):
+            key = key * n + rows[:, k]
+        return key
+    # very large meshes: rank the rows instead (same order, no overflow)
+    _, key = np.unique(rows, axis=0, return_inverse=True)
+    return key.ravel().astype(np.int64)
 
 
 def _undirected(t: np.ndarray) -> np.ndarray:
