@@ -123,3 +123,16 @@ def test_input_arrays_are_copied():
     m = Mesh(v, [[0, 1, 2]])
     v[0] = 9
     assert m.vertices[0].tolist() == [0, 0]
+
+
+@pytest.mark.parametrize("n", [10, 3_000_000])
+def test_row_keys_order_rows_lexicographically(n):
+    from deforma.mesh.mesh import _row_keys
+
+    rng = np.random.default_rng(0)
+    rows = rng.integers(0, min(n, 7), size=(200, 3))
+    keys = _row_keys(rows, n)
+    order = np.lexsort(rows.T[::-1])
+    assert (np.diff(keys[order]) >= 0).all()  # lexicographic order is key order
+    same = (rows[:, None, :] == rows[None, :, :]).all(axis=2)
+    assert np.array_equal(same, keys[:, None] == keys[None, :])  # equal rows <=> equal keys
