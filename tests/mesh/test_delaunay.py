@@ -166,3 +166,10 @@ def test_property_structured_degenerate_sets(n, seed, kind):
     if len(u) < 3 or np.linalg.matrix_rank(u[1:] - u[0]) < 2:
         return
     check_delaunay(pts, deforma.delaunay(pts))
+
+
+def test_regression_box_points_reusing_cavity_slots():
+    # Crashed an early version of the kernel: a fan reused a freed cavity slot whose id
+    # the outside triangle still held, and the adjacency was patched in the wrong place.
+    m = deforma.mesh.box(((0.1, 0.3), (2.7, 0.1), (2.3, 1.9), (0.3, 1.3)), detail=7, edges=True)
+    check_delaunay(m.vertices, deforma.delaunay(m.vertices))
