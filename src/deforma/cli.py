@@ -183,7 +183,6 @@ def cmd_run(a) -> int:
         view = WorldView(renderer, world)
         if a.wireframe:
             view.wireframe = True
-        writer = open_writer(a.output, fps=fps)
 
     events = sorted(scene.event, key=lambda e: e.time)
     times, frames = [], []
@@ -191,6 +190,9 @@ def cmd_run(a) -> int:
     bar = _progress(n_frames, not a.quiet, label)
     t_wall = time.perf_counter()
     try:
+        if a.output:
+            # inside the try: from here on an interrupt removes the temporary file
+            writer = open_writer(a.output, fps=fps)
         for k in range(n_frames):
             t_frame = k / fps
             # step until the world's clock reaches this frame (dt need not divide 1/fps)

@@ -233,6 +233,9 @@ class GifWriter(FrameWriter):
         self._frames = []
         self._palette = None
         self._palette_after = max(1, int(round(self.fps)))
+        # the temporary file exists from the start, like the MP4's: it reserves the name and
+        # shows a run is in progress; it gets its bytes at the end (GIF needs all frames)
+        self._tmp = _temp_beside(self.path)
 
     def _quantize(self, frame):
         from PIL import Image
@@ -265,9 +268,10 @@ class GifWriter(FrameWriter):
     def _commit(self):
         if self._palette is None and self._pending:
             self._build_palette()
+        tmp = self._tmp
         if not self._frames:
+            tmp.unlink(missing_ok=True)
             raise ValueError(f"{self.path}: no frames were written")
-        tmp = _temp_beside(self.path)
         try:
             first, rest = self._frames[0], self._frames[1:]
             first.save(tmp, format="GIF", save_all=True, append_images=rest, loop=0,
@@ -282,6 +286,7 @@ class GifWriter(FrameWriter):
     def _discard(self):
         self._frames = []
         self._pending = []
+        self._tmp.unlink(missing_ok=True)
 
 
 class PngFolderWriter(FrameWriter):
