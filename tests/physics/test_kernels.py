@@ -71,9 +71,9 @@ def test_parallel_and_serial_steps_agree_exactly():
         w.step()  # packs the colliders and grabs
         m, s, inp = w._model, w._state, w._inputs
         fbuf = np.zeros((3, m.n_vertices, 2))  # the same 3 spring chunks for both
-        chunks = integrators.spring_chunks(m.n_springs, 3)
+        chunks, verts = integrators.spring_chunks(m.spring_i, m.spring_j, 3)
         for _ in range(50):
-            kernel(s.x, s.v, s.x_start, s.v_start, fbuf, chunks, m.spring_i, m.spring_j, m.spring_rest_length,
+            kernel(s.x, s.v, s.x_start, s.v_start, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
                    m.spring_stiffness, m.spring_damping, m.vertex_inv_mass, 0.0, -9.81, inp.grab_slot,
                    inp.grab_pull, inp.rects, 1e-3, 2, 1e6)
         assert not fbuf.any()  # scratch left zeroed

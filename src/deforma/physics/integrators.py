@@ -151,12 +151,13 @@ def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
 # slower). Scalar-only helpers are free.
 
 @njit(cache=True)
-def symplectic_euler_serial(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i, spring_j, rest, ks, kd,
+def symplectic_euler_serial(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
                             inv_mass, gx, gy, grab_slot, grab_pull, rects, h, substeps, vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions, one thread.
 
     ``fbuf`` (T, N, 2) are zeroed force buffers, one per spring chunk ``chunk_ptr[t]:
-    chunk_ptr[t + 1]``, and are left zeroed. Saves the start state into ``x_start`` /
+    chunk_ptr[t + 1]``, and are left zeroed; chunk ``t`` touches only the vertices
+    ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see :func:`spring_chunks`). Saves the start state into ``x_start`` /
     ``v_start``; stops early and returns the number of vertices that ended non-finite or
     faster than ``sqrt(vmax2)`` m/s.
     """
@@ -175,10 +176,11 @@ def symplectic_euler_serial(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i, s
             fx = 0.0
             fy = 0.0
             for t in range(n_chunks):
-                fx += fbuf[t, i, 0]
-                fy += fbuf[t, i, 1]
-                fbuf[t, i, 0] = 0.0
-                fbuf[t, i, 1] = 0.0
+                if chunk_vertices[t, 0] <= i < chunk_vertices[t, 1]:  # only where chunk t wrote
+                    fx += fbuf[t, i, 0]
+                    fy += fbuf[t, i, 1]
+                    fbuf[t, i, 0] = 0.0
+                    fbuf[t, i, 1] = 0.0
             g = grab_slot[i]
             if g >= 0:  # forces.grab_force
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
@@ -198,7 +200,7 @@ def symplectic_euler_serial(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i, s
 
 
 @njit(cache=True, parallel=True)
-def symplectic_euler_parallel(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i, spring_j, rest, ks, kd,
+def symplectic_euler_parallel(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
                               inv_mass, gx, gy, grab_slot, grab_pull, rects, h, substeps, vmax2):
     """:func:`symplectic_euler_serial` with one spring chunk per thread and the vertex
     pass split across threads (same arguments, same result for the same chunks)."""
@@ -217,10 +219,11 @@ def symplectic_euler_parallel(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i,
             fx = 0.0
             fy = 0.0
             for t in range(n_chunks):
-                fx += fbuf[t, i, 0]
-                fy += fbuf[t, i, 1]
-                fbuf[t, i, 0] = 0.0
-                fbuf[t, i, 1] = 0.0
+                if chunk_vertices[t, 0] <= i < chunk_vertices[t, 1]:  # only where chunk t wrote
+                    fx += fbuf[t, i, 0]
+                    fy += fbuf[t, i, 1]
+                    fbuf[t, i, 0] = 0.0
+                    fbuf[t, i, 1] = 0.0
             g = grab_slot[i]
             if g >= 0:  # forces.grab_force
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
@@ -239,18 +242,31 @@ def symplectic_euler_parallel(x, v, x_start, v_start, fbuf, chunk_ptr, spring_i,
     return 0
 
 
-def spring_chunks(n_springs: int, n_chunks: int) -> np.ndarray:
-    """(n_chunks + 1,) int64 boundaries splitting ``n_springs`` springs into equal runs.
+def spring_chunks(spring_i, spring_j, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
+    """Split the springs into ``n_chunks`` equal runs; say which vertices each run touches.
 
-    Springs are sorted by their first vertex, so each run touches a narrow band of
-    vertices and its force buffer stays in cache.
+    Returns ``(chunk_ptr, chunk_vertices)``: run ``t`` is springs ``chunk_ptr[t]:chunk_ptr[t +
+    1]`` and touches only vertices ``chunk_vertices[t, 0]:chunk_vertices[t, 1]``. Springs
+    are sorted by their first vertex, so on a mesh numbered row by row each run covers a
+    narrow band of vertices: its force buffer stays in cache and the vertex pass reads a
+    buffer only where its run wrote.
 
     Examples
     --------
-    >>> spring_chunks(10, 3).tolist()
-    [0, 3, 6, 10]
+    >>> import numpy as np
+    >>> ptr, verts = spring_chunks(np.array([0, 0, 1, 2], np.int32), np.array([1, 2, 3, 3], np.int32), 2)
+    >>> ptr.tolist(), verts.tolist()
+    ([0, 2, 4], [[0, 3], [1, 4]])
     """
-    return (np.arange(n_chunks + 1, dtype=np.int64) * n_springs) // n_chunks
+    n = len(spring_i)
+    ptr = (np.arange(n_chunks + 1, dtype=np.int64) * n) // n_chunks
+    verts = np.zeros((n_chunks, 2), np.int64)
+    for t in range(n_chunks):
+        lo, hi = ptr[t], ptr[t + 1]
+        if hi > lo:
+            ends = np.concatenate([spring_i[lo:hi], spring_j[lo:hi]])
+            verts[t] = ends.min(), ends.max() + 1
+    return ptr, verts
 
 
 @register_integrator("symplectic-euler")
@@ -279,7 +295,9 @@ class SymplecticEuler:
 
     def __init__(self):
         self._fbuf = np.zeros((0, 0, 2))
+        self._model = None
         self._chunks = np.zeros(1, np.int64)
+        self._chunk_vertices = np.zeros((0, 2), np.int64)
         self._calls = 0
         self._seconds = {"serial": None, "parallel": None}  # smoothed time per substep
         self._warm = set()
@@ -293,10 +311,11 @@ class SymplecticEuler:
         # the chunking, and so the result, depends on the body size and thread count only
         n_chunks = threads if n >= PARALLEL_MIN_VERTICES and threads > 1 else 1
         may_parallel = n_chunks > 1 and self.mode != "serial"
-        if self._fbuf.shape[:2] != (n_chunks, n) or self._chunks[-1] != model.n_springs:
+        if self._model is not model or self._fbuf.shape[:2] != (n_chunks, n):
             # scratch kept between steps: the kernels allocate nothing and leave it zeroed
+            self._model = model  # a new Model means new topology: new chunks
             self._fbuf = np.zeros((n_chunks, n, 2))
-            self._chunks = spring_chunks(model.n_springs, n_chunks)
+            self._chunks, self._chunk_vertices = spring_chunks(model.spring_i, model.spring_j, n_chunks)
             self._seconds = {"serial": None, "parallel": None}
             self._warm = set()
         if self.mode not in ("auto", "serial", "parallel"):
@@ -326,7 +345,7 @@ class SymplecticEuler:
         kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
         gx, gy = inputs.gravity
         start = time.perf_counter()
-        bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks,
+        bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks, self._chunk_vertices,
                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
                      model.spring_damping, model.vertex_inv_mass, float(gx), float(gy), inputs.grab_slot,
                      inputs.grab_pull, inputs.rects, float(h), int(substeps), float(inputs.max_speed) ** 2)
