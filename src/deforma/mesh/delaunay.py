@@ -42,7 +42,7 @@ _PREV = np.array([2, 0, 1], np.int64)
 # A triangle is one 32-byte record of int32 so that a visit touches one cache line:
 # vertices (counter-clockwise), then the neighbours across the edges opposite them, then
 # the cavity mark (+stamp: in this insertion's cavity; -stamp: tested, not in conflict).
-_V0, _N0, _MARK, _REC = 0, 3, 6, 8
+_N0, _MARK, _REC = 3, 6, 8
 
 
 @njit(inline="always")
@@ -231,7 +231,7 @@ def _bowyer_watson(P, index):
             T[s, 0] = u
             T[s, 1] = v
             T[s, 2] = p
-            T[s, 5] = out
+            T[s, _N0 + 2] = out  # across (u, v), opposite p
             # the outside triangle's pointer across (v, u): found by vertex, since ids of
             # freed cavity slots may already be reused by this fan
             for j in range(3):
@@ -245,8 +245,8 @@ def _bowyer_watson(P, index):
                 last = s
         for e in range(nbnd):
             s = bnd_new[e]
-            T[s, 3] = link_start[bnd_v[e]]
-            T[s, 4] = link_end[bnd_u[e]]
+            T[s, _N0] = link_start[bnd_v[e]]  # across (v, p), opposite u
+            T[s, _N0 + 1] = link_end[bnd_u[e]]  # across (p, u), opposite v
 
     # -- collect the real triangles, as input indices -------------------------------------
     count = 0
