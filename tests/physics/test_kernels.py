@@ -107,3 +107,17 @@ def test_world_results_do_not_depend_on_the_threading_mode():
             w.step()
         runs.append(b.positions.copy())
     assert np.array_equal(runs[0], runs[1]) and np.array_equal(runs[0], runs[2])
+
+
+def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_loses():
+    integ = integrators.SymplecticEuler()
+    integ._samples = {"parallel": [1.0, 1.2, 0.9], "serial": [2.0, 2.1, 1.9]}
+    picks = [integ._choose() for _ in range(200)]
+    assert picks[:15] == ["parallel"] * 15 and picks[15:17] == ["serial"] * 2  # probe: two calls
+    assert picks.count("serial") < 12  # 16, 32, 64, 128: fewer and fewer probes
+    integ._reset_timing()
+    integ._samples = {"parallel": [30.0] * 3, "serial": [1.0] * 3}  # threads starved by other work
+    picks = [integ._choose() for _ in range(1000)]
+    assert picks.count("parallel") == 2  # one probe, then none for 4096 calls
+    integ._samples["parallel"] = [0.5] * 3  # cores free again: the probe wins, parallel is used
+    assert integ._choose() == "parallel"

@@ -280,9 +280,9 @@ class SymplecticEuler:
     chunk per Numba thread, and both the one-thread and the all-threads driver then give
     bitwise the same result. Which one runs is measured, not assumed: threads that meet at
     a barrier every pass are fast on an idle machine but can be 100x slower when other
-    processes keep the cores busy, so now and then a step runs on the other driver (every
-    16 steps, backing off to every 4096 while it keeps losing) and the faster one (smoothed)
-    is used. Set ``mode`` to ``"serial"`` or ``"parallel"`` to
+    processes keep the cores busy, so now and then two steps run on the other driver (every
+    16 steps, backing off to every 4096 while it keeps losing) and the faster one (median of
+    its last three timed steps) is used. Set ``mode`` to ``"serial"`` or ``"parallel"`` to
     pin one (benchmarks, tests).
 
     Examples
@@ -298,12 +298,42 @@ class SymplecticEuler:
         self._model = None
         self._chunks = np.zeros(1, np.int64)
         self._chunk_vertices = np.zeros((0, 2), np.int64)
-        self._calls = 0
-        self._seconds = {"serial": None, "parallel": None}  # smoothed time per substep
-        self._warm = set()
+        self._reset_timing()
+        self.mode = "auto"
+
+    def _reset_timing(self):
+        self._samples = {"serial": [], "parallel": []}  # recent seconds per substep
+        self._last = None  # driver of the previous call
+        self._calls = 0  # calls since the last probe
+        self._probing = 0  # calls of the other driver still to make
         self._probe_every = 16
         self._last_best = None
-        self.mode = "auto"
+
+    def _choose(self) -> str:
+        smp = self._samples
+        for k in ("parallel", "serial"):
+            if len(smp[k]) < 3:
+                return k
+        est = {k: float(np.median(v)) for k, v in smp.items()}
+        best, other = ("parallel", "serial") if est["parallel"] <= est["serial"] else ("serial", "parallel")
+        if self._probing:
+            self._probing -= 1
+            return other
+        self._calls += 1
+        if self._calls < self._probe_every:
+            return best
+        # Probe the other driver for two calls (only the second is timed: the first wakes
+        # sleeping threads and warms caches). A probe can cost 100x a step when the cores
+        # are busy, so probe less often while it keeps losing, often again once it wins.
+        self._calls, self._probing = 0, 1
+        if est[other] > 10 * est[best]:  # hopeless (cores taken): look again much later
+            self._probe_every = 4096
+        elif best != self._last_best:
+            self._probe_every = 16
+        else:
+            self._probe_every = min(2 * self._probe_every, 4096)
+        self._last_best = best
+        return other
 
     def advance(self, model, state, inputs, h, substeps):
         n = model.n_vertices
@@ -316,32 +346,15 @@ class SymplecticEuler:
             self._model = model  # a new Model means new topology: new chunks
             self._fbuf = np.zeros((n_chunks, n, 2))
             self._chunks, self._chunk_vertices = spring_chunks(model.spring_i, model.spring_j, n_chunks)
-            self._seconds = {"serial": None, "parallel": None}
-            self._warm = set()
+            self._reset_timing()
         if self.mode not in ("auto", "serial", "parallel"):
             raise ValueError(f"mode must be 'auto', 'serial' or 'parallel', got {self.mode!r}")
-        t = self._seconds
         if not may_parallel:
             which = "serial"
-        elif self.mode == "parallel" or t["parallel"] is None:
+        elif self.mode == "parallel":
             which = "parallel"
-        elif t["serial"] is None:
-            which = "serial"
         else:
-            self._calls += 1
-            best, other = ("parallel", "serial") if t["parallel"] <= t["serial"] else ("serial", "parallel")
-            which = best
-            if self._calls >= self._probe_every:
-                # a probe of the slow driver can cost 100x a step when the cores are busy, so
-                # probe less often while it keeps losing, and often again once it wins
-                which, self._calls = other, 0
-                if best != self._last_best:
-                    self._probe_every = 16
-                elif t[other] > 10 * t[best]:  # hopeless (cores taken): look again much later
-                    self._probe_every = 4096
-                else:
-                    self._probe_every = min(2 * self._probe_every, 4096)
-                self._last_best = best
+            which = self._choose()
         kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
         gx, gy = inputs.gravity
         start = time.perf_counter()
@@ -351,9 +364,9 @@ class SymplecticEuler:
                      inputs.grab_pull, inputs.rects, float(h), int(substeps), float(inputs.max_speed) ** 2)
         if may_parallel:
             took = (time.perf_counter() - start) / substeps
-            if which not in self._warm:  # the first call may compile or start threads
-                self._warm.add(which)
-            else:
-                old = t[which]
-                t[which] = took if old is None else 0.7 * old + 0.3 * took
+            if which == self._last:  # the driver ran last call too: threads awake, caches warm
+                smp = self._samples[which]
+                smp.append(took)
+                del smp[:-3]
+            self._last = which
         return bad
