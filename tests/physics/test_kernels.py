@@ -112,12 +112,14 @@ def test_world_results_do_not_depend_on_the_threading_mode():
 def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_loses():
     integ = integrators.SymplecticEuler()
     integ._samples = {"parallel": [1.0, 1.2, 0.9], "serial": [2.0, 2.1, 1.9]}
+    integ._estimate = {"parallel": 1.0, "serial": 2.0}
     picks = [integ._choose() for _ in range(200)]
     assert picks[:15] == ["parallel"] * 15 and picks[15:17] == ["serial"] * 2  # probe: two calls
     assert picks.count("serial") < 12  # 16, 32, 64, 128: fewer and fewer probes
     integ._reset_timing()
     integ._samples = {"parallel": [30.0] * 3, "serial": [1.0] * 3}  # threads starved by other work
+    integ._estimate = {"parallel": 30.0, "serial": 1.0}
     picks = [integ._choose() for _ in range(1000)]
     assert picks.count("parallel") == 2  # one probe, then none for 4096 calls
-    integ._samples["parallel"] = [0.5] * 3  # cores free again: the probe wins, parallel is used
+    integ._estimate["parallel"] = 0.5  # cores free again: the probe wins, parallel is used
     assert integ._choose() == "parallel"

@@ -25,6 +25,7 @@ passes use all of Numba's threads for bodies big enough to pay for waking them
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Callable, Protocol
 
@@ -303,6 +304,7 @@ class SymplecticEuler:
 
     def _reset_timing(self):
         self._samples = {"serial": [], "parallel": []}  # recent seconds per substep
+        self._estimate = {"serial": math.inf, "parallel": math.inf}
         self._last = None  # driver of the previous call
         self._calls = 0  # calls since the last probe
         self._probing = 0  # calls of the other driver still to make
@@ -314,7 +316,7 @@ class SymplecticEuler:
         for k in ("parallel", "serial"):
             if len(smp[k]) < 3:
                 return k
-        est = {k: float(np.median(v)) for k, v in smp.items()}
+        est = self._estimate
         best, other = ("parallel", "serial") if est["parallel"] <= est["serial"] else ("serial", "parallel")
         if self._probing:
             self._probing -= 1
@@ -368,5 +370,6 @@ class SymplecticEuler:
                 smp = self._samples[which]
                 smp.append(took)
                 del smp[:-3]
+                self._estimate[which] = sorted(smp)[len(smp) // 2]  # median: one outlier is ignored
             self._last = which
         return bad
