@@ -299,6 +299,8 @@ class SymplecticEuler:
         self._model = None
         self._chunks = np.zeros(1, np.int64)
         self._chunk_vertices = np.zeros((0, 2), np.int64)
+        self._threads = None  # numba.get_num_threads(), re-read every 1024 steps
+        self._ticks = 0
         self._reset_timing()
         self.mode = "auto"
 
@@ -339,7 +341,10 @@ class SymplecticEuler:
 
     def advance(self, model, state, inputs, h, substeps):
         n = model.n_vertices
-        threads = numba.get_num_threads()
+        self._ticks += 1
+        if self._ticks >= 1024 or self._threads is None:  # costs 1 us: a few % of a small step
+            self._ticks, self._threads = 0, numba.get_num_threads()
+        threads = self._threads
         # the chunking, and so the result, depends on the body size and thread count only
         n_chunks = threads if n >= PARALLEL_MIN_VERTICES and threads > 1 else 1
         may_parallel = n_chunks > 1 and self.mode != "serial"
