@@ -206,3 +206,20 @@ def test_drawing_into_a_given_framebuffer_like_a_window(gl_ctx):
     assert not body_mask(img)[:, 80:].any()
     r.release()
     fbo.release()
+
+
+def test_draw_image_puts_a_panel_at_its_pixels(renderer):
+    panel = np.zeros((10, 20, 4), np.uint8)
+    panel[..., 1] = 255
+    panel[..., 3] = 255
+    panel[0, :, :] = (0, 0, 255, 255)      # its top row blue: the panel must not be upside down
+    panel[:, 15:, 3] = 0                   # its right quarter transparent
+    renderer.render()
+    empty = renderer.read()
+    renderer.draw_image(panel, (30, 40))
+    img = renderer.read()
+    assert np.all(img[41:50, 30:45] == [0, 255, 0])
+    assert np.all(img[40, 30:45] == [0, 0, 255])
+    np.testing.assert_array_equal(img[40:50, 45:50], empty[40:50, 45:50])
+    changed = np.any(img != empty, axis=-1)
+    assert changed.sum() == 10 * 15

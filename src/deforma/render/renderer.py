@@ -229,6 +229,26 @@ def _blend():
     return (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
 
 
+_IMAGE_VS = """
+#version 330
+uniform vec4 u_rect;   // x0, y0, x1, y1 in normalised device coordinates
+out vec2 v_uv;
+void main() {
+    vec2 t = vec2(float(gl_VertexID & 1), float((gl_VertexID >> 1) & 1));
+    v_uv = vec2(t.x, 1.0 - t.y);
+    gl_Position = vec4(mix(u_rect.xy, u_rect.zw, t), 0.0, 1.0);
+}
+"""
+
+_IMAGE_FS = """
+#version 330
+uniform sampler2D u_tex;
+in vec2 v_uv;
+out vec4 f_color;
+void main() { f_color = texture(u_tex, v_uv); }
+"""
+
+
 class MeshHandle:
     """GPU buffers of one body: constant triangles, UVs and texture, positions updated per frame.
 
@@ -334,6 +354,9 @@ class Renderer:
         self._coll_prog = ctx.program(vertex_shader=_COLLIDER_VS, fragment_shader=_COLLIDER_FS)
         self._grid_vbo = ctx.buffer(reserve=4096, dynamic=True)
         self._grid_vao = ctx.vertex_array(self._flat_prog, [(self._grid_vbo, "2f", "in_pos")])
+        self._img_prog = ctx.program(vertex_shader=_IMAGE_VS, fragment_shader=_IMAGE_FS)
+        self._img_vao = ctx.vertex_array(self._img_prog, [])
+        self._img_tex = None
         self._coll_vbo = None
         self._coll_vao = None
         self._coll_capacity = 0
@@ -562,6 +585,41 @@ class Renderer:
             f["u_color"].value = (0.6 * r, 0.6 * g, 0.6 * b, a)
             handle.outline_vao.render(moderngl.LINES)
 
+    def draw_image(self, image, position=(0, 0)) -> None:
+        """Draw a picture in pixel coordinates over what is drawn, e.g. an inspector panel.
+
+        Parameters
+        ----------
+        image : (H, W, 4) or (H, W, 3) uint8 array
+            Row 0 on top; alpha blends it over the scene (straight, not premultiplied).
+        position : (int, int)
+            Column and row of its top-left corner in the picture, pixels.
+        """
+        import moderngl
+
+        img = np.asarray(image)
+        if img.dtype != np.uint8 or img.ndim != 3 or img.shape[2] not in (3, 4):
+            raise ValueError(f"image must be an (H, W, 3 or 4) uint8 array, got {img.dtype} {img.shape}")
+        h, w = img.shape[:2]
+        key = (w, h, img.shape[2])
+        if self._img_tex is None or self._img_tex_key != key:
+            if self._img_tex is not None:
+                self._img_tex.release()
+            self._img_tex = self.ctx.texture((w, h), img.shape[2])
+            self._img_tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self._img_tex_key = key
+        # uploaded as is (row 0 first), so t = 0 is the image's top row; the shader flips v
+        self._img_tex.write(np.ascontiguousarray(img).tobytes())
+        W, H = self.size
+        x, y = position
+        rect = (2 * x / W - 1, 1 - 2 * (y + h) / H, 2 * (x + w) / W - 1, 1 - 2 * y / H)
+        self._img_prog["u_rect"].value = rect
+        self._img_tex.use(0)
+        self._img_prog["u_tex"].value = 0
+        self.ctx.enable(moderngl.BLEND)
+        self.ctx.blend_func = _blend()
+        self._img_vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
+
     def finish(self) -> None:
         """Resolve multisampling into the readable framebuffer (called by :meth:`read`)."""
         if self._owns_fbo and self._msaa is not None:
@@ -599,7 +657,8 @@ class Renderer:
         """Free every GPU resource this renderer made (not the context)."""
         for h in list(self._meshes):
             self.remove_mesh(h)
-        for obj in (self._coll_vao, self._coll_vbo, self._grid_vao, self._grid_vbo, self._bg_vao, self._bg_prog, self._body_prog,
+        for obj in (self._img_tex, self._img_vao, self._img_prog, self._coll_vao, self._coll_vbo,
+                    self._grid_vao, self._grid_vbo, self._bg_vao, self._bg_prog, self._body_prog,
                     self._flat_prog, self._coll_prog):
             if obj is not None:
                 obj.release()
