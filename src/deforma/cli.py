@@ -3,6 +3,7 @@
 ``deforma run demo -o demo.mp4``    simulate the demo scene and write a video
 ``deforma mesh bunny -o mesh.png``  a picture of a triangulation with its figures
 ``deforma scenes``                  the built-in scenes and textures
+``deforma view demo``               a window: watch, pull, blow up and edit a scene live
 
 User mistakes (unknown scene, invalid file, output folder missing, unstable simulation) give
 one line on stderr and a non-zero exit code; ``--debug`` shows the traceback instead.
@@ -93,6 +94,21 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("-o", "--output", required=True, metavar="OUT.png", help="the picture to write")
 
     sub.add_parser("scenes", help="list the built-in scenes and textures")
+
+    v = sub.add_parser("view", help="open a window: watch, pull, blow up and edit a scene live",
+                       description="The interactive viewer: a window with the inspector panel, mouse pull (left "
+                                   "drag), explosion (space); H in the window lists every key. With --frames it "
+                                   "runs that many 1/60 s frames without waiting for input (off-screen when "
+                                   "there is no display) and can save the last one.")
+    v.add_argument("scene", metavar="SCENE", nargs="?", default="demo",
+                   help="built-in scene name or a .toml file (default: demo)")
+    v.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="window size (default 1280x720)")
+    v.add_argument("--frames", type=_positive(int), metavar="N", help="run N frames, then close")
+    v.add_argument("--screenshot", metavar="OUT.png", help="with --frames: save the last frame")
+    v.add_argument("--no-panel", action="store_true", help="start with the inspector hidden (Tab shows it)")
+    v.add_argument("--wireframe", action="store_true", help="draw the springs over the bodies")
+    v.add_argument("--samples", type=int, default=0, choices=(0, 2, 4, 8), help="window multisampling (default 0)")
+    v.add_argument("--paused", action="store_true", help="start paused")
     return p
 
 
@@ -337,11 +353,33 @@ def cmd_scenes(a) -> int:
     return 0
 
 
+# -- view ---------------------------------------------------------------------------------------------
+def cmd_view(a) -> int:
+    if a.screenshot and a.frames is None:
+        raise CliError("--screenshot needs --frames N (in the window, F2 takes screenshots)")
+    try:
+        from . import viewer
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise CliError(f"the viewer needs pygame-ce, pygame_gui and moderngl ({e}); "
+                       f"pip install 'deforma[render]'", EXIT_NO_GL) from None
+    try:
+        viewer.run(a.scene, size=a.size, frames=a.frames, screenshot=a.screenshot, panel=not a.no_panel,
+                   wireframe=a.wireframe, samples=a.samples, paused=a.paused)
+    except ImportError as e:  # pragma: no cover - pygame or moderngl missing
+        raise CliError(f"the viewer needs pygame-ce, pygame_gui and moderngl ({e}); "
+                       f"pip install 'deforma[render]'", EXIT_NO_GL) from None
+    except RuntimeError as e:  # no display or no OpenGL 3.3
+        raise CliError(str(e), EXIT_NO_GL) from None
+    if a.screenshot:
+        print(f"{a.scene}: {a.frames} frames -> {a.screenshot}")
+    return 0
+
+
 def main(argv=None) -> int:
     """Entry point of the ``deforma`` command; returns the exit code."""
     parser = _parser()
     a = parser.parse_args(argv)
-    commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes}
+    commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view}
     try:
         return commands[a.command](a)
     except KeyboardInterrupt:
