@@ -1,0 +1,718 @@
+"""The interactive viewer: a pygame-ce OpenGL window, mouse and keys, the inspector panel.
+
+``deforma view [SCENE]`` runs :func:`run`. Each frame:
+
+1. events: the panel gets the ones over it (and key presses while a text box has focus);
+   the others grab and pull bodies, drag colliders, pan, zoom, or are shortcut keys
+   (:mod:`deforma.viewer.controls`);
+2. physics: a :class:`~deforma.viewer.clock.FixedStepClock` turns the frame's wall time into
+   whole ``world.dt`` steps, so the motion is the same at any frame rate; a slow frame is
+   capped instead of spiralling, and an unstable step pauses the viewer and shows the hint;
+3. drawing: the shared :class:`deforma.render.WorldView` paints the world into the window's
+   framebuffer, then the panel, status line and help are drawn over it as textures.
+
+With ``frames=N`` (``--frames``) the viewer runs N frames of exactly 1/60 s of simulated
+time each, without waiting for input or the wall clock, so a script gets the same picture
+every time.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .clock import FixedStepClock
+from .controls import KEYS, help_rows
+from .session import Session
+
+__all__ = ["Viewer", "run"]
+
+#: Simulated seconds per frame in ``frames=N`` mode (a 60 Hz display).
+HEADLESS_FRAME_TIME = 1 / 60
+#: Wall seconds of physics per frame before the rest of the frame's steps are dropped:
+#: keeps the window responsive when a setting makes the physics slower than real time.
+PHYSICS_BUDGET = 0.05
+STATUS_INTERVAL = 0.25   # seconds between status line updates
+SELECTED_COLLIDER_COLOR = "#5b8def"
+
+
+def _font_path() -> str | None:
+    try:
+        import pygame_gui
+
+        p = Path(pygame_gui.__file__).parent / "data" / "NotoSans-Regular.ttf"
+        return str(p) if p.is_file() else None
+    except ImportError:  # pragma: no cover - pygame_gui is required by the viewer anyway
+        return None
+
+
+def _wrap(text: str, font, width: int) -> list[str]:
+    lines, line = [], ""
+    for word in text.split():
+        trial = f"{line} {word}".strip()
+        if line and font.size(trial)[0] > width:
+            lines.append(line)
+            line = word
+        else:
+            line = trial
+    if line:
+        lines.append(line)
+    return lines
+
+
+class Viewer:
+    """A window showing a scene, with the inspector panel, mouse pull and explosion.
+
+    Parameters
+    ----------
+    scene : str, path or deforma.scene.Scene, optional
+        A built-in scene name, a ``.toml`` file or a scene object.
+    size : (int, int), keyword-only
+        Window size in pixels.
+    panel : bool, keyword-only
+        Show the inspector panel (Tab toggles it).
+    vsync : bool, keyword-only
+        Wait for the display's refresh (off for benchmarks and scripts).
+    samples : int, keyword-only
+        Multisampling of the window (0 off; 4 smooths edges at a cost on software GL).
+    save_path : str, keyword-only
+        Initial file name in the panel's "save scene" box.
+
+    Raises
+    ------
+    RuntimeError
+        No window with OpenGL 3.3 can be opened (no display, no GL driver); one line.
+
+    Examples
+    --------
+    >>> import os; os.environ.setdefault("SDL_VIDEODRIVER", "offscreen")  # doctest: +SKIP
+    >>> v = Viewer("demo", size=(640, 360))                               # doctest: +SKIP
+    >>> for _ in range(30): v.frame(1 / 60)                               # doctest: +SKIP
+    >>> v.screenshot().shape                                              # doctest: +SKIP
+    (360, 640, 3)
+    """
+
+    def __init__(self, scene="demo", *, size=(1280, 720), panel: bool = True, vsync: bool = False,
+                 samples: int = 0, save_path: str | None = None):
+        import pygame
+
+        self.pg = pygame
+        self.session = session = scene if isinstance(scene, Session) else Session(scene)
+        self.window_size = (int(size[0]), int(size[1]))
+        self._open_window(vsync=vsync, samples=samples)
+        import moderngl
+
+        from ..render import Camera, Renderer, WorldView
+        from .inspector import Inspector
+        from .overlay import Overlay
+
+        try:
+            self.ctx = moderngl.create_context(require=330)
+        except Exception as e:  # noqa: BLE001 - moderngl raises plain Exceptions
+            pygame.display.quit()
+            raise RuntimeError(f"cannot use OpenGL 3.3 in the window ({e})") from None
+        self._Camera = Camera
+        self.renderer = Renderer(self.ctx, self.window_size, target=self.ctx.screen)
+        self.view = WorldView(self.renderer, session.world)
+        self.overlay = Overlay(self.ctx)
+        name = session.scene.scene.name or "scene"
+        self.save_path = save_path or f"{name}-edited.toml"
+        actions = {"pause": self.toggle_pause, "step": self.single_step, "reset": self.reset,
+                   "wireframe": self.toggle_wireframe}
+        self._Inspector = Inspector
+        self._actions = actions
+        self.inspector = Inspector(session, self.window_size[1], save_path=self.save_path, actions=actions)
+        self.panel_visible = bool(panel)
+        self._panel_stale = True
+        self.panel_layer = self.overlay.layer(self.inspector.surface.get_size())
+        pygame.font.init()
+        fp = _font_path()
+        self.font = pygame.font.Font(fp, 15)
+        self.small_font = pygame.font.Font(fp, 14)
+        self.status_layer = None
+        self.help_layer = None
+        self.message_layer = None
+        self._message_key = None
+        self.help_visible = False
+        self.clock = FixedStepClock()
+        self.paused = False
+        self.unstable: str | None = None
+        self.running = True
+        self.grab = None
+        self._collider_drag = None     # offset from the pointer to the collider centre
+        self._pan = None               # last pointer position while panning
+        self.pointer = (0, 0)
+        self._generation = session.generation
+        self._n_colliders = len(session.world.colliders)
+        self._single = 0
+        self.frames = 0
+        self.steps = 0
+        self._last_time = time.perf_counter()
+        self._stat_time = self._last_time
+        self._stat_frames = 0
+        self._stat_steps = 0
+        self.fps = 0.0
+        self.steps_per_second = 0.0
+        self._status_text = None
+        self._screenshot_requests: list[str] = []
+        self.last_screenshot: np.ndarray | None = None
+        self._keymap = self._make_keymap()
+        pygame.display.set_caption(f"deforma - {name}")
+
+    # -- window ------------------------------------------------------------------------------
+    def _open_window(self, *, vsync: bool, samples: int) -> None:
+        pg = self.pg
+        try:
+            pg.display.init()
+            pg.font.init()  # pygame_gui's fonts need it before the panel is made
+            pg.display.gl_set_attribute(pg.GL_CONTEXT_MAJOR_VERSION, 3)
+            pg.display.gl_set_attribute(pg.GL_CONTEXT_MINOR_VERSION, 3)
+            pg.display.gl_set_attribute(pg.GL_CONTEXT_PROFILE_MASK, pg.GL_CONTEXT_PROFILE_CORE)
+            if samples and samples > 1:
+                pg.display.gl_set_attribute(pg.GL_MULTISAMPLEBUFFERS, 1)
+                pg.display.gl_set_attribute(pg.GL_MULTISAMPLESAMPLES, int(samples))
+            flags = pg.OPENGL | pg.DOUBLEBUF | pg.RESIZABLE
+            try:
+                pg.display.set_mode(self.window_size, flags, vsync=1 if vsync else 0)
+            except pg.error:
+                if not vsync:
+                    raise
+                pg.display.set_mode(self.window_size, flags)  # vsync is a wish, not a need
+        except pg.error as e:
+            pg.display.quit()
+            raise RuntimeError(f"cannot open an OpenGL 3.3 window ({e}); the viewer needs a display "
+                               f"(for scripts: SDL_VIDEODRIVER=offscreen)") from None
+
+    @property
+    def world_size(self) -> tuple[int, int]:
+        """Pixels of the window that show the world (left of the panel)."""
+        from .inspector import PANEL_WIDTH
+
+        w, h = self.window_size
+        if self.panel_visible:
+            w = max(1, w - PANEL_WIDTH)
+        return (w, h)
+
+    def _resize(self, size) -> None:
+        self.window_size = (max(200, int(size[0])), max(200, int(size[1])))
+        message = (self.inspector.message, self.inspector.message_is_error)
+        self.inspector = self._Inspector(self.session, self.window_size[1], save_path=self.inspector.save_entry.get_text(),
+                                         actions=self._actions)
+        self.inspector.say(message[0], error=message[1])
+
+    def close(self) -> None:
+        """Free GL resources and close the window."""
+        for layer in (self.panel_layer, self.status_layer, self.help_layer, self.message_layer):
+            if layer is not None:
+                layer.release()
+        self.overlay.release()
+        self.renderer.release()
+        self.ctx.release()
+        self.pg.display.quit()
+
+    # -- actions -----------------------------------------------------------------------------
+    def _make_keymap(self) -> dict:
+        pg = self.pg
+        out = {}
+        for names, action, _ in KEYS:
+            for n in names:
+                out[pg.key.key_code(n)] = action
+        return out
+
+    def toggle_pause(self) -> None:
+        """Pause or resume; resuming after an instability clears its message."""
+        self.paused = not self.paused
+        if not self.paused:
+            self.unstable = None
+        self.clock.reset()
+
+    def single_step(self) -> None:
+        """Pause (if running) and advance exactly one step."""
+        self.paused = True
+        self._single += 1
+
+    def reset(self) -> None:
+        """Bodies back to their start (keeps every edited value)."""
+        self._release_grab()
+        self.session.reset()
+        self.unstable = None
+        self.clock.reset()
+
+    def toggle_wireframe(self) -> None:
+        self.session.wireframe = not self.session.wireframe
+
+    def explode(self) -> None:
+        """The space key: every vertex gets the explosive force upward (m/s)."""
+        self.session.world.explode(self.session.explosive_force)
+
+    def select_object(self, name: str) -> None:
+        """Switch the edited body to ``bunny``, ``donut``, ``armadillo`` or ``box``."""
+        self._release_grab()
+        self.inspector.apply_object(name)
+
+    def load(self, scene) -> None:
+        """Open another scene (a name, a file, or a Session) in the same window."""
+        self._release_grab()
+        self.session = scene if isinstance(scene, Session) else Session(scene)
+        self.inspector = self._Inspector(self.session, self.window_size[1], save_path=self.save_path,
+                                         actions=self._actions)
+        self._generation = -1  # forces the view to re-upload meshes
+        self.unstable = None
+        self.paused = False
+        self.clock.reset()
+
+    def request_screenshot(self, path: str | None = None) -> None:
+        """Save the next drawn frame to ``path`` (default ``deforma-NNN.png``, never overwriting)."""
+        if path is None:
+            k = 1
+            while Path(f"deforma-{k:03d}.png").exists():
+                k += 1
+            path = f"deforma-{k:03d}.png"
+        self._screenshot_requests.append(str(path))
+
+    def _do(self, action: str) -> None:
+        if action == "explode":
+            self.explode()
+        elif action == "pause":
+            self.toggle_pause()
+        elif action == "step":
+            self.single_step()
+        elif action == "reset":
+            self.reset()
+        elif action == "wireframe":
+            self.toggle_wireframe()
+        elif action.startswith("object:"):
+            self.select_object(action.split(":", 1)[1])
+        elif action == "panel":
+            self.panel_visible = not self.panel_visible
+            self._panel_stale = True
+        elif action == "screenshot":
+            self.request_screenshot()
+        elif action == "help":
+            self.help_visible = not self.help_visible
+        elif action == "quit":
+            self.running = False
+
+    # -- input -------------------------------------------------------------------------------
+    def to_world(self, pos) -> tuple[float, float]:
+        """Window pixel (column, row from the top) to world metres."""
+        p = self.renderer.camera.pixel_to_world(np.asarray(pos, float), self.world_size)
+        return float(p[0]), float(p[1])
+
+    def to_pixel(self, point) -> tuple[float, float]:
+        """World metres to window pixel (column, row from the top)."""
+        q = self.renderer.camera.world_to_pixel(np.asarray(point, float), self.world_size)
+        return float(q[0]), float(q[1])
+
+    def _over_panel(self, pos) -> bool:
+        return self.panel_visible and pos[0] >= self.world_size[0]
+
+    def _panel_event(self, e):
+        pg = self.pg
+        if e.type in (pg.MOUSEMOTION, pg.MOUSEBUTTONDOWN, pg.MOUSEBUTTONUP):
+            d = dict(e.dict)
+            d["pos"] = (e.pos[0] - self.world_size[0], e.pos[1])
+            return pg.event.Event(e.type, d)
+        return e
+
+    def _release_grab(self) -> None:
+        if self.grab is not None:
+            try:
+                self.session.world.release(self.grab)
+            except ValueError:
+                pass  # the world was rebuilt: the grab went with it
+            self.grab = None
+        self._collider_drag = None
+
+    def handle_event(self, e) -> None:
+        """React to one pygame event (the panel's, the world's or a shortcut)."""
+        pg = self.pg
+        t = e.type
+        if t == pg.QUIT:
+            self.running = False
+            return
+        if t == pg.VIDEORESIZE:
+            self._resize(e.size)
+            return
+        if t == pg.DROPFILE and str(e.file).lower().endswith(".toml"):
+            try:
+                self.load(e.file)
+            except ValueError as err:
+                self.inspector.say(str(err), error=True)
+            return
+        if t in (pg.MOUSEMOTION, pg.MOUSEBUTTONDOWN, pg.MOUSEBUTTONUP):
+            self.pointer = tuple(e.pos)
+            busy = self.grab is not None or self._collider_drag is not None or self._pan is not None
+            if self.panel_visible and (t != pg.MOUSEBUTTONDOWN or self._over_panel(e.pos)):
+                # the panel sees every motion and release (hover, slider drags ending outside it)
+                used = self.inspector.process_event(self._panel_event(e))
+                if t == pg.MOUSEBUTTONDOWN and (used or self._over_panel(e.pos)):
+                    return
+            if t == pg.MOUSEMOTION and not busy and self._over_panel(e.pos):
+                return
+            self._world_mouse(e)
+            return
+        if t == pg.MOUSEWHEEL:
+            if self._over_panel(self.pointer):
+                self.inspector.process_event(e)
+            else:
+                self._zoom(e.y)
+            return
+        if t in (pg.KEYDOWN, pg.KEYUP, pg.TEXTINPUT, pg.TEXTEDITING):
+            if self.panel_visible and self.inspector.typing:
+                self.inspector.process_event(e)
+                return
+            if t == pg.KEYDOWN:
+                if e.key == pg.K_s and e.mod & pg.KMOD_CTRL:
+                    self.inspector.save()
+                    self.panel_visible = True
+                    return
+                action = self._keymap.get(e.key)
+                if action is not None:
+                    self._do(action)
+            return
+        # the panel's own events (button presses, entries finished, ...)
+        self.inspector.process_event(e)
+
+    def _world_mouse(self, e) -> None:
+        pg = self.pg
+        s = self.session
+        t = e.type
+        if t == pg.MOUSEBUTTONDOWN and e.button == 1:
+            p = self.to_world(e.pos)
+            self._release_grab()
+            # the triangle under the pointer, as World.grab picks it: mouse strength is per held
+            # vertex, so grabbing a whole patch of a fine mesh would multiply the pull and tear it
+            g = s.world.grab(p)
+            if len(g.vertices):
+                self.grab = g
+                body = s.world.bodies.index(g.body)
+                if body != s.body_index:
+                    s.select_body(body)
+                    self.inspector.refresh(force=True)
+                return
+            s.world.release(g)
+            i = s.collider_at(p)
+            if i is not None:
+                s.select_collider(i)
+                c = s.world.colliders[i]
+                self._collider_drag = (c.center[0] - p[0], c.center[1] - p[1])
+                self.inspector.refresh()
+        elif t == pg.MOUSEBUTTONDOWN and e.button in (2, 3):
+            self._pan = tuple(e.pos)
+        elif t == pg.MOUSEMOTION:
+            if self.grab is not None:
+                s.world.drag(self.grab, self.to_world(e.pos))
+            elif self._collider_drag is not None:
+                p = self.to_world(e.pos)
+                dx, dy = self._collider_drag
+                s.move_collider((p[0] + dx, p[1] + dy))
+            elif self._pan is not None:
+                a, b = self.to_world(self._pan), self.to_world(e.pos)
+                cx, cy = s.camera_center
+                s.camera_center = (cx - (b[0] - a[0]), cy - (b[1] - a[1]))
+                self._pan = tuple(e.pos)
+        elif t == pg.MOUSEBUTTONUP:
+            if e.button == 1:
+                self._release_grab()
+            elif e.button in (2, 3):
+                self._pan = None
+
+    def _metres_per_pixel(self) -> float:
+        hx, _ = self.renderer.camera.extent(self.world_size)
+        return 2 * hx / self.world_size[0]
+
+    def _zoom(self, clicks: float) -> None:
+        s = self.session
+        f = 0.9 ** float(clicks)
+        before = self.to_world(self.pointer)
+        w, h = s.camera_size
+        s.camera_size = (min(max(w * f, 0.2), 500.0), min(max(h * f, 0.2), 500.0))
+        self.renderer.camera = self._Camera(s.camera_center, s.camera_size)
+        after = self.to_world(self.pointer)
+        cx, cy = s.camera_center
+        s.camera_center = (cx + before[0] - after[0], cy + before[1] - after[1])  # zoom about the pointer
+
+    # -- one frame ---------------------------------------------------------------------------
+    def frame(self, frame_time: float | None = None) -> None:
+        """Handle pending events, advance the physics and draw one frame.
+
+        Parameters
+        ----------
+        frame_time : float, optional
+            Seconds this frame stands for. Default: the wall time since the previous frame
+            (and the physics then also stops at :data:`PHYSICS_BUDGET` seconds of work).
+            Given, the frame advances exactly that much simulated time (scripts, tests).
+        """
+        now = time.perf_counter()
+        live = frame_time is None
+        if live:
+            frame_time = now - self._last_time
+        self._last_time = now
+        for e in self.pg.event.get():
+            self.handle_event(e)
+            if not self.running:
+                return
+        self._simulate(frame_time, budget=PHYSICS_BUDGET if live else None)
+        self._draw(frame_time)
+        self.pg.display.flip()
+        self.frames += 1
+        self._stat_frames += 1
+
+    def _simulate(self, frame_time: float, *, budget: float | None) -> None:
+        from ..physics import SimulationUnstable
+
+        world = self.session.world
+        n = 0 if self.paused else self.clock.advance(frame_time, dt=world.dt)
+        n += self._single
+        self._single = 0
+        t0 = time.perf_counter()
+        for k in range(n):
+            try:
+                world.step()
+            except SimulationUnstable as e:
+                self.paused = True
+                self.unstable = e.hint
+                self._release_grab()
+                self.clock.reset()
+                return
+            self.steps += 1
+            self._stat_steps += 1
+            if budget is not None and time.perf_counter() - t0 > budget and k + 1 < n:
+                self.clock.dropped += (n - k - 1) * world.dt
+                break
+
+    def _sync_view(self) -> None:
+        s, v = self.session, self.view
+        if self._generation != s.generation or v.world is not s.world:
+            v.world = s.world
+            v.sync()
+            self._generation = s.generation
+            self._n_colliders = len(s.world.colliders)
+            self.grab = None
+        elif len(s.world.colliders) != self._n_colliders:
+            v.sync()
+            self._n_colliders = len(s.world.colliders)
+        colors = list(s.collider_colors) + [None] * (len(s.world.colliders) - len(s.collider_colors))
+        if s.collider_index is not None and self.panel_visible:
+            colors[s.collider_index] = SELECTED_COLLIDER_COLOR
+        v.collider_colors = colors if any(colors) else None
+        v.wireframe = s.wireframe
+
+    def _draw(self, frame_time: float) -> None:
+        s = self.session
+        self._sync_view()
+        r = self.renderer
+        r.resize(self.world_size)
+        cam = r.camera
+        if cam.center != tuple(s.camera_center) or cam.size != tuple(s.camera_size):
+            r.camera = self._Camera(s.camera_center, s.camera_size)
+        self.view.draw(read=False)
+        win = self.window_size
+        if self.panel_visible:
+            self.inspector.set_paused(self.paused)
+            surf = self.inspector.update(frame_time)
+            if surf is not None or self._panel_stale:
+                self.panel_layer.upload(self.inspector.surface)
+                self._panel_stale = False
+            self.overlay.draw(self.panel_layer, (self.world_size[0], 0), win, blend=False)
+        self._draw_status(win)
+        if self.unstable is not None:
+            self._draw_message(win)
+        if self.help_visible:
+            self._draw_help(win)
+        if self._screenshot_requests:
+            img = self.screenshot()
+            from PIL import Image
+
+            for path in self._screenshot_requests:
+                try:
+                    Image.fromarray(img).save(path)
+                    if self.panel_visible:
+                        self.inspector.say(f"screenshot saved to {path}")
+                except (OSError, ValueError) as e:
+                    self.inspector.say(f"cannot save the screenshot: {e}", error=True)
+            self._screenshot_requests.clear()
+
+    def screenshot(self) -> np.ndarray:
+        """The window's current picture as an (H, W, 3) uint8 array, row 0 on top."""
+        from .overlay import as_rgb_array
+
+        w, h = self.window_size
+        raw = self.ctx.screen.read(viewport=(0, 0, w, h), components=3, alignment=1)
+        self.last_screenshot = as_rgb_array(raw, (w, h))
+        return self.last_screenshot
+
+    # -- text overlays -----------------------------------------------------------------------
+    def _update_stats(self) -> None:
+        now = time.perf_counter()
+        dt = now - self._stat_time
+        if dt >= STATUS_INTERVAL or self._status_text is None:
+            if dt > 0 and self._stat_frames:
+                self.fps = self._stat_frames / dt
+                self.steps_per_second = self._stat_steps / dt
+            self._stat_time, self._stat_frames, self._stat_steps = now, 0, 0
+            w = self.session.world
+            nv = sum(b.n_vertices for b in w.bodies)
+            nt = sum(len(b.triangles) for b in w.bodies)
+            try:
+                energy = f"{w.energy().total:.2f} J"
+            except (ValueError, FloatingPointError):
+                energy = "-"
+            state = "   PAUSED" if self.paused else ""
+            self._status_text = (f"{self.fps:.0f} frames/s   {self.steps_per_second:.0f} steps/s   "
+                                 f"{nv} vertices   {nt} triangles   energy {energy}   "
+                                 f"t = {w.time:.2f} s{state}   H: help")
+
+    def _draw_status(self, win) -> None:
+        from .overlay import rounded_box
+
+        prev = self._status_text
+        self._update_stats()
+        if self.status_layer is None or prev != self._status_text:
+            text = self.small_font.render(self._status_text, True, (245, 247, 250))
+            box = rounded_box((text.get_width() + 20, text.get_height() + 10), (24, 30, 40, 190), 8)
+            box.blit(text, (10, 5))
+            if self.status_layer is None:
+                self.status_layer = self.overlay.layer(box.get_size())
+            self.status_layer.upload(box)
+        h = self.status_layer.size[1]
+        self.overlay.draw(self.status_layer, (10, win[1] - h - 10), win)
+
+    def _text_box(self, rows, *, width, fg, bg, title=None, key_width=0):
+        """A rounded box of text rows; a row is a string or (key, text) drawn in two columns."""
+        from .overlay import rounded_box
+
+        f = self.small_font
+        rendered = []
+        if title:
+            rendered.append((None, self.font.render(title, True, fg), 6))
+        for row in rows:
+            if isinstance(row, tuple):
+                rendered.append((f.render(row[0], True, (150, 190, 255)), f.render(row[1], True, fg), 0))
+            else:
+                rendered.append((None, f.render(row, True, fg), 0))
+        h = sum(t.get_height() + extra for _, t, extra in rendered) + 24
+        w = min(width, max(t.get_width() + (key_width if k is not None else 0) for k, t, _ in rendered) + 32)
+        box = rounded_box((w, h), bg, 10)
+        y = 12
+        for k, t, extra in rendered:
+            if k is not None:
+                box.blit(k, (16, y))
+                box.blit(t, (16 + key_width, y))
+            else:
+                box.blit(t, (16, y))
+            y += t.get_height() + extra
+        return box
+
+    def _draw_help(self, win) -> None:
+        if self.help_layer is None:
+            rows = help_rows()
+            key_width = max(self.small_font.size(k)[0] for k, _ in rows) + 18
+            box = self._text_box(rows, width=760, fg=(245, 247, 250), bg=(24, 30, 40, 225),
+                                 title="Keys and mouse", key_width=key_width)
+            self.help_layer = self.overlay.layer(box.get_size())
+            self.help_layer.upload(box)
+        w, h = self.help_layer.size
+        ww, wh = self.world_size
+        self.overlay.draw(self.help_layer, (max(0, (ww - w) // 2), max(0, (wh - h) // 2)), win)
+
+    def _draw_message(self, win) -> None:
+        key = (self.unstable, self.world_size)
+        if self.message_layer is None or key != self._message_key:
+            width = min(640, self.world_size[0] - 40)
+            lines = _wrap(f"{self.unstable}. Change a value in the panel, then press P to resume or R to reset.",
+                          self.small_font, width - 32)
+            box = self._text_box(lines, width=width, fg=(255, 255, 255), bg=(170, 45, 40, 230),
+                                 title="Simulation unstable: paused")
+            if self.message_layer is not None:
+                self.message_layer.release()
+            self.message_layer = self.overlay.layer(box.get_size())
+            self.message_layer.upload(box)
+            self._message_key = key
+        w, _ = self.message_layer.size
+        self.overlay.draw(self.message_layer, (max(0, (self.world_size[0] - w) // 2), 20), win)
+
+    # -- loop --------------------------------------------------------------------------------
+    def run(self, *, frames: int | None = None, screenshot: str | None = None, max_fps: float = 240.0) -> None:
+        """Run until quit, or exactly ``frames`` frames (1/60 s each) then save ``screenshot``."""
+        if frames is not None:
+            for k in range(frames):
+                if k == frames - 1 and screenshot:
+                    self.request_screenshot(screenshot)
+                self.frame(HEADLESS_FRAME_TIME)
+                if not self.running:
+                    break
+            return
+        limiter = self.pg.time.Clock()
+        while self.running:
+            self.frame()
+            limiter.tick(max_fps)
+
+
+def _no_display() -> bool:
+    """True on Linux/BSD without X11 or Wayland (and no SDL driver chosen by the user).
+
+    SDL would then quietly fall back to an invisible off-screen window, which is right for
+    scripts (``--frames``) and wrong for a person waiting for a window.
+    """
+    import sys
+
+    if sys.platform in ("win32", "darwin"):
+        return False
+    return not any(os.environ.get(k) for k in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER"))
+
+
+def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot: str | None = None,
+        panel: bool = True, wireframe: bool = False, samples: int = 0, paused: bool = False) -> Viewer | None:
+    """Open the viewer on ``scene``: until the window is closed, or for ``frames`` frames.
+
+    Parameters
+    ----------
+    scene : str or path
+        Built-in scene name or ``.toml`` file.
+    size : (int, int), keyword-only
+        Window size in pixels.
+    frames : int, keyword-only
+        Run this many frames (each 1/60 s of simulated time) without waiting for input, then
+        return. Without a display, the window is then made off-screen (SDL's ``offscreen``).
+    screenshot : str, keyword-only
+        With ``frames``: save the last frame to this PNG.
+    panel, wireframe, samples, paused : keyword-only
+        Start with the panel shown, the springs drawn, this multisampling, paused.
+
+    Raises
+    ------
+    RuntimeError
+        No OpenGL window can be opened; ValueError for a bad scene or output path.
+    """
+    if screenshot is not None:
+        out = Path(screenshot)
+        if out.suffix.lower() != ".png":
+            raise ValueError(f"{screenshot}: a screenshot is written as PNG; give a name ending in .png")
+        if not out.parent.is_dir():
+            raise ValueError(f"{screenshot}: the folder {str(out.parent)!r} does not exist")
+    session = Session(scene)  # a bad scene fails before a window opens
+    if wireframe:
+        session.wireframe = True
+    if _no_display():
+        if frames is None:
+            raise RuntimeError("no display to open a window on (neither DISPLAY nor WAYLAND_DISPLAY is set); "
+                               "for scripts use --frames N --screenshot out.png")
+        os.environ["SDL_VIDEODRIVER"] = "offscreen"
+    v = Viewer(session, size=size, panel=panel, vsync=frames is None, samples=samples)
+    v.paused = paused
+    try:
+        v.run(frames=frames, screenshot=screenshot)
+    finally:
+        v.close()
+    return None
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    run(sys.argv[1] if len(sys.argv) > 1 else "demo")

@@ -1,0 +1,131 @@
+"""The inspector's parameters, grouped as in the original Unity inspector.
+
+Plain data (no GUI): :mod:`deforma.viewer.inspector` makes a row of widgets for each
+:class:`Param`, and :meth:`deforma.viewer.session.Session.set_param` applies values by name.
+Slider ranges are what is comfortable to drag; the text box beside each slider accepts any
+value the session accepts (it refuses the others with a message).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["GROUPS", "PARAMS", "Param", "format_value", "parse_value"]
+
+
+@dataclass(frozen=True)
+class Param:
+    """One inspector row.
+
+    ``kind`` is ``float``, ``int`` or ``bool``; ``lo``/``hi`` the slider's range and ``log``
+    whether it moves in equal ratios (stiffness from 10 to 100000 N/m needs that).
+    ``rebuild`` marks values that rebuild the body (the original's mesh settings).
+    """
+
+    name: str
+    label: str
+    kind: str = "float"
+    lo: float = 0.0
+    hi: float = 1.0
+    log: bool = False
+    unit: str = ""
+    rebuild: bool = False
+    tip: str = ""
+
+    def to_slider(self, value: float) -> float:
+        """Slider position in [0, 1] for ``value`` (clamped)."""
+        if self.log:
+            v = max(float(value), self.lo)
+            t = math.log(v / self.lo) / math.log(self.hi / self.lo)
+        else:
+            t = (float(value) - self.lo) / (self.hi - self.lo)
+        return min(1.0, max(0.0, t))
+
+    def from_slider(self, t: float):
+        """The value at slider position ``t`` in [0, 1], rounded to what reads well."""
+        t = min(1.0, max(0.0, float(t)))
+        v = self.lo * (self.hi / self.lo) ** t if self.log else self.lo + t * (self.hi - self.lo)
+        if self.kind == "int":
+            return int(round(v))
+        return float(f"{v:.3g}")
+
+
+GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
+    ("Square", (
+        Param("detail", "Detail", "int", 0, 40, tip="n: n*n points inside the box", rebuild=True),
+        Param("edges", "Set edges", "bool", tip="points on the four sides too", rebuild=True),
+    )),
+    ("Texture", (
+        Param("scale", "Scale", "float", 0.001, 0.02, log=True, unit="m/px", tip="metres per pixel", rebuild=True),
+        Param("resolution", "Resolution", "int", 3, 40, unit="px",
+              tip="sample every n-th pixel; smaller gives more points", rebuild=True),
+        Param("detect_edges", "Detect edges", "bool", tip="points along the outline", rebuild=True),
+        Param("edge_step", "Edge step", "int", 1, 20, unit="px", tip="every n-th outline pixel", rebuild=True),
+    )),
+    ("Physics", (
+        Param("dt", "Dt", "float", 1e-4, 1e-2, log=True, unit="s", tip="seconds per step"),
+        Param("substeps", "Substeps", "int", 1, 20, tip="integration substeps per step"),
+        Param("gravity_x", "Gravity x", "float", -20, 20, unit="m/s²"),
+        Param("gravity_y", "Gravity y", "float", -20, 20, unit="m/s²"),
+        Param("damping", "Damping", "float", 0.0, 10.0, unit="N·s/m", tip="spring damping kd"),
+        Param("mass", "Mass", "float", 0.1, 20.0, log=True, unit="kg", tip="total mass of a body"),
+        Param("stiffness", "Stiffness", "float", 10.0, 20000.0, log=True, unit="N/m", tip="spring constant ks"),
+        Param("static_friction", "Static friction", "float", 0.0, 2.0),
+        Param("friction", "Friction", "float", 0.0, 2.0),
+        Param("explosive_force", "Explosive force", "float", 0.0, 30.0, unit="m/s", tip="the space key"),
+    )),
+    ("Collision", (
+        Param("collider_x", "Center x", "float", -20, 20, unit="m"),
+        Param("collider_y", "Center y", "float", -10, 20, unit="m"),
+        Param("collider_width", "Width", "float", 0.05, 30, log=True, unit="m"),
+        Param("collider_height", "Height", "float", 0.05, 10, log=True, unit="m"),
+        Param("collider_angle", "Angle", "float", -90, 90, unit="°"),
+    )),
+    ("Mouse", (
+        Param("mouse_strength", "Mouse strength", "float", 1.0, 2000.0, log=True, unit="N/m",
+              tip="pull per held vertex"),
+    )),
+)
+
+PARAMS: dict[str, Param] = {p.name: p for _, group in GROUPS for p in group}
+
+
+def format_value(param: Param, value) -> str:
+    """Text for the value box: integers plain, floats with up to 4 significant digits."""
+    if value is None:
+        return ""
+    if param.kind == "int":
+        return str(int(value))
+    return f"{float(value):.4g}"
+
+
+def parse_value(param: Param, text: str):
+    """The number typed in a value box.
+
+    Raises
+    ------
+    ValueError
+        Not a number (or not a whole number for an integer parameter); one line.
+
+    Examples
+    --------
+    >>> parse_value(PARAMS["stiffness"], " 2.5e3 ")
+    2500.0
+    >>> parse_value(PARAMS["detail"], "7.5")
+    Traceback (most recent call last):
+    ...
+    ValueError: Detail must be a whole number, got '7.5'
+    """
+    s = text.strip().replace(",", ".")
+    try:
+        v = float(s)
+    except ValueError:
+        raise ValueError(f"{param.label} must be a number, got {text.strip()!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{param.label} must be finite, got {text.strip()!r}")
+    if param.kind == "int":
+        if not v.is_integer():
+            raise ValueError(f"{param.label} must be a whole number, got {text.strip()!r}")
+        return int(v)
+    return v

@@ -1,0 +1,364 @@
+"""What the viewer edits, without any window: the world, its scene and the inspector's values.
+
+A :class:`Session` owns the live :class:`deforma.World` and knows how it was made (through
+``deforma.scene.scene_of``), so that
+
+- physics values are set on the running world at once;
+- mesh values (the original's Square and Texture settings and "Selected") rebuild the world
+  from its current scene with the edited body's recipe replaced: the bodies start again from
+  their starting positions, every other setting is kept;
+- colliders are added, removed and edited in place;
+- :meth:`Session.save` writes a scene file that ``deforma run`` renders the same way.
+
+Everything here is testable without pygame; :mod:`deforma.viewer.app` only forwards input.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..physics import Rect
+from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
+from ..scene.assets import builtin_textures
+
+__all__ = ["MESH_LIMITS", "OBJECTS", "MeshSettings", "Session"]
+
+#: The original's "Selected" choices, in the order of the number keys 1-4.
+OBJECTS = ("bunny", "donut", "armadillo", "box")
+
+#: Ranges the inspector accepts for mesh values. Tighter than the scene schema on purpose:
+#: a live window must rebuild in a fraction of a second and still run at 60 frames/s, and
+#: detail 100 or resolution 3 already give about ten thousand points (``deforma run`` takes
+#: the schema's full range).
+MESH_LIMITS = {"detail": (0, 100), "resolution": (3, 64), "edge_step": (1, 64), "scale": (1e-4, 0.1)}
+
+# Used when a body switches kind and has no value of the other kind yet: a 1.5 m object
+# either way, with a few hundred to a thousand points.
+_IMAGE_DEFAULTS = {"resolution": 10, "detect_edges": True, "edge_step": 5, "scale": 0.004}
+_BOX_HALF = 0.75
+#: Substeps a mesh change may raise on its own (beyond, the unstable hint explains what to do).
+MAX_AUTO_SUBSTEPS = 64
+
+
+@dataclass(frozen=True)
+class MeshSettings:
+    """The inspector's mesh values of one body (both kinds, so switching back keeps them)."""
+
+    selected: str = "box"
+    detail: int = 8
+    edges: bool = True
+    corners: tuple = ((-_BOX_HALF, -_BOX_HALF), (_BOX_HALF, -_BOX_HALF), (_BOX_HALF, _BOX_HALF),
+                      (-_BOX_HALF, _BOX_HALF))
+    resolution: int = _IMAGE_DEFAULTS["resolution"]
+    detect_edges: bool = _IMAGE_DEFAULTS["detect_edges"]
+    edge_step: int = _IMAGE_DEFAULTS["edge_step"]
+    scale: float = _IMAGE_DEFAULTS["scale"]
+
+    @classmethod
+    def from_spec(cls, spec) -> "MeshSettings":
+        """The settings a body spec implies; ``selected`` is the texture name, ``box`` or ``mesh``."""
+        if isinstance(spec, BoxBody):
+            return cls(selected="box", detail=spec.detail, edges=spec.edges, corners=spec.corners)
+        if isinstance(spec, ImageBody):
+            name = spec.source if spec.source in builtin_textures() else Path(spec.source).stem
+            return cls(selected=name, resolution=spec.resolution, detect_edges=spec.detect_edges,
+                       edge_step=spec.edge_step, scale=spec.scale)
+        return cls(selected="mesh")
+
+
+def _check_int(value, name: str) -> int:
+    lo, hi = MESH_LIMITS[name]
+    if isinstance(value, bool) or not float(value).is_integer():
+        raise ValueError(f"{name} must be a whole number in [{lo}, {hi}], got {value!r}")
+    v = int(value)
+    if not lo <= v <= hi:
+        raise ValueError(f"{name} must be in [{lo}, {hi}] in the viewer, got {v}")
+    return v
+
+
+class Session:
+    """The live world, the scene it came from, and the inspector's selection.
+
+    Parameters
+    ----------
+    scene : deforma.scene.Scene or str
+        A scene, a built-in scene name or a ``.toml`` path.
+
+    Examples
+    --------
+    >>> s = Session("demo")
+    >>> s.set_param("stiffness", 3000.0); s.world.stiffness
+    3000.0
+    >>> s.select_object("box"); s.mesh.selected, type(s.body_spec).__name__
+    ('box', 'BoxBody')
+    >>> s.set_param("detail", 1000)
+    Traceback (most recent call last):
+    ...
+    ValueError: detail must be in [0, 100] in the viewer, got 1000
+    """
+
+    def __init__(self, scene):
+        if not isinstance(scene, Scene):
+            scene = load(scene)
+        self.world = build(scene)
+        self.explosive_force = float(scene.interaction.explosive_force)
+        self.camera_center = tuple(scene.camera.center)
+        self.camera_size = tuple(scene.camera.size)
+        self.wireframe = bool(scene.camera.wireframe)
+        self.collider_colors = [c.color for c in scene.collider]
+        self.collider_index = 0 if scene.collider else None
+        self.body_index = 0
+        self.mesh = MeshSettings.from_spec(scene.body[0]) if scene.body else MeshSettings()
+        #: Bumped on every rebuild, so a window knows to re-upload meshes.
+        self.generation = 0
+        #: A remark about the last change (e.g. substeps raised), for the panel to show.
+        self.note = ""
+
+    # -- what the inspector reads --------------------------------------------------------------
+    @property
+    def scene(self) -> Scene:
+        """The current setup as a scene (starting positions, current parameters, camera, colliders)."""
+        s = scene_of(self.world)
+        colliders = tuple(replace(c, color=self.collider_colors[i] if i < len(self.collider_colors) else None)
+                          for i, c in enumerate(s.collider))
+        camera = replace(s.camera, center=tuple(map(float, self.camera_center)),
+                         size=tuple(map(float, self.camera_size)), wireframe=bool(self.wireframe))
+        return replace(s, collider=colliders, camera=camera,
+                       interaction=replace(s.interaction, explosive_force=float(self.explosive_force)))
+
+    @property
+    def body_spec(self):
+        """The scene spec of the body the mesh values edit (None without bodies)."""
+        bodies = scene_of(self.world).body
+        return bodies[self.body_index] if bodies else None
+
+    @property
+    def collider(self) -> Rect | None:
+        """The collider the inspector edits."""
+        if self.collider_index is None:
+            return None
+        return self.world.colliders[self.collider_index]
+
+    # -- parameters ----------------------------------------------------------------------------
+    def get_param(self, name: str):
+        """Current value of an inspector parameter by name (see :data:`deforma.viewer.params.PARAMS`)."""
+        w = self.world
+        if name in ("gravity_x", "gravity_y"):
+            return w.gravity[0 if name == "gravity_x" else 1]
+        if name in ("dt", "substeps", "damping", "mass", "stiffness", "friction", "static_friction"):
+            return getattr(w, name)
+        if name == "explosive_force":
+            return self.explosive_force
+        if name == "mouse_strength":
+            return w.grab_strength
+        if name in ("detail", "edges", "resolution", "detect_edges", "edge_step", "scale"):
+            return getattr(self.mesh, name)
+        if name.startswith("collider_"):
+            c = self.collider
+            if c is None:
+                return None
+            return {"collider_x": c.center[0], "collider_y": c.center[1], "collider_width": c.size[0],
+                    "collider_height": c.size[1], "collider_angle": c.angle}[name]
+        raise KeyError(f"unknown parameter {name!r}")
+
+    def set_param(self, name: str, value) -> None:
+        """Set an inspector parameter; physics applies at once, mesh values rebuild the body.
+
+        Raises
+        ------
+        ValueError
+            One line naming the parameter and what is allowed; nothing changes then.
+        """
+        w = self.world
+        if name in ("gravity_x", "gravity_y"):
+            g = list(w.gravity)
+            g[0 if name == "gravity_x" else 1] = value
+            w.gravity = g
+        elif name == "substeps":
+            if isinstance(value, float) and value.is_integer():
+                value = int(value)
+            w.substeps = value
+        elif name in ("dt", "damping", "mass", "stiffness", "friction", "static_friction"):
+            setattr(w, name, value)
+        elif name == "explosive_force":
+            v = float(value)
+            if not (np.isfinite(v) and v >= 0):
+                raise ValueError(f"explosive_force must be a finite number >= 0 m/s, got {value!r}")
+            self.explosive_force = v
+        elif name == "mouse_strength":
+            w.grab_strength = value
+        elif name in ("detail", "resolution", "edge_step"):
+            self._set_mesh(**{name: _check_int(value, name)})
+        elif name in ("edges", "detect_edges"):
+            self._set_mesh(**{name: bool(value)})
+        elif name == "scale":
+            lo, hi = MESH_LIMITS["scale"]
+            v = float(value)
+            if not lo <= v <= hi:
+                raise ValueError(f"scale must be in [{lo:g}, {hi:g}] m/px in the viewer, got {value!r}")
+            self._set_mesh(scale=v)
+        elif name.startswith("collider_"):
+            self._edit_collider(name, value)
+        else:
+            raise KeyError(f"unknown parameter {name!r}")
+
+    # -- mesh ---------------------------------------------------------------------------------
+    def select_object(self, name: str) -> None:
+        """Switch the edited body to ``bunny``, ``donut``, ``armadillo`` or ``box`` (rebuilds)."""
+        if name not in OBJECTS:
+            raise ValueError(f"object must be one of {', '.join(OBJECTS)}, got {name!r}")
+        self._set_mesh(selected=name)
+
+    def select_body(self, index: int) -> None:
+        """Make body ``index`` the one the mesh values edit."""
+        n = len(self.world.bodies)
+        if not 0 <= index < n:
+            raise ValueError(f"body index must be in [0, {n - 1}], got {index}")
+        self.body_index = index
+        self.mesh = MeshSettings.from_spec(self.body_spec)
+
+    def _set_mesh(self, **changes) -> None:
+        new = replace(self.mesh, **changes)
+        spec = self.body_spec
+        if spec is None:
+            raise ValueError("the scene has no body to change")
+        if new.selected == "mesh":
+            raise ValueError("this body was given as a mesh in the scene: choose bunny, donut, armadillo or box first")
+        position = spec.position
+        if position is None:  # keep the body where it is when the new mesh has other coordinates
+            rest = self.world.bodies[self.body_index].topology.rest_positions
+            position = tuple(float(v) for v in (rest.min(axis=0) + rest.max(axis=0)) / 2)
+        common = dict(position=position, mass=spec.mass, stiffness=spec.stiffness, damping=spec.damping)
+        if new.selected == "box":
+            color = spec.color if isinstance(spec, BoxBody) else None
+            texture = spec.texture if isinstance(spec, BoxBody) else None
+            body = BoxBody(corners=new.corners, detail=new.detail, edges=new.edges, color=color, texture=texture,
+                           **common)
+        else:
+            source = new.selected
+            if isinstance(spec, ImageBody) and MeshSettings.from_spec(spec).selected == new.selected:
+                source = spec.source  # an image file given by path keeps its path
+            keep = isinstance(spec, ImageBody) and source == spec.source
+            body = ImageBody(source=source, resolution=new.resolution, detect_edges=new.detect_edges,
+                             edge_step=new.edge_step, scale=new.scale,
+                             color=spec.color if keep else None, texture=spec.texture if keep else None, **common)
+        self._rebuild(body)
+        self.mesh = new
+        self._keep_stable()
+
+    def _keep_stable(self) -> None:
+        # mass per vertex is mass / N (the original's rule), so a finer mesh needs smaller
+        # substeps; raise them to what the world's own estimate asks rather than let the new
+        # body blow up on its first frame
+        w = self.world
+        stable = w.stable_dt()
+        need = math.ceil(w.dt / stable) if stable > 0 else w.substeps
+        if w.substeps < need <= MAX_AUTO_SUBSTEPS:
+            w.substeps = need
+            self.note = f"substeps raised to {need} so the finer mesh stays stable (stable dt {stable:.2g} s)"
+
+    def _rebuild(self, body_spec=None) -> None:
+        self.note = ""
+        scene = self.scene
+        if body_spec is not None:
+            bodies = list(scene.body)
+            bodies[self.body_index] = body_spec
+            scene = replace(scene, body=tuple(bodies))
+        try:
+            world = build(scene)
+        except SceneError as e:
+            # the message starts with the scene file's name, which says nothing in a panel
+            raise ValueError(str(e).split(": ", 1)[-1]) from None
+        self.world = world
+        self.generation += 1
+
+    def reset(self) -> None:
+        """Start again: every body back at its starting position, at rest, time zero."""
+        self._rebuild()
+
+    # -- colliders ----------------------------------------------------------------------------
+    def add_collider(self, *, center=None, size=(3.0, 0.3), angle=0.0) -> Rect:
+        """Add a rectangle (by default 3 m x 0.3 m at the camera centre) and select it."""
+        r = self.world.add_collider(Rect(self.camera_center if center is None else center, size, angle))
+        self.collider_colors.append(None)
+        self.collider_index = len(self.world.colliders) - 1
+        return r
+
+    def remove_collider(self) -> None:
+        """Remove the selected collider."""
+        if self.collider_index is None:
+            raise ValueError("there is no collider to remove")
+        i = self.collider_index
+        del self.world.colliders[i]
+        if i < len(self.collider_colors):
+            del self.collider_colors[i]
+        n = len(self.world.colliders)
+        self.collider_index = None if n == 0 else min(i, n - 1)
+
+    def select_collider(self, index) -> None:
+        """Make collider ``index`` the one the inspector edits (None for none)."""
+        n = len(self.world.colliders)
+        if index is not None and not 0 <= index < n:
+            raise ValueError(f"collider index must be in [0, {n - 1}], got {index}")
+        self.collider_index = index
+
+    def move_collider(self, center) -> None:
+        """Put the selected collider's centre at ``center`` (metres): mouse dragging."""
+        c = self.collider
+        if c is None:
+            raise ValueError("there is no collider selected")
+        self._replace_collider(center=tuple(float(v) for v in center))
+
+    def _edit_collider(self, name, value) -> None:
+        c = self.collider
+        if c is None:
+            raise ValueError("there is no collider selected: add one first")
+        v = float(value)
+        if name == "collider_x":
+            self._replace_collider(center=(v, c.center[1]))
+        elif name == "collider_y":
+            self._replace_collider(center=(c.center[0], v))
+        elif name == "collider_width":
+            self._replace_collider(size=(v, c.size[1]))
+        elif name == "collider_height":
+            self._replace_collider(size=(c.size[0], v))
+        elif name == "collider_angle":
+            if not -360.0 <= v <= 360.0:
+                raise ValueError(f"collider angle must be in [-360, 360] degrees, got {value!r}")
+            self._replace_collider(angle=v)
+        else:
+            raise KeyError(f"unknown parameter {name!r}")
+
+    def _replace_collider(self, **changes) -> None:
+        c = self.collider
+        fields = dict(center=c.center, size=c.size, angle=c.angle)
+        fields.update(changes)
+        # Rect is frozen and validates: a bad value raises before the world sees it
+        new = Rect(fields["center"], fields["size"], fields["angle"], friction=c.friction,
+                   static_friction=c.static_friction)
+        self.world.colliders[self.collider_index] = new
+
+    def collider_at(self, point) -> int | None:
+        """Index of the topmost collider containing ``point`` (metres), or None."""
+        p = np.asarray([point], dtype=np.float64)
+        for i in range(len(self.world.colliders) - 1, -1, -1):
+            if bool(self.world.colliders[i].contains(p)[0]):
+                return i
+        return None
+
+    # -- files --------------------------------------------------------------------------------
+    def save(self, path) -> Path:
+        """Write the current setup as a scene file; returns the path written.
+
+        Raises
+        ------
+        ValueError
+            The name does not end in ``.toml`` or its folder does not exist.
+        """
+        from ..scene import save_scene
+
+        return save_scene(self.scene, path)

@@ -1,0 +1,265 @@
+"""The real viewer, driven by posted pygame events in an off-screen OpenGL window."""
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pygame
+import pytest
+from PIL import Image
+
+import deforma
+
+
+def post(kind, **fields):
+    pygame.event.post(pygame.event.Event(kind, **fields))
+
+
+def key(k, mod=0):
+    post(pygame.KEYDOWN, key=k, mod=mod, unicode="", scancode=0)
+    post(pygame.KEYUP, key=k, mod=mod, unicode="", scancode=0)
+
+
+def run(v, frames):
+    for _ in range(frames):
+        v.frame(1 / 60)
+
+
+def body(v):
+    return v.session.world.bodies[0]
+
+
+def test_mouse_drag_pulls_the_body_toward_the_pointer(demo):
+    run(demo, 40)  # let the bunny land on the first slope
+    start = body(demo).center_of_mass.copy()
+    px = demo.to_pixel(start)
+    # the centre of mass may fall in the bunny's hollow: press on a vertex instead
+    verts = body(demo).positions
+    press = demo.to_pixel(verts[np.argmin(np.linalg.norm(verts - start, axis=1))])
+    press = (int(round(press[0])), int(round(press[1])))
+    post(pygame.MOUSEBUTTONDOWN, pos=press, button=1)
+    run(demo, 1)
+    assert demo.grab is not None and len(demo.grab.vertices) >= 3
+    target_px = (int(px[0]) + 150, int(px[1]) - 120)
+    target = np.array(demo.to_world(target_px))
+    post(pygame.MOUSEMOTION, pos=target_px, rel=(150, -120), buttons=(1, 0, 0))
+    run(demo, 12)
+    moved = body(demo).center_of_mass
+    assert np.linalg.norm(target - moved) < np.linalg.norm(target - start) - 0.3
+    post(pygame.MOUSEBUTTONUP, pos=target_px, button=1)
+    run(demo, 1)
+    assert demo.grab is None
+
+
+def test_press_on_empty_sky_grabs_nothing(demo):
+    post(pygame.MOUSEBUTTONDOWN, pos=(900, 30), button=1)  # top right of the world, above everything
+    run(demo, 1)
+    assert demo.grab is None
+
+
+def test_space_makes_the_body_rise(demo):
+    run(demo, 60)
+    y0 = body(demo).center_of_mass[1]
+    demo.session.explosive_force = 8.0
+    key(pygame.K_SPACE)
+    run(demo, 15)
+    assert body(demo).center_of_mass[1] > y0 + 0.4
+
+
+def test_dragging_the_stiffness_slider_changes_the_world(demo):
+    row = demo.inspector.rows["stiffness"]
+    button = row.slider.sliding_button.rect
+    offset = demo.world_size[0]  # the panel's left edge in window pixels
+    x, y = offset + button.centerx, button.centery
+    before = demo.session.world.stiffness
+    post(pygame.MOUSEMOTION, pos=(x, y), rel=(0, 0), buttons=(0, 0, 0))
+    run(demo, 1)
+    post(pygame.MOUSEBUTTONDOWN, pos=(x, y), button=1)
+    run(demo, 1)
+    post(pygame.MOUSEMOTION, pos=(x + 25, y), rel=(25, 0), buttons=(1, 0, 0))
+    run(demo, 2)
+    post(pygame.MOUSEBUTTONUP, pos=(x + 25, y), button=1)
+    run(demo, 2)
+    after = demo.session.world.stiffness
+    assert after > before * 1.5
+    assert row.entry.get_text() == f"{after:.4g}"
+
+
+def test_slider_set_through_its_api_applies(demo):
+    row = demo.inspector.rows["damping"]
+    row.slider.set_current_value(0.5)
+    run(demo, 1)
+    assert demo.session.world.damping == pytest.approx(5.0)
+
+
+def test_typed_value_applies_and_invalid_one_is_refused(demo):
+    entry = demo.inspector.rows["mass"].entry
+    entry.set_text("2.5")
+    post(pygame_gui_event("UI_TEXT_ENTRY_FINISHED"), ui_element=entry, text="2.5")
+    run(demo, 1)
+    assert demo.session.world.mass == 2.5
+    entry.set_text("heavy")
+    post(pygame_gui_event("UI_TEXT_ENTRY_FINISHED"), ui_element=entry, text="heavy")
+    run(demo, 2)
+    assert demo.session.world.mass == 2.5
+    assert demo.inspector.message_is_error and "must be a number" in demo.inspector.message
+    assert entry.get_text() == "2.5"  # the box shows the value in force again
+    demo.inspector.rows["detail"].entry.set_text("100000")
+    post(pygame_gui_event("UI_TEXT_ENTRY_FINISHED"), ui_element=demo.inspector.rows["detail"].entry, text="")
+    run(demo, 2)
+    assert demo.inspector.message_is_error and "detail" in demo.inspector.message
+
+
+def pygame_gui_event(name):
+    import pygame_gui
+
+    return getattr(pygame_gui, name)
+
+
+@pytest.mark.parametrize("k, name", [(pygame.K_4, "box"), (pygame.K_2, "donut"), (pygame.K_3, "armadillo"),
+                                     (pygame.K_1, "bunny")])
+def test_number_keys_switch_the_object(demo, k, name):
+    if name == "bunny":
+        key(pygame.K_2)
+        run(demo, 1)
+    key(k)
+    run(demo, 3)
+    assert demo.session.mesh.selected == name
+    assert demo.inspector.selected_menu.selected_option[0] == name
+    spec = demo.session.body_spec
+    assert (spec.shape, getattr(spec, "source", "box")) == ("box" if name == "box" else "image", name)
+    assert demo.view._bodies[0] is body(demo)  # the window draws the new body
+    assert demo.unstable is None
+
+
+def test_shortcuts_pause_step_reset_wireframe_panel(demo):
+    key(pygame.K_p)
+    run(demo, 1)
+    t = demo.session.world.time
+    run(demo, 5)
+    assert demo.paused and demo.session.world.time == t
+    key(pygame.K_n)
+    run(demo, 1)
+    assert demo.session.world.step_count == int(round(t / demo.session.world.dt)) + 1
+    key(pygame.K_r)
+    run(demo, 1)
+    assert demo.session.world.time == 0.0
+    key(pygame.K_w)
+    key(pygame.K_TAB)
+    run(demo, 1)
+    assert demo.session.wireframe and demo.view.wireframe and not demo.panel_visible
+    key(pygame.K_h)
+    run(demo, 1)
+    assert demo.help_visible
+
+
+def test_keys_go_to_a_focused_text_box_not_to_shortcuts(demo):
+    entry = demo.inspector.rows["friction"].entry
+    demo.inspector.manager.set_focus_set(entry)
+    assert demo.inspector.typing
+    key(pygame.K_p)
+    run(demo, 1)
+    assert not demo.paused
+
+
+def test_save_button_writes_a_scene_that_loads_back(demo, tmp_path):
+    path = tmp_path / "mine.toml"
+    demo.session.set_param("stiffness", 3210.0)
+    key(pygame.K_4)
+    run(demo, 1)
+    ins = demo.inspector
+    ins.save_entry.set_text(str(path))
+    r = ins.save_button.rect
+    pos = (demo.world_size[0] + r.centerx, r.centery)
+    post(pygame.MOUSEMOTION, pos=pos, rel=(0, 0), buttons=(0, 0, 0))
+    run(demo, 1)
+    post(pygame.MOUSEBUTTONDOWN, pos=pos, button=1)
+    post(pygame.MOUSEBUTTONUP, pos=pos, button=1)
+    run(demo, 2)
+    assert path.is_file(), ins.message
+    assert not ins.message_is_error and "saved" in ins.message
+    world = deforma.load_scene(path)
+    assert world.stiffness == 3210.0 and len(world.colliders) == len(demo.session.world.colliders)
+    assert deforma.scene.load(path).body[0].shape == "box"
+    demo.load(str(path))  # and the viewer opens it
+    run(demo, 1)
+    assert demo.session.world.stiffness == 3210.0
+
+
+def test_collider_drag_with_the_mouse(demo):
+    c = demo.session.world.colliders[0]
+    start = np.array(c.center)
+    px = demo.to_pixel(start)
+    pos = (int(px[0]), int(px[1]))
+    post(pygame.MOUSEBUTTONDOWN, pos=pos, button=1)
+    post(pygame.MOUSEMOTION, pos=(pos[0], pos[1] + 40), rel=(0, 40), buttons=(1, 0, 0))
+    post(pygame.MOUSEBUTTONUP, pos=(pos[0], pos[1] + 40), button=1)
+    run(demo, 2)
+    moved = np.array(demo.session.world.colliders[0].center)
+    assert moved[1] < start[1] - 0.3 and abs(moved[0] - start[0]) < 1e-6
+    assert demo.inspector.rows["collider_y"].entry.get_text() == f"{moved[1]:.4g}"
+
+
+def test_unstable_simulation_pauses_and_shows_the_hint(demo):
+    demo.session.set_param("dt", 0.01)
+    demo.session.set_param("substeps", 1)
+    run(demo, 30)
+    assert demo.paused and demo.unstable and "substeps" in demo.unstable
+    x = body(demo).positions
+    assert np.isfinite(x).all()
+    img = demo.screenshot()
+    ww = demo.world_size[0]
+    top = img[20:60, ww // 2 - 100: ww // 2 + 100].reshape(-1, 3).astype(int)
+    assert ((top[:, 0] > 140) & (top[:, 1] < 90)).mean() > 0.5  # the red message box is drawn
+
+
+def test_screenshot_shows_the_textured_body_and_the_panel(demo, tmp_path):
+    run(demo, 20)
+    out = tmp_path / "shot.png"
+    demo.request_screenshot(str(out))
+    run(demo, 1)
+    img = np.asarray(Image.open(out).convert("RGB"))
+    assert img.shape == (720, 1280, 3)
+    b = body(demo)
+    lo = np.array(demo.to_pixel(b.positions.min(axis=0)))
+    hi = np.array(demo.to_pixel(b.positions.max(axis=0)))
+    x0, x1 = int(min(lo[0], hi[0])), int(max(lo[0], hi[0]))
+    y0, y1 = int(min(lo[1], hi[1])), int(max(lo[1], hi[1]))
+    patch = img[y0:y1, x0:x1].reshape(-1, 3).astype(int)
+    # the bunny texture is grey-brown; the background there is pale blue
+    background = np.array([218, 230, 243])
+    far = np.abs(patch - background).sum(axis=1) > 60
+    assert far.mean() > 0.2
+    panel = img[:, demo.world_size[0]:]
+    assert (np.abs(panel.astype(int) - [247, 248, 250]).sum(axis=2) < 6).mean() > 0.4  # the panel's background
+
+
+def test_physics_independent_of_frame_rate(viewer):
+    results = []
+    for fps in (30, 120):
+        viewer.load("demo")
+        for _ in range(fps):  # one second of wall time, at two frame rates
+            viewer.frame(1 / fps)
+        results.append((viewer.session.world.step_count, viewer.session.world.bodies[0].positions.copy()))
+    assert results[0][0] == results[1][0] == 600
+    np.testing.assert_array_equal(results[0][1], results[1][1])
+
+
+def test_cli_view_frames_screenshot(tmp_path):
+    out = tmp_path / "view.png"
+    env = dict(os.environ, SDL_VIDEODRIVER="offscreen")
+    r = subprocess.run([sys.executable, "-m", "deforma.cli", "view", "demo", "--frames", "5", "--size", "640x360",
+                        "--screenshot", str(out)], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert Image.open(out).size == (640, 360)
+    bad = subprocess.run([sys.executable, "-m", "deforma.cli", "view", "nonesuch", "--frames", "1"],
+                         capture_output=True, text=True, env=env, timeout=120)
+    assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "nonesuch" in bad.stderr
+
+
+def test_cli_view_without_display_is_one_line(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")}
+    r = subprocess.run([sys.executable, "-m", "deforma.cli", "view", "demo"], capture_output=True, text=True,
+                       env=env, timeout=120)
+    assert r.returncode == 4 and r.stderr.count("\n") == 1 and "display" in r.stderr
