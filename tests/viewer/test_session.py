@@ -118,3 +118,19 @@ def test_save_and_load_back(tmp_path):
     np.testing.assert_allclose(world.bodies[0].positions, Session(path).world.bodies[0].positions)
     with pytest.raises(ValueError, match=".toml"):
         s.save(tmp_path / "edited.txt")
+
+
+def test_docs_list_every_key():
+    from pathlib import Path
+
+    from deforma.viewer.controls import KEYS, MOUSE, help_rows
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "viewer.md").read_text(encoding="utf-8")
+    table = "\n".join(line for line in doc.splitlines() if line.startswith("| "))
+    for names, _action, _text in KEYS:
+        for n in names:
+            shown = n.capitalize() if len(n) > 1 else n.upper()
+            assert f"| {shown}" in table or f" {shown} " in table or f"/ {shown}" in table, n
+    for button, _ in MOUSE:
+        assert f"| {button}" in table
+    assert len(help_rows()) == len(KEYS) + 1 + len(MOUSE)

@@ -36,7 +36,8 @@ HEADLESS_FRAME_TIME = 1 / 60
 #: keeps the window responsive when a setting makes the physics slower than real time.
 PHYSICS_BUDGET = 0.05
 STATUS_INTERVAL = 0.25   # seconds between status line updates
-SELECTED_COLLIDER_COLOR = "#5b8def"
+GREETING = "Left-drag the body to pull it, Space blows it up, H lists every key."
+SELECTED_COLLIDER_COLOR = "#6d8fcb"  # a bluer slate: selected, not shouting
 
 
 def _font_path() -> str | None:
@@ -125,6 +126,7 @@ class Viewer:
         self._Inspector = Inspector
         self._actions = actions
         self.inspector = Inspector(session, self.window_size[1], save_path=self.save_path, actions=actions)
+        self.inspector.say(GREETING)
         self.panel_visible = bool(panel)
         self._panel_stale = True
         self.panel_layer = self.overlay.layer(self.inspector.surface.get_size())
@@ -550,7 +552,8 @@ class Viewer:
     def _update_stats(self) -> None:
         now = time.perf_counter()
         dt = now - self._stat_time
-        if dt >= STATUS_INTERVAL or self._status_text is None:
+        # a screenshot shows the figures of its own frame, not ones up to STATUS_INTERVAL old
+        if dt >= STATUS_INTERVAL or self._status_text is None or self._screenshot_requests:
             if dt > 0 and self._stat_frames:
                 self.fps = self._stat_frames / dt
                 self.steps_per_second = self._stat_steps / dt
