@@ -263,3 +263,27 @@ def test_cli_view_without_display_is_one_line(tmp_path):
     r = subprocess.run([sys.executable, "-m", "deforma.cli", "view", "demo"], capture_output=True, text=True,
                        env=env, timeout=120)
     assert r.returncode == 4 and r.stderr.count("\n") == 1 and "display" in r.stderr
+
+
+def test_panel_adds_selects_and_removes_colliders(demo):
+    import pygame_gui
+
+    ins = demo.inspector
+    n = len(demo.session.world.colliders)
+    post(pygame_gui.UI_BUTTON_PRESSED, ui_element=ins.add_collider)
+    run(demo, 2)
+    assert len(demo.session.world.colliders) == n + 1 and demo.session.collider_index == n
+    assert ins.collider_label.text == f"{n + 1} of {n + 1}"
+    assert demo.view.collider_colors[n] is not None  # the new one is highlighted
+    entry = ins.rows["collider_angle"].entry
+    entry.set_text("25")
+    post(pygame_gui.UI_TEXT_ENTRY_FINISHED, ui_element=entry, text="25")
+    run(demo, 1)
+    assert demo.session.world.colliders[n].angle == 25.0
+    post(pygame_gui.UI_BUTTON_PRESSED, ui_element=ins.next_collider)
+    run(demo, 1)
+    assert demo.session.collider_index == 0
+    post(pygame_gui.UI_BUTTON_PRESSED, ui_element=ins.remove_collider)
+    run(demo, 1)
+    assert len(demo.session.world.colliders) == n
+    assert all(c.angle != -16.0 for c in demo.session.world.colliders)  # the first (angle -16) went

@@ -499,7 +499,7 @@ class Viewer:
             v.sync()
             self._n_colliders = len(s.world.colliders)
         colors = list(s.collider_colors) + [None] * (len(s.world.colliders) - len(s.collider_colors))
-        if s.collider_index is not None and self.panel_visible:
+        if s.collider_index is not None and s.collider_active and self.panel_visible:
             colors[s.collider_index] = SELECTED_COLLIDER_COLOR
         v.collider_colors = colors if any(colors) else None
         v.wireframe = s.wireframe

@@ -150,13 +150,15 @@ class Inspector:
                 self._make_menu()
                 y += ROW
             if group == "Collision":
-                self.prev_collider = UIButton(pygame.Rect(14, y, 28, 24), "<", m, container=c,
+                self.prev_collider = UIButton(pygame.Rect(14, y, 26, 24), "<", m, container=c,
                                               tool_tip_text="previous collider")
-                self.collider_label = UILabel(pygame.Rect(44, y, 120, 24), "", m, container=c)
-                self.next_collider = UIButton(pygame.Rect(166, y, 28, 24), ">", m, container=c,
-                                              tool_tip_text="next collider")
-                self.add_collider = UIButton(pygame.Rect(200, y, 54, 24), "Add", m, container=c)
-                self.remove_collider = UIButton(pygame.Rect(258, y, 54, 24), "Remove", m, container=c)
+                self.collider_label = UILabel(pygame.Rect(42, y, 70, 24), "", m, container=c)
+                self.next_collider = UIButton(pygame.Rect(114, y, 26, 24), ">", m, container=c,
+                                              tool_tip_text="next collider (or click one in the world)")
+                self.add_collider = UIButton(pygame.Rect(150, y, 66, 24), "Add", m, container=c,
+                                             tool_tip_text="a new 3 m rectangle at the view's centre")
+                self.remove_collider = UIButton(pygame.Rect(222, y, 90, 24), "Remove", m, container=c,
+                                                tool_tip_text="remove the selected collider")
                 y += ROW
             for p in params:
                 self.rows[p.name] = self._row(p, y)
@@ -348,7 +350,7 @@ class Inspector:
                     row.slider.set_current_value(row.param.to_slider(value), warn=False)
                 row.slider_value = row.slider.get_current_value()
         n = len(s.world.colliders)
-        text = "no colliders" if s.collider_index is None else f"collider {s.collider_index + 1} of {n}"
+        text = "none" if s.collider_index is None else f"{s.collider_index + 1} of {n}"
         if self.collider_label.text != text:
             self.collider_label.set_text(text)
         sel = self._selected_text()

@@ -111,6 +111,8 @@ class Session:
         self.wireframe = bool(scene.camera.wireframe)
         self.collider_colors = [c.color for c in scene.collider]
         self.collider_index = 0 if scene.collider else None
+        #: True once a collider was picked, added or edited: the window then highlights it.
+        self.collider_active = False
         self.body_index = 0
         self.mesh = MeshSettings.from_spec(scene.body[0]) if scene.body else MeshSettings()
         #: Bumped on every rebuild, so a window knows to re-upload meshes.
@@ -284,6 +286,7 @@ class Session:
     def add_collider(self, *, center=None, size=(3.0, 0.3), angle=0.0) -> Rect:
         """Add a rectangle (by default 3 m x 0.3 m at the camera centre) and select it."""
         r = self.world.add_collider(Rect(self.camera_center if center is None else center, size, angle))
+        self.collider_active = True
         self.collider_colors.append(None)
         self.collider_index = len(self.world.colliders) - 1
         return r
@@ -305,6 +308,7 @@ class Session:
         if index is not None and not 0 <= index < n:
             raise ValueError(f"collider index must be in [0, {n - 1}], got {index}")
         self.collider_index = index
+        self.collider_active = index is not None
 
     def move_collider(self, center) -> None:
         """Put the selected collider's centre at ``center`` (metres): mouse dragging."""
@@ -341,6 +345,7 @@ class Session:
         new = Rect(fields["center"], fields["size"], fields["angle"], friction=c.friction,
                    static_friction=c.static_friction)
         self.world.colliders[self.collider_index] = new
+        self.collider_active = True
 
     def collider_at(self, point) -> int | None:
         """Index of the topmost collider containing ``point`` (metres), or None."""
