@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from scipy.spatial import Delaunay as ScipyDelaunay
 
 import deforma
-from delaunay_checks import canonical, check_delaunay
+from delaunay_checks import canonical, check_delaunay, orient_exact
 
 HYP = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -126,6 +126,19 @@ def test_bad_input_raises_one_line_value_error(points, message):
 
 # -- property-based: degenerate sets ------------------------------------------------------
 
+
+def _exactly_degenerate(pts: np.ndarray) -> bool:
+    """Fewer than 3 distinct points, or all on one line, decided in exact arithmetic.
+
+    (A float rank test is no oracle here: rounding makes "collinear" lattice points, once
+    scaled and offset, slightly non-collinear, and those the triangulation must accept.)
+    """
+    u = np.unique(pts, axis=0)
+    if len(u) < 3:
+        return True
+    far = max(range(1, len(u)), key=lambda i: abs(u[i] - u[0]).sum())
+    return all(orient_exact(u[0], u[far], q) == 0 for q in u)
+
 coords = st.integers(min_value=-6, max_value=6)
 small_int_points = st.lists(st.tuples(coords, coords), min_size=3, max_size=40)
 
@@ -135,8 +148,7 @@ small_int_points = st.lists(st.tuples(coords, coords), min_size=3, max_size=40)
 def test_property_integer_lattice_sets(raw, scale, offset):
     """Few distinct values per axis: many duplicates, collinear runs and cocircular sets."""
     pts = np.array(raw, float) * scale + offset
-    u = np.unique(pts, axis=0)
-    if len(u) < 3 or np.linalg.matrix_rank(u[1:] - u[0]) < 2:
+    if _exactly_degenerate(pts):
         with pytest.raises(ValueError):
             deforma.delaunay(pts)
         return
@@ -162,8 +174,9 @@ def test_property_structured_degenerate_sets(n, seed, kind):
         pts = np.vstack([np.c_[s, np.zeros(n)], np.c_[s, np.ones(n)]])
     else:  # a tight cluster far from the origin: differences round
         pts = 1e6 + rng.random((n, 2)) * 1e-9
-    u = np.unique(pts, axis=0)
-    if len(u) < 3 or np.linalg.matrix_rank(u[1:] - u[0]) < 2:
+    if _exactly_degenerate(pts):
+        with pytest.raises(ValueError):
+            deforma.delaunay(pts)
         return
     check_delaunay(pts, deforma.delaunay(pts))
 
@@ -173,3 +186,13 @@ def test_regression_box_points_reusing_cavity_slots():
     # the outside triangle still held, and the adjacency was patched in the wrong place.
     m = deforma.mesh.box(((0.1, 0.3), (2.7, 0.1), (2.3, 1.9), (0.3, 1.3)), detail=7, edges=True)
     check_delaunay(m.vertices, deforma.delaunay(m.vertices))
+
+
+def test_nearly_collinear_after_rounding_is_triangulated():
+    # Lattice points on one line, scaled and offset: rounding moves them off the line by an
+    # ulp, so they are not collinear any more and must be triangulated (without slivers of
+    # negative area), not rejected.
+    raw = np.array([[11, 6], [-13, -18], [11, 6], [-16, -21], [-4, -9]], float)
+    pts = raw * 3.0e7 + 29.777640542740528
+    assert not _exactly_degenerate(pts)
+    check_delaunay(pts, deforma.delaunay(pts))
