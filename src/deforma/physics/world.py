@@ -678,7 +678,10 @@ class World:
         self._state.restore()
         h = self._dt / self._substeps
         stable = self.stable_dt()
-        if h > stable:
+        if math.isinf(stable) and getattr(self._integrator, "unconditionally_stable", False):
+            hint = (f"the {self.integrator} integrator has no step limit, so a large force ran away "
+                    f"(grab strength, explosion): lower it, or raise max_speed if such speeds are intended")
+        elif h > stable:
             need = math.ceil(self._dt / stable)
             hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s: "
                     f"lower dt or raise substeps to at least {need}")
@@ -690,8 +693,12 @@ class World:
                                  body=body, step=self.step_count, hint=hint)
 
     # -- diagnostics ------------------------------------------------------------------------
-    def stable_dt(self) -> float:
+    def stable_dt(self, *, explicit: bool = False) -> float:
         """Estimate of the largest stable explicit (sub)step in seconds for the current bodies.
+
+        For an unconditionally stable integrator (``"implicit-euler"``, ``"xpbd"``) this is
+        ``inf`` unless ``explicit=True``, which always gives the semi-implicit Euler limit
+        below (e.g. to say how far beyond it a stiff setup is).
 
         Bounds the fastest spring mode by Gershgorin's theorem, ``omega^2 <= max_i
         2 sum(ks)_i / m_i`` and ``gamma <= max_i 2 sum(kd)_i / m_i`` over the springs (and
@@ -708,7 +715,7 @@ class World:
         0.0816
         """
         m = self._model
-        if m.n_vertices == 0:
+        if m.n_vertices == 0 or (not explicit and getattr(self._integrator, "unconditionally_stable", False)):
             return math.inf
         ks = np.bincount(m.spring_i, m.spring_stiffness, m.n_vertices) + \
             np.bincount(m.spring_j, m.spring_stiffness, m.n_vertices)
