@@ -223,3 +223,24 @@ def test_draw_image_puts_a_panel_at_its_pixels(renderer):
     np.testing.assert_array_equal(img[40:50, 45:50], empty[40:50, 45:50])
     changed = np.any(img != empty, axis=-1)
     assert changed.sum() == 10 * 15
+
+
+def test_shrunk_textures_are_filtered_not_aliased(renderer):
+    # stripes 3 texels wide: drawn 8x smaller each pixel spans 1.3 periods, so a single
+    # bilinear sample per pixel lands on varying phases (stripes of black and white that
+    # should not be there); mipmaps average them to grey
+    tex = np.zeros((256, 256, 4), np.uint8)
+    tex[..., 3] = 255
+    xx = np.arange(256)
+    tex[:, (xx // 3) % 2 == 0, :3] = 255
+    pts, tris, uv = square_mesh(-0.32, -0.32, 0.32, 0.32)      # 32 x 32 pixels
+    h = renderer.add_mesh(tris, uv, texture=tex)
+    renderer.render([(h, pts)])
+    inner = renderer.read()[52 - 12 : 52 + 12, 100 - 12 : 100 + 12].astype(float)
+    assert h.mipmapped is True
+    # with mipmaps the 8-texel averages stay within 96..160 (std 26); without, 0 or 255 (std 104)
+    assert abs(inner.mean() - 127.5) < 12 and inner.std() < 50
+    # drawn larger than the picture, plain bilinear filtering is used (cheaper)
+    big = renderer.add_mesh(tris, uv, texture=tex[:8, :8])
+    renderer.render([(big, pts)])
+    assert big.mipmapped is False

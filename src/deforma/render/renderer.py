@@ -292,8 +292,17 @@ class MeshHandle:
         self.outline_vao = None if self._outline_ibo is None else ctx.vertex_array(
             renderer._flat_prog, [(self._pos, "2f", "in_pos")], self._outline_ibo)
         self.texture = None
+        self.mipmapped = None
+        opaque_texture = True
         if texture is not None:
             self.texture = renderer._make_texture(texture)
+            img = np.asarray(texture)
+            opaque_texture = img.shape[2] == 3 or bool(img[..., 3].min() == 255)
+            # texels the mesh spans, to tell at draw time whether the picture is shrunk
+            span = uv.max(axis=0) - uv.min(axis=0)
+            self._texels = (float(span[0]) * img.shape[1], float(span[1]) * img.shape[0])
+        # opaque bodies skip blending: a measurable share of the frame on a software rasteriser
+        self.opaque = opaque_texture and self.color[3] >= 1.0
 
     def upload(self, positions) -> None:
         p = np.asarray(positions)
@@ -558,22 +567,43 @@ class Renderer:
         self.ctx.blend_func = _blend()
         self._coll_vao.render(moderngl.TRIANGLES, vertices=len(data))
 
+    def _choose_filter(self, handle: MeshHandle) -> None:
+        """Mipmaps only when the picture is drawn smaller than it is (they cost ~10% of a frame)."""
+        import moderngl
+
+        p = handle._scratch
+        hx, hy = self.camera.extent(self.size)
+        w_px = float(p[:, 0].max() - p[:, 0].min()) * self.size[0] / (2 * hx)
+        h_px = float(p[:, 1].max() - p[:, 1].min()) * self.size[1] / (2 * hy)
+        shrink = max(handle._texels[0] / max(w_px, 1.0), handle._texels[1] / max(h_px, 1.0))
+        # a little shrinking is fine with bilinear filtering; beyond it texels would shimmer
+        mip = shrink > 1.25
+        if mip != handle.mipmapped:
+            handle.texture.filter = ((moderngl.LINEAR_MIPMAP_NEAREST if mip else moderngl.LINEAR), moderngl.LINEAR)
+            handle.mipmapped = mip
+
     def draw_mesh(self, handle: MeshHandle, positions, *, wireframe: bool = False, wire_color=None) -> None:
         """Draw one body at ``positions`` (N, 2) metres: textured or flat, optionally its springs."""
         import moderngl
 
         handle.upload(positions)
         ctx = self.ctx
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = _blend()
+        if handle.opaque:
+            ctx.disable(moderngl.BLEND)
+        else:
+            ctx.enable(moderngl.BLEND)
+            ctx.blend_func = _blend()
         p = self._body_prog
         self._set_camera(p)
         p["u_color"].value = handle.color
         p["u_textured"].value = handle.texture is not None
         if handle.texture is not None:
+            self._choose_filter(handle)
             handle.texture.use(0)
             p["u_tex"].value = 0
         handle.body_vao.render(moderngl.TRIANGLES)
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = _blend()
         f = self._flat_prog
         if wireframe:
             self._set_camera(f)
@@ -647,7 +677,9 @@ class Renderer:
     def render(self, bodies: Iterable = (), colliders: Iterable = (), *, wireframe: bool = False,
                collider_colors: Sequence | None = None) -> None:
         """One whole frame: background, colliders, then each ``(handle, positions)`` body."""
-        self.clear()
+        # the background covers every pixel, so binding is enough: a clear would be a wasted pass
+        self.framebuffer.use()
+        self.ctx.viewport = (0, 0, *self.size)
         self.draw_background()
         self.draw_colliders(colliders, colors=collider_colors)
         for handle, positions in bodies:
