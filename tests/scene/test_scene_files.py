@@ -151,7 +151,9 @@ BAD = [
     ("[run]\nfps = 0\n", "run.fps: must be in [1, 240] frames/s, got 0"),
     ("[physics\ndt = 1\n", "invalid TOML"),
     ("[[body]]\nshape = 'box'\ncorners = [[0, 0], [1, 1], [1, 0], [0, 1]]\n", "body[0]:"),
-    ("[physics]\nintegrator = 'rk99'\n", "physics:"),
+    ("[physics]\nintegrator = 'rk99'\n",
+     "physics.integrator: unknown value 'rk99'; allowed: symplectic-euler, implicit-euler, xpbd"),
+    ("[physics]\nintegrator = 'xpdb'\n", "physics.integrator: unknown value 'xpdb'; did you mean 'xpbd'?"),
 ]
 
 

@@ -178,7 +178,7 @@ def system_matrix(model, grab_slot, grab_pull, h: float) -> sp.csc_matrix:
     >>> from deforma.physics.model import BodyTopology, Model
     >>> t = BodyTopology.from_arrays([[0, 0], [1, 0]], [[0, 1]])
     >>> m = Model([t], masses=[2.0], stiffness=[100.0], damping=[0.0])
-    >>> system_matrix(m, np.full(2, -1, np.int32), np.zeros((0, 3)), 0.1).toarray().tolist()
+    >>> system_matrix(m, np.full(2, -1, np.int32), np.zeros((0, 3)), 0.1).toarray().round(9).tolist()
     [[2.0, -1.0], [-1.0, 2.0]]
     """
     n = model.n_vertices

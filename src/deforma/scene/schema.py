@@ -121,7 +121,9 @@ class PhysicsSettings:
     static_friction: float = spec("float", 0.5, lo=0.0, doc="Static Coulomb friction coefficient of colliders.")
     max_speed: float = spec("float", 1000.0, lo=0.0, lo_open=True, unit="m/s",
                             doc="A vertex faster than this means the simulation became unstable.")
-    integrator: str = spec("str", "symplectic-euler", doc="Time integrator by name.")
+    integrator: str = spec("str", "symplectic-euler",
+                           doc="Time integrator by name: symplectic-euler (explicit, the original's), "
+                               "implicit-euler or xpbd (both stable at any dt; see docs/integrators.md).")
 
 
 @dataclass(frozen=True)
@@ -406,6 +408,17 @@ def _body(data, path, ctx):
     return body
 
 
+def _check_integrator(name: str, path: str) -> None:
+    # the registry, not a fixed list: an integrator registered by the user is allowed too
+    from ..physics.integrators import available_integrators
+
+    names = available_integrators()
+    if name not in names:
+        close = difflib.get_close_matches(name, names, n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise _Problem(path, f"unknown value {name!r}; {hint}allowed: {', '.join(names)}")
+
+
 def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
     """Validate a TOML document (as a dict) and make a :class:`Scene`.
 
@@ -455,6 +468,8 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
         for name, cls in SECTIONS.items():
             if name in data:
                 values[name] = _table(cls, data[name], name, ctx)
+        if "physics" in values:
+            _check_integrator(values["physics"].integrator, "physics.integrator")
         for name, cls in ARRAYS.items():
             if name in data:
                 items = data[name]
