@@ -64,7 +64,6 @@ def run(quick: bool) -> list[Row]:
                         goal=">= 60 frames/s" if goal else "informational (default of `deforma run`)",
                         met=(fps >= 60) if goal else None))
         r.release()
-        r.ctx.release()
     return rows
 
 

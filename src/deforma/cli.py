@@ -236,6 +236,8 @@ def cmd_run(a) -> int:
             bar.close()
         if writer is not None:
             writer.abort()  # no-op after close(); discards the temporary file otherwise
+        if view is not None:
+            view.renderer.release()
     wall = time.perf_counter() - t_wall
     outputs = [o for o in (a.output, a.states) if o]
     sim = world.time

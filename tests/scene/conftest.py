@@ -1,11 +1,15 @@
 import pytest
 
-pytest.importorskip  # rendering tests never skip: moderngl and EGL are test requirements
 
-
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def gl_ctx():
-    """One headless EGL context for the whole session (creating one costs ~50 ms)."""
+    """A headless EGL context shared by a test module (rendering tests never skip).
+
+    Released after the module: a standalone context left alive would keep a pygame-ce window
+    opened later in the same process (the viewer tests) from finding its own OpenGL context.
+    """
     from deforma.render import create_headless_context
 
-    return create_headless_context()
+    ctx = create_headless_context()
+    yield ctx
+    ctx.release()

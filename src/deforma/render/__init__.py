@@ -10,6 +10,7 @@ Examples
 >>> r.render(colliders=[((0, -0.5), (3, 0.2), 10.0)])
 >>> r.read().shape
 (180, 320, 3)
+>>> r.release()                # frees the context too
 """
 
 from .renderer import Camera, MeshHandle, Renderer, collider_corners, create_headless_context

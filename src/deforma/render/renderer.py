@@ -348,6 +348,7 @@ class Renderer:
     >>> img = r.read()
     >>> img.shape, img[30, 25].tolist()        # a pixel inside the red triangle
     ((48, 64, 3), [255, 0, 0])
+    >>> r.release()
     """
 
     def __init__(self, ctx, size=(1280, 720), *, samples: int = 4, target=None, camera: Camera | None = None):
@@ -371,6 +372,7 @@ class Renderer:
         self._coll_capacity = 0
         self._white = None
         self._meshes: list[MeshHandle] = []
+        self._owns_ctx = False
         self._target = target
         self._owns_fbo = target is None
         self._msaa = self._resolve = None
@@ -394,7 +396,9 @@ class Renderer:
             If no OpenGL 3.3 context can be created, naming the packages to install.
         """
         ctx = create_headless_context()
-        return cls(ctx, size, samples=samples, camera=camera)
+        r = cls(ctx, size, samples=samples, camera=camera)
+        r._owns_ctx = True
+        return r
 
     # -- framebuffer ---------------------------------------------------------------------
     def resize(self, size) -> None:
@@ -685,8 +689,19 @@ class Renderer:
         for handle, positions in bodies:
             self.draw_mesh(handle, positions, wireframe=wireframe)
 
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()
+        return False
+
     def release(self) -> None:
-        """Free every GPU resource this renderer made (not the context)."""
+        """Free every GPU resource this renderer made, and the context if :meth:`headless` made it.
+
+        Release a headless renderer when done: a standalone EGL context left current in the
+        process keeps a window opened later (pygame-ce) from finding its own OpenGL context.
+        """
         for h in list(self._meshes):
             self.remove_mesh(h)
         for obj in (self._img_tex, self._img_vao, self._img_prog, self._coll_vao, self._coll_vbo,
@@ -700,6 +715,10 @@ class Renderer:
                     for a in fb.color_attachments:
                         a.release()
                     fb.release()
+            self._msaa = self._resolve = None
+        if self._owns_ctx:
+            self.ctx.release()
+            self._owns_ctx = False
 
 
 _HEADLESS_HELP = (

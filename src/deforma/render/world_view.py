@@ -33,6 +33,7 @@ class WorldView:
     >>> view = WorldView(Renderer.headless((320, 180)), world)
     >>> view.draw().shape
     (180, 320, 3)
+    >>> view.renderer.release()
     """
 
     def __init__(self, renderer: Renderer, world, scene=None):
