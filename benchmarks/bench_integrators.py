@@ -1,0 +1,121 @@
+"""Integrator benchmark: cost per simulated second of the three integrators on one body.
+
+The body is ``bench_physics``'s: a 1 m square of n x n vertices (stiffness 2000 N/m per
+spring, damping 0.5 N*s/m, 1 kg) standing on a floor, with the two other colliders beside
+it. Each integrator runs at settings that show the body as stiff as it is:
+
+- ``symplectic-euler`` at half its stable step (``0.5 * world.stable_dt()``), as in
+  ``bench_physics``: the reference, it integrates the stiffness as given;
+- ``implicit-euler`` and ``xpbd`` at ``dt = 1/60 s`` with the substeps that keep the body's
+  height within 0.5% of its 1 m after 1/6 s on the floor at 1e4 vertices (found by
+  ``python benchmarks/bench_integrators.py --sag``: implicit 16, XPBD 64; fewer let the
+  body sink into itself, because contacts are resolved after each substep, outside the
+  solve; see docs/integrators.md). The rows give the height at the end of the timed steps
+  (the body still rings a little) and use the same substeps at 1e5 vertices.
+
+Figures are medians of timed ``world.step()`` calls after warm-up steps (which include
+Numba compilation and, for implicit Euler, the one factorization). The cost per simulated
+second is the step time divided by ``dt``. A separate row times one implicit Euler step of
+one substep at ``dt = 1/60 s`` on 1e5 vertices, the issue's goal (<= 0.1 s).
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_physics import grid_mesh  # noqa: E402
+from common import Row  # noqa: E402
+
+import deforma  # noqa: E402
+
+SUBSTEPS = {"implicit-euler": 16, "xpbd": 64}
+
+
+def make_world(n: int, integrator: str, *, substeps: int = 1):
+    """The bench_physics body (n*n vertices, touching the floor) under ``integrator``."""
+    w = deforma.World(stiffness=2000.0, damping=0.5, mass=1.0, integrator=integrator)
+    w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
+    w.add_collider(deforma.Rect((-1.2, 0.5), (0.8, 0.1), 30.0))
+    w.add_collider(deforma.Rect((1.0, 0.1), (0.2, 0.2), 10.0))
+    body = w.add_body(grid_mesh(n), position=(0.0, 0.5 + 1e-6))
+    if integrator == "symplectic-euler":
+        w.dt = 0.5 * w.stable_dt()
+    else:
+        w.dt, w.substeps = 1 / 60, substeps
+    return w, body
+
+
+def timed_steps(w, *, warmup: int, repeat: int) -> float:
+    """Median seconds per ``world.step()`` over ``repeat`` steps after ``warmup`` steps."""
+    for _ in range(warmup):
+        w.step()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        w.step()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def run(quick: bool) -> list[Row]:
+    """Rows for the table: cost per simulated second per integrator and size, and the goal."""
+    rows = []
+    sizes = (100,) if quick else (100, 317)
+    for n in sizes:
+        nv = n * n
+        label = f"{nv:.0e}".replace("+0", "") + " vertices"
+        costs, made = {}, {}
+        for name in ("symplectic-euler", "implicit-euler", "xpbd"):
+            w, body = make_world(n, name, substeps=SUBSTEPS.get(name, 1))
+            if name == "symplectic-euler":
+                w._integrator.mode = "serial"  # both cores fight other processes; serial is steady
+                step = timed_steps(w, warmup=20, repeat=50)
+                settings = f"dt {w.dt * 1e6:.3g} us"
+                height = ""
+            else:
+                warm = 10  # 1/6 s on the floor: also the settle for the height figure
+                step = timed_steps(w, warmup=warm, repeat=3 if nv > 50_000 else 5)
+                settings = f"dt 1/60 s x {w.substeps}"
+                height = f", height {np.ptp(body.positions[:, 1]):.4f} m after {w.time:.2f} s"
+            costs[name] = step / w.dt
+            made[name] = Row("integrators", f"{name}, {label}, {settings}: s per simulated s{height}",
+                             costs[name], "s", f"step {step * 1e3:.3g} ms")
+            rows.append(made[name])
+        for name in ("implicit-euler", "xpbd"):
+            made[name].ratio += f"; {costs['symplectic-euler'] / costs[name]:.2g}x faster than symplectic"
+    # the issue's goal: one implicit Euler step (one substep) at dt = 1/60 s on 1e5 vertices
+    n = 100 if quick else 317
+    w, body = make_world(n, "implicit-euler", substeps=1)
+    step = timed_steps(w, warmup=3, repeat=5 if quick else 7)
+    rows.append(Row("integrators", f"implicit-euler, {n * n:.0e} vertices, one step of 1/60 s "
+                                   f"({w._integrator.iterations} local/global iterations)".replace("+0", ""),
+                    step, "s", "", "<= 0.1 s per step at 1e5 vertices", None if quick else step <= 0.1))
+    return rows
+
+
+def sag(n: int = 100) -> None:
+    """Print the body's height after 1/6 s for several substep counts (how SUBSTEPS was chosen)."""
+    for name, counts in (("implicit-euler", (1, 4, 8, 16)), ("xpbd", (16, 32, 64))):
+        for s in counts:
+            w, body = make_world(n, name, substeps=s)
+            try:
+                for _ in range(10):
+                    w.step()
+                print(f"{name} x {s}: height {np.ptp(body.positions[:, 1]):.4f} m")
+            except deforma.SimulationUnstable as e:
+                print(f"{name} x {s}: unstable ({e})")
+
+
+if __name__ == "__main__":
+    from common import format_table
+
+    if "--sag" in sys.argv:
+        sag()
+    else:
+        print(format_table(run(quick="--quick" in sys.argv)))
