@@ -332,3 +332,14 @@ def test_pull_gives_the_same_momentum_to_first_order(name):
         w.step()
     m = b.mass / b.n_vertices
     assert m * b.velocities.sum(axis=0) == pytest.approx(impulse, rel=0.02, abs=1e-4)
+
+
+@pytest.mark.parametrize("name", STABLE)
+def test_runaway_under_a_stable_integrator_blames_the_force_not_dt(name):
+    w = deforma.World(dt=1 / 60, gravity=(0, 0), integrator=name)
+    b = w.add_body(grid_mesh(0.2, 0.1, 4, 3), position=(0, 0))
+    w.explode(5000.0, center=(0.0, 0.0))  # faster than max_speed 1000 m/s
+    with pytest.raises(SimulationUnstable) as e:
+        w.step()
+    assert "has no step limit" in e.value.hint and "dt/substeps" not in e.value.hint
+    assert np.isfinite(b.positions).all()
