@@ -91,6 +91,8 @@ def run(args) -> dict:
 
     worlds, views, status, energy, cost = {}, {}, {}, {}, {}
     pw, ph = args.panel
+    # one renderer (one GL context) draws all three panels: each view draws its own meshes
+    renderer = Renderer.headless((pw, ph)) if args.video else None
     for name in INTEGRATORS:
         w = deforma.load_scene(args.scene)
         w.integrator = name
@@ -99,7 +101,8 @@ def run(args) -> dict:
         if args.substeps is not None:
             w.substeps = args.substeps
         worlds[name] = w
-        views[name] = WorldView(Renderer.headless((pw, ph)), w)
+        if renderer is not None:
+            views[name] = WorldView(renderer, w)
         status[name] = f"{name}  dt {w.dt * 1e3:.3g} ms x {w.substeps}"
         energy[name] = [(0.0, w.energy().total)]
         cost[name] = 0.0
@@ -136,6 +139,8 @@ def run(args) -> dict:
     finally:
         if writer is not None:
             writer.close()
+        if renderer is not None:
+            renderer.release()  # a live standalone context would hinder a window opened later
     for name in INTEGRATORS:
         print(f"{name:17s} cost {cost[name]:.2f} s for {worlds[name].time:.2f} simulated s; "
               f"energy {energy[name][0][1]:.3f} J -> {energy[name][-1][1]:.3f} J")
