@@ -134,3 +134,31 @@ def test_docs_list_every_key():
     for button, _ in MOUSE:
         assert f"| {button}" in table
     assert len(help_rows()) == len(KEYS) + 1 + len(MOUSE)
+
+
+def test_integrator_switches_on_the_running_world_and_is_saved(tmp_path):
+    s = Session("demo")
+    world = s.world
+    assert s.integrator == "symplectic-euler"
+    s.set_integrator("implicit-euler")
+    assert s.world is world and world.integrator == "implicit-euler" and s.note == ""
+    for _ in range(30):  # the switched world keeps stepping
+        world.step()
+    assert np.isfinite(world.bodies[0].positions).all()
+    path = s.save(tmp_path / "implicit.toml")
+    assert deforma.load_scene(path).integrator == "implicit-euler"
+
+
+def test_unknown_integrator_is_refused_with_the_names():
+    s = Session("demo")
+    with pytest.raises(ValueError, match="integrator must be one of .*xpbd.*got 'rk4'"):
+        s.set_integrator("rk4")
+    assert s.world.integrator == "symplectic-euler"
+
+
+def test_switching_to_the_explicit_method_with_stiff_springs_warns():
+    s = Session("demo")
+    s.set_integrator("xpbd")
+    s.set_param("stiffness", 1e6)
+    s.set_integrator("symplectic-euler")
+    assert "exceeds the explicit stable estimate" in s.note and "\n" not in s.note

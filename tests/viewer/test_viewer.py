@@ -287,3 +287,58 @@ def test_panel_adds_selects_and_removes_colliders(demo):
     run(demo, 1)
     assert len(demo.session.world.colliders) == n
     assert all(c.angle != -16.0 for c in demo.session.world.colliders)  # the first (angle -16) went
+
+
+def choose_from_menu(v, menu, option):
+    """Open a panel drop-down and click ``option`` with posted mouse events, as a user would."""
+    offset = v.world_size[0]  # the panel's left edge in window pixels
+
+    def click(rect):
+        pos = (offset + rect.centerx, rect.centery)
+        post(pygame.MOUSEMOTION, pos=pos, rel=(0, 0), buttons=(0, 0, 0))
+        run(v, 1)
+        post(pygame.MOUSEBUTTONDOWN, pos=pos, button=1)
+        post(pygame.MOUSEBUTTONUP, pos=pos, button=1)
+        run(v, 4)  # button press -> list selection -> menu changed: one posted event per frame
+
+    click(menu.rect)
+    expanded = menu.menu_states["expanded"]
+    items = expanded.options_selection_list.item_list
+    button = next(item["button_element"] for item in items if item["text"] == option)
+    click(button.rect)
+
+
+def test_integrator_drop_down_makes_stiff_springs_stable(demo):
+    inspector = demo.inspector
+    choose_from_menu(demo, inspector.integrator_menu, "implicit-euler")
+    assert demo.session.world.integrator == "implicit-euler"
+    assert inspector.integrator_menu.selected_option[0] == "implicit-euler"
+    w = demo.session.world
+    w.substeps = 1
+    w.stiffness = 100 * w.stiffness * (w.dt / w.stable_dt(explicit=True)) ** 2  # 100x the explicit limit
+    run(demo, 90)
+    assert demo.unstable is None and not demo.paused
+    assert np.isfinite(body(demo).positions).all()
+    choose_from_menu(demo, inspector.integrator_menu, "symplectic-euler")
+    assert "expect a blow-up" in inspector.message
+    run(demo, 30)
+    assert demo.paused and demo.unstable and "substeps" in demo.unstable
+    assert np.isfinite(body(demo).positions).all()
+
+
+def test_loaded_scene_shows_its_integrator(demo, tmp_path):
+    demo.session.set_integrator("xpbd")
+    path = demo.session.save(tmp_path / "xpbd.toml")
+    demo.load("demo")
+    run(demo, 1)
+    assert demo.inspector.integrator_menu.selected_option[0] == "symplectic-euler"
+    demo.load(str(path))
+    run(demo, 1)
+    assert demo.inspector.integrator_menu.selected_option[0] == "xpbd"
+
+
+def test_selected_drop_down_switches_the_object(demo):
+    choose_from_menu(demo, demo.inspector.selected_menu, "donut")
+    run(demo, 2)
+    assert demo.session.mesh.selected == "donut"
+    assert demo.view._bodies[0] is body(demo)

@@ -18,6 +18,7 @@ from pygame_gui.core import ObjectID
 from pygame_gui.elements import (UIButton, UICheckBox, UIDropDownMenu, UIHorizontalSlider, UILabel, UIPanel,
                                  UIScrollingContainer, UITextBox, UITextEntryLine)
 
+from ..physics import available_integrators
 from .params import GROUPS, PARAMS, Param, format_value, parse_value
 from .session import OBJECTS
 
@@ -149,6 +150,11 @@ class Inspector:
                 self._menu_rect = pygame.Rect(124, y, 188, 24)
                 self._make_menu()
                 y += ROW
+            if group == "Physics":
+                UILabel(pygame.Rect(14, y, 108, 24), "Integrator", m, container=c)
+                self._integrator_rect = pygame.Rect(124, y, 188, 24)
+                self._make_integrator_menu()
+                y += ROW
             if group == "Collision":
                 self.prev_collider = UIButton(pygame.Rect(14, y, 26, 24), "<", m, container=c,
                                               tool_tip_text="previous collider")
@@ -183,8 +189,15 @@ class Inspector:
         return row
 
     def _make_menu(self) -> None:
-        self.selected_menu = UIDropDownMenu(list(OBJECTS), self._selected_text(), self._menu_rect, self.manager,
+        self._menu_made_for = self._selected_text()
+        self.selected_menu = UIDropDownMenu(list(OBJECTS), self._menu_made_for, self._menu_rect, self.manager,
                                             container=self.scroll, expansion_height_limit=4 * 26)
+
+    def _make_integrator_menu(self) -> None:
+        names = available_integrators()  # the registry: a user-registered integrator shows too
+        self._integrator_menu_made_for = self.session.integrator
+        self.integrator_menu = UIDropDownMenu(names, self._integrator_menu_made_for, self._integrator_rect, self.manager,
+                                              container=self.scroll, expansion_height_limit=len(names) * 26)
 
     def _selected_text(self) -> str:
         sel = self.session.mesh.selected
@@ -217,6 +230,9 @@ class Inspector:
             used = True
         elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.selected_menu:
             self.apply_object(event.text)
+            used = True
+        elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.integrator_menu:
+            self.apply_integrator(event.text)
             used = True
         return bool(used)
 
@@ -280,6 +296,17 @@ class Inspector:
         ok = self._try(lambda: self.session.select_object(name))
         if ok:
             self.say(self._mesh_summary())
+        self.refresh(force=True)
+        return ok
+
+    def apply_integrator(self, name: str) -> bool:
+        """Switch the running world's integrator (the drop-down in the Physics group)."""
+        if name == self.session.integrator:
+            return True
+        ok = self._try(lambda: self.session.set_integrator(name))
+        if ok:
+            note = self.session.note
+            self.say(f"integrator: {name}" + (f"; {note}" if note else ""), error=bool(note))
         self.refresh(force=True)
         return ok
 
@@ -353,11 +380,20 @@ class Inspector:
         text = "none" if s.collider_index is None else f"{s.collider_index + 1} of {n}"
         if self.collider_label.text != text:
             self.collider_label.set_text(text)
+        # A drop-down has no setter, so one the session changed behind it (a number key, a
+        # loaded scene) is made anew. Compare with what the menu was made for, not with what it
+        # shows: a choice just clicked shows before its event reaches apply_*(), and remaking
+        # the menu then would drop that event. After a refused choice (force), the menu is put
+        # back to the value in force.
         sel = self._selected_text()
-        if self.selected_menu.selected_option[0] != sel:
-            # changed by a key or a rebuild: the menu has no setter, so make it anew
+        if sel != self._menu_made_for or (force and self.selected_menu.selected_option[0] != sel):
             self.selected_menu.kill()
             self._make_menu()
+            self.dirty = True
+        integ = self.session.integrator
+        if integ != self._integrator_menu_made_for or (force and self.integrator_menu.selected_option[0] != integ):
+            self.integrator_menu.kill()
+            self._make_integrator_menu()
             self.dirty = True
         if self._message_shown != (self.message, self.message_is_error):
             self._message_shown = (self.message, self.message_is_error)

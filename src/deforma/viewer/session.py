@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..physics import Rect
+from ..physics import Rect, available_integrators
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 
@@ -207,6 +207,33 @@ class Session:
             self._edit_collider(name, value)
         else:
             raise KeyError(f"unknown parameter {name!r}")
+
+    # -- integrator ---------------------------------------------------------------------------
+    @property
+    def integrator(self) -> str:
+        """Name of the running world's time integrator."""
+        return self.world.integrator
+
+    def set_integrator(self, name: str) -> None:
+        """Switch the running world to another integrator (state and every value kept).
+
+        Raises
+        ------
+        ValueError
+            ``name`` is not in ``deforma.physics.available_integrators()``; one line.
+        """
+        names = available_integrators()
+        if name not in names:
+            raise ValueError(f"integrator must be one of {', '.join(names)}, got {name!r}")
+        self.world.integrator = name
+        self.note = ""
+        stable = self.world.stable_dt()
+        h = self.world.dt / self.world.substeps
+        if h > stable:
+            # switching back to the explicit method with stiff settings is a legitimate
+            # experiment (watch it blow up); say beforehand what will happen
+            self.note = (f"dt/substeps {h:.2g} s exceeds the explicit stable estimate {stable:.2g} s: "
+                         f"expect a blow-up unless you raise substeps")
 
     # -- mesh ---------------------------------------------------------------------------------
     def select_object(self, name: str) -> None:
