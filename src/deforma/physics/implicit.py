@@ -53,8 +53,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point
-from .integrators import _is_bad, register_integrator
+from .colliders import finish_position_step
+from .integrators import register_integrator
 
 
 @njit(cache=True)
@@ -123,51 +123,6 @@ def implicit_rhs(x, x_n, y, vertex_mass, spring_i, spring_j, rest, wk, wd, grab_
         b[i, 1] -= ty
         b[j, 0] += tx
         b[j, 1] += ty
-
-
-# Serial on purpose: it is a few percent of a step (the solves dominate), and a parallel
-# loop waits out other processes' time slices at its barrier when the cores are busy
-# (the 4 s jelly comparison took 27.6 s instead of 1.7 s once while the other core was busy).
-@njit(cache=True)
-def implicit_finish(x, v, x_n, rects, h, vmax2):
-    """Velocities ``(x - x_n) / h``, collisions and friction, and the bad-vertex count.
-
-    Parameters
-    ----------
-    x, v : (N, 2) float64
-        Solved positions (m), updated in place with the collided positions; velocities
-        (m/s) output.
-    x_n : (N, 2) float64
-        Positions at the start of the substep (m).
-    rects : (R, RECT_COLUMNS) float64
-        Packed colliders.
-    h : float
-        Substep (s).
-    vmax2 : float
-        Squared runaway speed (m^2/s^2).
-
-    Returns
-    -------
-    int
-        Vertices that ended non-finite or faster than ``sqrt(vmax2)``.
-    """
-    n_rects = rects.shape[0]
-    inv_h = 1.0 / h
-    bad = 0
-    for i in range(x.shape[0]):
-        x0, y0 = x_n[i, 0], x_n[i, 1]
-        px, py = x[i, 0], x[i, 1]
-        vx = (px - x0) * inv_h
-        vy = (py - y0) * inv_h
-        near = False
-        for r in range(n_rects):
-            if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
-                near = True
-        if near:
-            px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
-        x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
-        bad += _is_bad(px, py, vx, vy, vmax2)
-    return bad
 
 
 def system_matrix(model, grab_slot, grab_pull, h: float) -> sp.csc_matrix:
@@ -286,7 +241,7 @@ class ImplicitEuler:
                 implicit_rhs(x, x_n, y, model.vertex_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              self._wk, self._wd, inputs.grab_slot, inputs.grab_pull, h2, b)
                 x[...] = self._lu.solve(b)
-            bad = implicit_finish(x, v, x_n, inputs.rects, float(h), vmax2)
+            bad = finish_position_step(x, v, x_n, inputs.rects, float(h), vmax2)
             if bad:
                 return bad
         return 0

@@ -38,8 +38,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point
-from .integrators import _is_bad, register_integrator
+from .colliders import finish_position_step
+from .integrators import register_integrator
 
 
 @njit(cache=True)
@@ -96,9 +96,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
     1.0
     """
     n = x.shape[0]
-    n_rects = rects.shape[0]
     h2 = h * h
-    inv_h = 1.0 / h
     for i in range(n):
         x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
     for sub in range(substeps):
@@ -144,20 +142,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
                 x[i, 1] -= wi * ny * dlam
                 x[j, 0] += wj * nx * dlam
                 x[j, 1] += wj * ny * dlam
-        bad = 0
-        for i in range(n):
-            x0, y0 = x_prev[i, 0], x_prev[i, 1]
-            px, py = x[i, 0], x[i, 1]
-            vx = (px - x0) * inv_h
-            vy = (py - y0) * inv_h
-            near = False
-            for r in range(n_rects):
-                if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
-                    near = True
-            if near:
-                px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
-            x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
-            bad += _is_bad(px, py, vx, vy, vmax2)
+        bad = finish_position_step(x, v, x_prev, rects, h, vmax2)
         if bad:
             return bad
     return 0
