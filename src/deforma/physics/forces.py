@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .jit import serial_and_parallel
+
 
 @njit(cache=True, inline="always")
 def spring_force(xi0, xi1, xj0, xj1, vi0, vi1, vj0, vj1, rest, ks, kd):
@@ -46,9 +48,11 @@ def spring_force(xi0, xi1, xj0, xj1, vi0, vi1, vj0, vj1, rest, ks, kd):
     return s * nx, s * ny
 
 
-@njit(cache=True)
-def spring_forces_serial(x, v, spring_i, spring_j, rest, ks, kd, fe):
+def _spring_forces(x, v, spring_i, spring_j, rest, ks, kd, fe):
     """Write into ``fe[e]`` the force (N) of spring ``e`` on its ``spring_i[e]`` end.
+
+    Built twice: ``spring_forces_serial`` (one thread) and ``spring_forces_parallel`` (all
+    cores); same arguments, same result.
 
     Parameters
     ----------
@@ -70,18 +74,6 @@ def spring_forces_serial(x, v, spring_i, spring_j, rest, ks, kd, fe):
     >>> fe.tolist()
     [[10.0, 0.0]]
     """
-    for e in range(spring_i.shape[0]):
-        i = spring_i[e]
-        j = spring_j[e]
-        fx, fy = spring_force(x[i, 0], x[i, 1], x[j, 0], x[j, 1], v[i, 0], v[i, 1], v[j, 0], v[j, 1],
-                              rest[e], ks[e], kd[e])
-        fe[e, 0] = fx
-        fe[e, 1] = fy
-
-
-@njit(cache=True, parallel=True)
-def spring_forces_parallel(x, v, spring_i, spring_j, rest, ks, kd, fe):
-    """:func:`spring_forces_serial` on all cores (same arguments, same result)."""
     for e in prange(spring_i.shape[0]):
         i = spring_i[e]
         j = spring_j[e]
@@ -89,6 +81,9 @@ def spring_forces_parallel(x, v, spring_i, spring_j, rest, ks, kd, fe):
                               rest[e], ks[e], kd[e])
         fe[e, 0] = fx
         fe[e, 1] = fy
+
+
+spring_forces_serial, spring_forces_parallel = serial_and_parallel(_spring_forces, "spring_forces")
 
 
 @njit(cache=True, inline="always")

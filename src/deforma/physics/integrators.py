@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import math
 import time
-import types
 from typing import Callable, Protocol
 
 
@@ -40,6 +39,7 @@ from numba import njit, prange
 
 from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad
 from .forces import spring_force
+from .jit import serial_and_parallel
 
 # Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
 PARALLEL_MIN_VERTICES = 512
@@ -212,18 +212,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
     return 0
 
 
-def _compiled_as(fn, name: str, **options):
-    """``njit(fn)`` under its own name, so the serial and parallel builds of one body keep
-    separate on-disk caches (Numba's cache is keyed by the function's qualified name, not
-    by its options)."""
-    f = types.FunctionType(fn.__code__, fn.__globals__, name, fn.__defaults__, fn.__closure__)
-    f.__qualname__ = name
-    f.__doc__ = fn.__doc__
-    return njit(cache=True, **options)(f)
-
-
-symplectic_euler_serial = _compiled_as(_symplectic_euler, "symplectic_euler_serial")
-symplectic_euler_parallel = _compiled_as(_symplectic_euler, "symplectic_euler_parallel", parallel=True)
+symplectic_euler_serial, symplectic_euler_parallel = serial_and_parallel(_symplectic_euler, "symplectic_euler")
 
 
 def spring_chunks(spring_i, spring_j, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
