@@ -116,7 +116,6 @@ def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, h):
     return x0 + h * vx, y0 + h * vy, vx, vy
 
 
-
 @njit(cache=True)
 def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
     """Add the force (N) of every spring to both of its ends in ``f`` (N, 2).
@@ -179,7 +178,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
             x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
             if save:
                 x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
-            if n_chunks == 1:  # one buffer over every vertex: no range test (15% of a small step)
+            if n_chunks == 1:  # one buffer over every vertex: no range test (~7% of a 1e3-vertex step)
                 fx = fbuf[0, i, 0]
                 fy = fbuf[0, i, 1]
                 fbuf[0, i, 0] = 0.0

@@ -196,8 +196,9 @@ class Inspector:
     def _make_integrator_menu(self) -> None:
         names = available_integrators()  # the registry: a user-registered integrator shows too
         self._integrator_menu_made_for = self.session.integrator
-        self.integrator_menu = UIDropDownMenu(names, self._integrator_menu_made_for, self._integrator_rect, self.manager,
-                                              container=self.scroll, expansion_height_limit=len(names) * 26)
+        self.integrator_menu = UIDropDownMenu(names, self._integrator_menu_made_for, self._integrator_rect,
+                                              self.manager, container=self.scroll,
+                                              expansion_height_limit=len(names) * 26)
 
     def _selected_text(self) -> str:
         sel = self.session.mesh.selected
