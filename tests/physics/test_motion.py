@@ -1,4 +1,5 @@
-"""Known answers of the free dynamics: free fall, a spring's period, conservation laws."""
+"""Known answers of the free dynamics under symplectic Euler: a spring's period at a small step,
+bounded energy, damping (free fall and momentum under every integrator: test_integrators.py)."""
 
 import math
 
@@ -6,23 +7,7 @@ import numpy as np
 import pytest
 
 import deforma
-from physics_meshes import Chain, grid_mesh
-
-
-def test_free_fall_matches_discrete_and_continuous_answers():
-    h, n, g = 1 / 1000, 500, 9.81
-    w = deforma.World(dt=h, gravity=(0.0, -g))
-    b = w.add_body(grid_mesh(0.3, 0.2, 4, 3), position=(1.0, 10.0))
-    b.velocities[:] = (0.5, 2.0)
-    for _ in range(n):
-        w.step()
-    t = n * h
-    com = b.center_of_mass
-    # symplectic Euler: v_k = v0 - g h k, y_n = y0 + h sum_k v_k = y0 + v0 t - g h^2 n (n + 1) / 2
-    assert com[1] == pytest.approx(10.0 + 2.0 * t - g * h * h * n * (n + 1) / 2, abs=1e-9)
-    assert com[1] == pytest.approx(10.0 + 2.0 * t - g * t * t / 2, abs=g * h * t)  # O(h) from the exact
-    assert com[0] == pytest.approx(1.0 + 0.5 * t, abs=1e-9)
-    assert w.time == pytest.approx(t) and w.step_count == n
+from physics_meshes import Chain, random_body
 
 
 def test_two_masses_on_one_spring_oscillate_with_period_2pi_sqrt_mu_over_k():
@@ -43,35 +28,9 @@ def test_two_masses_on_one_spring_oscillate_with_period_2pi_sqrt_mu_over_k():
     assert period == pytest.approx(2 * math.pi * math.sqrt(0.75 / k), rel=2e-3)
 
 
-def _random_body(world, seed):
-    rng = np.random.default_rng(seed)
-    b = world.add_body(grid_mesh(1.0, 0.6, 7, 5), position=(0, 0))
-    b.positions[:] += rng.normal(scale=0.03, size=b.positions.shape)
-    b.velocities[:] = rng.normal(scale=0.5, size=b.velocities.shape)
-    return b
-
-
-def test_momentum_and_angular_momentum_kept_without_gravity_or_colliders():
-    w = deforma.World(dt=1 / 2000, gravity=(0, 0), stiffness=400.0, damping=0.3)
-    b = _random_body(w, 1)
-    m = b.mass / b.n_vertices
-
-    def momenta():
-        x, v = b.positions, b.velocities
-        return m * v.sum(axis=0), m * float(np.sum(x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]))
-
-    p0, l0 = momenta()
-    for _ in range(1000):
-        w.step()
-    p1, l1 = momenta()
-    assert np.abs(p1 - p0).max() < 1e-12
-    # symplectic Euler keeps angular momentum exactly for central forces (up to rounding)
-    assert l1 == pytest.approx(l0, abs=1e-12)
-
-
 def test_energy_stays_bounded_without_damping():
     w = deforma.World(dt=1 / 2000, gravity=(0, -9.81), stiffness=400.0, damping=0.0)
-    _random_body(w, 2)
+    random_body(w, 2)
     totals = []
     for _ in range(4000):
         w.step()
@@ -86,7 +45,7 @@ def test_energy_stays_bounded_without_damping():
 
 def test_damping_removes_energy():
     w = deforma.World(dt=1 / 2000, gravity=(0, 0), stiffness=400.0, damping=0.5)
-    _random_body(w, 3)
+    random_body(w, 3)
     e0 = w.energy().total
     for _ in range(2000):
         w.step()
