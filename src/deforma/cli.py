@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -117,24 +115,30 @@ def _check_states_path(path: str) -> None:
     p = Path(path)
     if p.suffix.lower() != ".npz":
         raise CliError(f"{path}: states are written as .npz; give a name ending in .npz")
-    folder = p.parent
-    if not folder.is_dir():
-        raise CliError(f"{path}: the folder {str(folder)!r} does not exist")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise CliError(f"{path}: the folder {str(folder)!r} is not writable")
+    _check_folder(path)
+
+
+def _check_folder(path) -> None:
+    """The folder ``path`` goes into exists and is writable, checked before any work."""
+    from .render.video import check_folder
+
+    try:
+        check_folder(path, Path(path).parent)
+    except ValueError as e:
+        raise CliError(str(e)) from None
 
 
 def _write_atomic(path: Path, write) -> None:
     """Call ``write(file)`` on a temporary file beside ``path``, then rename it into place."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".partial{path.suffix}", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-        from .render.video import publish
+    from .render.video import publish, temp_beside
 
+    tmp = temp_beside(path)
+    try:
+        with open(tmp, "wb") as f:
+            write(f)
         publish(tmp, path)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise
 
 
@@ -311,10 +315,7 @@ def cmd_mesh(a) -> int:
     out = Path(a.output)
     if out.suffix.lower() != ".png":
         raise CliError(f"{a.output}: the picture is written as PNG; give a name ending in .png")
-    if not out.parent.is_dir():
-        raise CliError(f"{a.output}: the folder {str(out.parent)!r} does not exist")
-    if not os.access(out.parent, os.W_OK | os.X_OK):
-        raise CliError(f"{a.output}: the folder {str(out.parent)!r} is not writable")
+    _check_folder(a.output)
     t0 = time.perf_counter()
     if a.source == "box":
         m = meshes.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=a.detail, edges=a.edges)

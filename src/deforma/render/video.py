@@ -58,26 +58,32 @@ def check_output(path) -> str:
     kind = output_kind(path)
     p = Path(str(path).rstrip("/" + os.sep) or ".")
     if kind == "png":
-        if p.exists():
-            if not p.is_dir():
-                raise ValueError(f"{path}: exists and is not a folder; PNG frames need a folder")
-            folder = p
-        else:
-            folder = p.parent
-            if not folder.is_dir():
-                raise ValueError(f"{path}: the folder {str(folder)!r} does not exist")
+        if p.exists() and not p.is_dir():
+            raise ValueError(f"{path}: exists and is not a folder; PNG frames need a folder")
+        folder = p if p.exists() else p.parent
     else:
         if p.is_dir():
             raise ValueError(f"{path}: is a folder; give a file name ending in .{kind}")
         folder = p.parent
-        if not folder.is_dir():
-            raise ValueError(f"{path}: the folder {str(folder)!r} does not exist")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise ValueError(f"{path}: the folder {str(folder)!r} is not writable")
+    check_folder(path, folder)
     return kind
 
 
-def _temp_beside(target: Path) -> Path:
+def check_folder(path, folder: Path) -> None:
+    """Check that ``folder``, where ``path`` will be written, exists and is writable.
+
+    Raises
+    ------
+    ValueError
+        One line naming ``path`` and the folder.
+    """
+    if not folder.is_dir():
+        raise ValueError(f"{path}: the folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f"{path}: the folder {str(folder)!r} is not writable")
+
+
+def temp_beside(target: Path) -> Path:
     """A fresh hidden file next to ``target`` with the same suffix (ffmpeg picks formats by it)."""
     fd, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=f".partial{target.suffix}", dir=target.parent)
     os.close(fd)
@@ -177,7 +183,7 @@ class Mp4Writer(FrameWriter):
         except ImportError:
             raise RuntimeError("MP4 output needs imageio-ffmpeg: pip install 'deforma[render]'") from None
         self.quality = quality
-        self._tmp = _temp_beside(self.path)
+        self._tmp = temp_beside(self.path)
         self._gen = None
 
     def _write(self, frame):
@@ -235,7 +241,7 @@ class GifWriter(FrameWriter):
         self._palette_after = max(1, int(round(self.fps)))
         # the temporary file exists from the start, like the MP4's: it reserves the name and
         # shows a run is in progress; it gets its bytes at the end (GIF needs all frames)
-        self._tmp = _temp_beside(self.path)
+        self._tmp = temp_beside(self.path)
 
     def _quantize(self, frame):
         from PIL import Image
@@ -309,7 +315,7 @@ class PngFolderWriter(FrameWriter):
         if self.frames_written == 0:
             self.path.mkdir(exist_ok=True)
         target = self.frame_path(self.frames_written)
-        tmp = _temp_beside(target)
+        tmp = temp_beside(target)
         try:
             Image.fromarray(frame).save(tmp, format="PNG", compress_level=self.compress_level)
             publish(tmp, target)
