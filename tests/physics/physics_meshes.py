@@ -29,11 +29,11 @@ class Chain:
         self.edges = np.asarray(edges, np.int32)
 
 
-def random_body(world, seed):
+def random_body(world, seed, *, self_collision=True):
     """A 7 x 5-vertex body added to ``world``, its positions jittered by 3 cm and its
     velocities random (0.5 m/s scale), from ``seed``."""
     rng = np.random.default_rng(seed)
-    b = world.add_body(grid_mesh(1.0, 0.6, 7, 5), position=(0, 0))
+    b = world.add_body(grid_mesh(1.0, 0.6, 7, 5), position=(0, 0), self_collision=self_collision)
     b.positions[:] += rng.normal(scale=0.03, size=b.positions.shape)
     b.velocities[:] = rng.normal(scale=0.5, size=b.velocities.shape)
     return b

@@ -215,7 +215,10 @@ def _stiff_world(name, *, floor, substeps=1):
     w = deforma.World(dt=1 / 60, substeps=substeps, stiffness=1.0, damping=0.5, mass=1.0, integrator=name)
     if floor:
         w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
-    b = w.add_body(grid_mesh(0.4, 0.2, 9, 5), position=(0.0, 0.1 + 1e-6 if floor else 2.0))
+    # Self contact off: at 10x the explicit step, one XPBD sweep per step reaches the rest
+    # shape through corners folded back over the next edge, and self contact (rightly) holds
+    # such a fold; these tests are about the integrators, not contacts inside their solves.
+    b = w.add_body(grid_mesh(0.4, 0.2, 9, 5), position=(0.0, 0.1 + 1e-6 if floor else 2.0), self_collision=False)
     h = w.dt / w.substeps
     # without damping the explicit limit scales as 1 / sqrt(stiffness), so 10x the step is
     # 100x the stiffness; a few fixed-point rounds account for the (small) damping

@@ -132,7 +132,7 @@ def test_positions_and_velocities_are_views_into_one_contiguous_state():
 def test_body_parameters_follow_the_world_unless_overridden():
     w = deforma.World(mass=2.0, stiffness=100.0)
     a = w.add_body(grid_mesh(0.2, 0.1, 3, 2))
-    b = w.add_body(grid_mesh(0.2, 0.1, 3, 2), stiffness=50.0, mass=6.0)
+    b = w.add_body(grid_mesh(0.2, 0.1, 3, 2), position=(1.0, 0.0), stiffness=50.0, mass=6.0)
     w.stiffness = 300.0
     assert (a.stiffness, b.stiffness) == (300.0, 50.0)
     assert w._model.spring_stiffness[: a.n_springs].tolist() == [300.0] * a.n_springs

@@ -13,7 +13,8 @@ integrator, ``p = p_prev + h*v``):
    shortest way out.
 3. Split the velocity into normal ``vn`` and tangential ``vt`` parts of that face. An
    inward ``vn`` is removed; its size ``jn = -vn`` is the normal impulse per unit mass
-   this substep, i.e. ``h * N / m``. Coulomb friction then acts on ``vt``: if
+   this substep, i.e. ``h * N / m``. Coulomb friction then acts on ``vt``
+   (:func:`deforma.physics.friction.coulomb`, the rule body contacts use too): if
    ``|vt| <= static_friction * jn`` the vertex sticks (``vt = 0``), otherwise dynamic
    friction removes ``friction * jn`` from ``|vt|`` (never reversing it).
 4. Put the point on the face (plus a nanometre skin so it is strictly outside) and move it
@@ -33,16 +34,34 @@ Angles are degrees in the API, radians nowhere outside this module. Units: m, m/
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit, prange
+
+from .friction import coulomb
 
 # Columns of the packed collider array read by the kernels.
 RECT_CX, RECT_CY, RECT_UX, RECT_UY, RECT_HX, RECT_HY = 0, 1, 2, 3, 4, 5
 RECT_FRICTION, RECT_STATIC_FRICTION = 6, 7
 RECT_XMIN, RECT_XMAX, RECT_YMIN, RECT_YMAX, RECT_SKIN = 8, 9, 10, 11, 12
 RECT_COLUMNS = 13
+
+# Per vertex of a world, the last collider contact: written only when a vertex touches one.
+ColliderHits = namedtuple("ColliderHits", [
+    "stamp",            # (N,) int64: the substep it happened in (see contacts.ST_STAMP)
+    "collider",         # (N,) int32: which collider
+    "normal",           # (N, 2) float64: the face's outward normal
+    "depth",            # (N,) float64: how deep inside it the vertex was (m)
+])
+
+
+def make_hits(n_vertices: int) -> ColliderHits:
+    """An empty record for ``n_vertices`` vertices (no substep has stamp -1)."""
+    return ColliderHits(np.full(n_vertices, -1, np.int64), np.zeros(n_vertices, np.int32),
+                        np.zeros((n_vertices, 2)), np.zeros(n_vertices))
+
 
 # Pushing a point out of one rectangle can push it into a touching one; a few passes settle
 # every sane arrangement, and a point still trapped falls back to its previous position.
@@ -171,7 +190,11 @@ def _inside(rects, r, px, py):
 
 @njit(cache=True)
 def collide_point(x0, y0, px, py, vx, vy, rects, h):
-    """Resolve one point against all rectangles; returns the new ``(px, py, vx, vy)``.
+    """Resolve one point against all rectangles.
+
+    Returns ``(px, py, vx, vy, hit, nx, ny, depth)``: the new position and velocity, the
+    index of the last rectangle the point was put out of (-1 if none), that face's outward
+    normal and how deep (m) the point was inside it.
 
     Parameters
     ----------
@@ -187,11 +210,15 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
     Examples
     --------
     >>> r = pack_rects([Rect((0, -1), (10, 2), 0.0)], friction=0.3, static_friction=0.5)
-    >>> px, py, vx, vy = collide_point(0.0, 0.0, 0.01, -0.01, 1.0, -1.0, r, 0.01)
-    >>> round(py, 6), vy, round(vx, 3)
-    (0.0, 0.0, 0.7)
+    >>> px, py, vx, vy, hit, nx, ny, depth = collide_point(0.0, 0.0, 0.01, -0.01, 1.0, -1.0, r, 0.01)
+    >>> round(py, 6), vy, round(vx, 3), hit, (nx, ny), round(depth, 6)
+    (0.0, 0.0, 0.7, 0, (-0.0, 1.0), 0.01)
     """
     hit = False
+    last = -1
+    hx_n = 0.0
+    hy_n = 0.0
+    last_depth = 0.0
     for _ in range(MAX_PASSES):
         hit = False
         for r in range(rects.shape[0]):
@@ -239,19 +266,12 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
             if vn < 0.0:
                 jn = -vn
                 vn = 0.0
-            vt_new = vt
-            if jn > 0.0:
-                if abs(vt) <= rects[r, RECT_STATIC_FRICTION] * jn:
-                    vt_new = 0.0
-                else:
-                    slow = rects[r, RECT_FRICTION] * jn
-                    if abs(vt) <= slow:
-                        vt_new = 0.0
-                    elif vt > 0.0:
-                        vt_new = vt - slow
-                    else:
-                        vt_new = vt + slow
+            vt_new = coulomb(vt, jn, rects[r, RECT_STATIC_FRICTION], rects[r, RECT_FRICTION])
             s += h * (vt_new - vt)
+            last = r
+            hx_n = nx
+            hy_n = ny
+            last_depth = best
             d += rects[r, RECT_SKIN]
             px = cx + d * nx + s * tx
             py = cy + d * ny + s * ty
@@ -263,8 +283,8 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
         for r in range(rects.shape[0]):
             if _inside(rects, r, px, py):
                 # trapped between rectangles: the original's answer, back to where it was
-                return x0, y0, 0.0, 0.0
-    return px, py, vx, vy
+                return x0, y0, 0.0, 0.0, last, hx_n, hy_n, last_depth
+    return px, py, vx, vy, last, hx_n, hy_n, last_depth
 
 
 @njit(cache=True, inline="always")
@@ -276,8 +296,18 @@ def is_bad(px, py, vx, vy, vmax2):
     return 1
 
 
+@njit(cache=True, inline="always")
+def record_hit(hits, i, stamp, r, nx, ny, depth):
+    """Note in ``hits`` (a :class:`ColliderHits`) that vertex ``i`` touched collider ``r`` in substep ``stamp``."""
+    hits.stamp[i] = stamp
+    hits.collider[i] = r
+    hits.normal[i, 0] = nx
+    hits.normal[i, 1] = ny
+    hits.depth[i] = depth
+
+
 @njit(cache=True)
-def finish_position_step(x, v, x_prev, rects, h, vmax2):
+def finish_position_step(x, v, x_prev, rects, hits, stamp, h, vmax2):
     """End a substep of a position-based integrator: velocities, contacts, the bad-vertex count.
 
     Implicit Euler and XPBD both produce new positions; the velocity is then
@@ -292,6 +322,8 @@ def finish_position_step(x, v, x_prev, rects, h, vmax2):
         Positions at the start of the substep (m).
     rects : (R, RECT_COLUMNS) float64
         From :func:`pack_rects`.
+    hits : ColliderHits
+        Where each vertex that touches a collider is noted, with ``stamp``.
     h : float
         Substep (s).
     vmax2 : float
@@ -317,7 +349,9 @@ def finish_position_step(x, v, x_prev, rects, h, vmax2):
             if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                 near = True
         if near:
-            px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
+            px, py, vx, vy, hit, nx, ny, depth = collide_point(x0, y0, px, py, vx, vy, rects, h)
+            if hit >= 0:
+                record_hit(hits, i, stamp, hit, nx, ny, depth)
         x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
         bad += is_bad(px, py, vx, vy, vmax2)
     return bad
@@ -337,7 +371,8 @@ def collide_points(x_prev, x, v, rects, h):
     (True, 0.0)
     """
     for i in prange(x.shape[0]):
-        px, py, vx, vy = collide_point(x_prev[i, 0], x_prev[i, 1], x[i, 0], x[i, 1], v[i, 0], v[i, 1], rects, h)
+        px, py, vx, vy, _, _, _, _ = collide_point(x_prev[i, 0], x_prev[i, 1], x[i, 0], x[i, 1], v[i, 0], v[i, 1],
+                                                   rects, h)
         x[i, 0] = px
         x[i, 1] = py
         v[i, 0] = vx

@@ -54,6 +54,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from .colliders import finish_position_step
+from .contacts import ST_STAMP, contact_stage, gather_start
 from .integrators import register_integrator
 
 
@@ -241,7 +242,12 @@ class ImplicitEuler:
                 implicit_rhs(x, x_n, y, model.vertex_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              self._wk, self._wd, inputs.grab_slot, inputs.grab_pull, h2, b)
                 x[...] = self._lu.solve(b)
-            bad = finish_position_step(x, v, x_n, inputs.rects, float(h), vmax2)
+            scr = inputs.contact_scratch
+            bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
             if bad:
                 return bad
+            gather_start(x_n, model.contact, scr)
+            if contact_stage(x, v, model.vertex_inv_mass, model.contact, scr, inputs.contacts, inputs.rects,
+                             inputs.hits, float(h)) < 0:
+                return 0  # the contact buffer is too small; the world grows it and repeats the step
         return 0

@@ -17,7 +17,13 @@ Semi-implicit (symplectic) Euler, per substep::
 
     v += h * F(x, v) / m
     x += h * v
-    x, v = collide(x_before, x, v)
+    x, v = collide(x_before, x, v)              # colliders, per vertex
+    x, v = contact_stage(x_before, x, v)        # bodies against bodies and themselves
+
+Every integrator ends its substeps with the same two responses: the collider response per
+vertex (fused into its last pass over the vertices) and then the body contact stage of
+:mod:`~deforma.physics.contacts` (collide, solve, verify), which needs the boundary's
+positions at the start of the substep (``contacts.gather_start``).
 
 It is fused into two passes over memory per substep: springs, each thread scattering a
 contiguous run of them into its own force buffer, then one per-vertex pass that sums the
@@ -37,7 +43,8 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad
+from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, record_hit
+from .contacts import ST_STAMP, contact_stage, gather_start
 from .forces import spring_force
 from .jit import serial_and_parallel
 
@@ -50,6 +57,9 @@ class StepInputs(Protocol):
 
     gravity: tuple[float, float]
     rects: np.ndarray          # (R, RECT_COLUMNS) packed colliders
+    hits: tuple                # colliders.ColliderHits: who touched which collider, per vertex
+    contact_scratch: tuple     # contacts.ContactScratch
+    contacts: tuple            # contacts.ContactBuffer
     grab_slot: np.ndarray      # (N,) int32, grab entry per vertex or -1
     grab_pull: np.ndarray      # (K, 3) float64, (S, S*tx, S*ty) per entry
     max_speed: float           # m/s; faster counts as runaway
@@ -154,14 +164,16 @@ def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
 # Scalar-only helpers are free.
 
 def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
-                      inv_mass, gx, gy, grab_slot, grab_pull, rects, h, substeps, vmax2):
+                      inv_mass, gx, gy, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions.
 
     ``fbuf`` (T, N, 2) are zeroed force buffers, one per spring chunk ``chunk_ptr[t]:
     chunk_ptr[t + 1]``, and are left zeroed; chunk ``t`` touches only the vertices
     ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see :func:`spring_chunks`). Saves the start state into ``x_start`` /
     ``v_start``; stops early and returns the number of vertices that ended non-finite or
-    faster than ``sqrt(vmax2)`` m/s.
+    faster than ``sqrt(vmax2)`` m/s (or 0 at once when the contact buffer ``cbuf`` is too
+    small: ``cscr.status`` says so). ``hits`` records collider contacts (written only on a
+    hit); ``ctopo``, ``cscr``, ``cbuf``: the contact stage's topology, scratch and buffer.
 
     Compiled twice below: ``symplectic_euler_serial`` (one thread: ``prange`` is ``range``)
     and ``symplectic_euler_parallel`` (one spring chunk per thread, the vertex pass split
@@ -169,6 +181,8 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
     """
     n_chunks = chunk_ptr.shape[0] - 1
     for sub in range(substeps):
+        gather_start(x, ctopo, cscr)
+        stamp = cscr.status[ST_STAMP] + 1  # the contact stage counts this substep when it runs
         for t in prange(n_chunks):
             lo, hi = chunk_ptr[t], chunk_ptr[t + 1]
             scatter_spring_forces(x, v, spring_i[lo:hi], spring_j[lo:hi], rest[lo:hi], ks[lo:hi], kd[lo:hi], fbuf[t])
@@ -203,11 +217,15 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
                 if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                     near = True
             if near:
-                px, py, vx, vy = collide_point(x0, y0, px, py, vx, vy, rects, h)
+                px, py, vx, vy, hit, nx, ny, depth = collide_point(x0, y0, px, py, vx, vy, rects, h)
+                if hit >= 0:
+                    record_hit(hits, i, stamp, hit, nx, ny, depth)
             x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
             bad += is_bad(px, py, vx, vy, vmax2)
         if bad:
             return bad
+        if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
+            return 0
     return 0
 
 
@@ -339,7 +357,8 @@ class SymplecticEuler:
         bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks, self._chunk_vertices,
                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
                      model.spring_damping, model.vertex_inv_mass, float(gx), float(gy), inputs.grab_slot,
-                     inputs.grab_pull, inputs.rects, float(h), int(substeps), float(inputs.max_speed) ** 2)
+                     inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch, inputs.contacts,
+                     float(h), int(substeps), float(inputs.max_speed) ** 2)
         if may_parallel:
             took = (time.perf_counter() - start) / substeps
             if which == self._last:  # the driver ran last call too: threads awake, caches warm

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .contacts import COLLIDE, SELF_COLLIDE, ContactTopology, rest_clearance
+
 
 @dataclass(frozen=True, eq=False)
 class BodyTopology:
@@ -28,7 +30,17 @@ class BodyTopology:
     spring_rest_length : (E,) float64
         Rest length of each spring in metres (its length in ``rest_positions``).
     triangles : (M, 3) int32
-        Triangles for picking and drawing; may be empty (a chain of springs).
+        Triangles, counter-clockwise; may be empty (a chain of springs).
+    boundary_edges : (B, 2) int32
+        Edges used by one triangle, directed with the body on their left (outer outlines
+        counter-clockwise, holes clockwise); empty without triangles.
+    boundary_vertices : (V,) int32
+        The vertices on those edges, sorted: the body's collision vertices.
+    boundary_clearance : (V,) float64
+        Per boundary vertex, at rest: how far it lies in front of the nearest other boundary
+        edge (``inf`` beyond twice the shortest boundary edge); see
+        :func:`deforma.physics.contacts.rest_clearance`. Caps the self-contact thickness so
+        that a body at rest never touches itself.
 
     Examples
     --------
@@ -42,6 +54,9 @@ class BodyTopology:
     springs: np.ndarray
     spring_rest_length: np.ndarray
     triangles: np.ndarray
+    boundary_edges: np.ndarray
+    boundary_vertices: np.ndarray
+    boundary_clearance: np.ndarray
 
     @classmethod
     def from_arrays(cls, vertices, springs, triangles=None) -> "BodyTopology":
@@ -78,7 +93,8 @@ class BodyTopology:
             t = np.ascontiguousarray(triangles, dtype=np.int32).reshape(-1, 3)
             if t.size and (t.min() < 0 or t.max() >= len(x)):
                 raise ValueError(f"triangle vertex indices must lie in [0, {len(x) - 1}]")
-        return cls(x, np.ascontiguousarray(s), rest, t)
+        edges, verts, clearance = _boundary(x, t)
+        return cls(x, np.ascontiguousarray(s), rest, t, edges, verts, clearance)
 
     @property
     def n_vertices(self) -> int:
@@ -89,6 +105,32 @@ class BodyTopology:
     def n_springs(self) -> int:
         """Number of springs."""
         return len(self.springs)
+
+    @property
+    def boundary_edge_lengths(self) -> np.ndarray:
+        """(B,) float64: rest length of each boundary edge, m."""
+        x, e = self.rest_positions, self.boundary_edges
+        return np.linalg.norm(x[e[:, 1]] - x[e[:, 0]], axis=1)
+
+
+def _boundary(x: np.ndarray, t: np.ndarray):
+    """Directed boundary edges, boundary vertices and their rest clearances of one body."""
+    if len(t) == 0:
+        return np.zeros((0, 2), np.int32), np.zeros(0, np.int32), np.zeros(0)
+    t = t.copy()
+    a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
+    cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
+    t[cw] = t[cw][:, [0, 2, 1]]
+    directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]).astype(np.int64)
+    lo, hi = directed.min(axis=1), directed.max(axis=1)
+    _, inverse, counts = np.unique(lo * len(x) + hi, return_inverse=True, return_counts=True)
+    edges = np.ascontiguousarray(directed[counts[inverse.ravel()] == 1], dtype=np.int32)
+    verts = np.unique(edges).astype(np.int32)
+    if len(edges) == 0:
+        return edges, verts, np.zeros(0)
+    reach = 2.0 * float(np.linalg.norm(x[edges[:, 1]] - x[edges[:, 0]], axis=1).min())
+    local = np.searchsorted(verts, edges).astype(np.int32)
+    return edges, verts, rest_clearance(x[verts], local, reach)
 
 
 class Model:
@@ -115,6 +157,12 @@ class Model:
         per-vertex gather sum spring forces computed once per spring, without write races.
     body_vertex_offsets, body_spring_offsets : (B + 1,) int64
         Where each body's vertices and springs start.
+    contact : ContactTopology
+        Every body's boundary as the contact stage reads it (collision vertices, boundary
+        edges, per-vertex contact thickness, per-body flags and friction); see
+        :mod:`deforma.physics.contacts`.
+    body_contact_offsets : (B + 1,) int64
+        Where each body's collision vertices start in ``contact.cv_vertex``.
 
     Examples
     --------
@@ -124,7 +172,7 @@ class Model:
     ([1.0, 1.0, 1.0], [0, 2, 4, 6])
     """
 
-    def __init__(self, topologies, *, masses, stiffness, damping):
+    def __init__(self, topologies, *, masses, stiffness, damping, contact=None):
         self.topologies = list(topologies)
         nv = [t.n_vertices for t in self.topologies]
         ne = [t.n_springs for t in self.topologies]
@@ -160,6 +208,32 @@ class Model:
         self.adj_spring = np.ascontiguousarray(ids[order])
         self.adj_sign = np.ascontiguousarray(signs[order])
 
+        # the contact stage's view: every body's boundary, collision vertices numbered body by body
+        nb = len(self.topologies)
+        nc = [len(t.boundary_vertices) for t in self.topologies]
+        self.body_contact_offsets = np.zeros(nb + 1, np.int64)
+        np.cumsum(nc, out=self.body_contact_offsets[1:])
+        cv, cb, ea, eb, ebody = [np.zeros(0, np.int32)], [np.zeros(0, np.int32)], [np.zeros(0, np.int32)], \
+            [np.zeros(0, np.int32)], [np.zeros(0, np.int32)]
+        
+        for b, t in enumerate(self.topologies):
+            local = np.full(t.n_vertices, -1, np.int64)
+            local[t.boundary_vertices] = np.arange(nc[b]) + self.body_contact_offsets[b]
+            cv.append(t.boundary_vertices + self.body_vertex_offsets[b])
+            cb.append(np.full(nc[b], b))
+            ea.append(local[t.boundary_edges[:, 0]])
+            eb.append(local[t.boundary_edges[:, 1]])
+            ebody.append(np.full(len(t.boundary_edges), b))
+        v = int(self.body_contact_offsets[-1])
+
+        def i32(parts):
+            return np.ascontiguousarray(np.concatenate(parts), dtype=np.int32)
+        self.contact = ContactTopology(i32(cv), i32(cb), i32(ea), i32(eb), i32(ebody), np.zeros(v), np.zeros(v),
+                                       np.zeros(nb, np.int32), np.zeros((nb, 2)), np.zeros(1))
+        for b in range(nb):
+            if contact is not None:
+                self.set_contact_parameters(b, **contact[b])
+
     @property
     def n_vertices(self) -> int:
         """Total number of vertices over all bodies."""
@@ -182,3 +256,21 @@ class Model:
         self.vertex_inv_mass[v0:v1] = 1.0 / m
         self.spring_stiffness[s0:s1] = stiffness
         self.spring_damping[s0:s1] = damping
+
+    def set_contact_parameters(self, body: int, *, collide: bool, self_collision: bool, friction: float,
+                               static_friction: float, thickness: float) -> None:
+        """Write body ``body``'s contact switches, friction coefficients and thickness (m).
+
+        The self-contact thickness of each boundary vertex is capped at half its rest
+        clearance in front of its own outline, so that no body touches itself at rest. The
+        caller validates the values.
+        """
+        c = self.contact
+        c.body_flags[body] = (COLLIDE if collide else 0) | (SELF_COLLIDE if self_collision else 0)
+        c.body_friction[body, 0] = friction
+        c.body_friction[body, 1] = static_friction
+        k0, k1 = self.body_contact_offsets[body], self.body_contact_offsets[body + 1]
+        clear = self.topologies[body].boundary_clearance
+        c.thick_other[k0:k1] = thickness
+        c.thick_self[k0:k1] = np.minimum(thickness, 0.5 * clear)
+        c.margin[0] = float(c.thick_other.max()) if len(c.thick_other) else 0.0

@@ -15,10 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .colliders import Rect, pack_rects
+from . import contacts as _contacts
+from .colliders import Rect, make_hits, pack_rects
 from .integrators import make_integrator
 from .model import BodyTopology, Model
 from .state import State
+
+# Automatic contact thickness: this fraction of a body's median boundary edge (see World).
+AUTO_THICKNESS = 0.05
 
 
 class SimulationUnstable(RuntimeError):
@@ -80,6 +84,12 @@ def _non_negative(value, name: str, unit: str) -> float:
     return v
 
 
+def _switch(value, name: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
 def _pair(value, name: str) -> tuple[float, float]:
     try:
         a = np.asarray(value, dtype=np.float64)
@@ -94,8 +104,10 @@ class Body:
     """A soft body in a world: a handle onto its slice of the world's arrays.
 
     Made by :meth:`World.add_body`, not directly. ``mass`` (kg, total), ``stiffness``
-    (N/m per spring) and ``damping`` (N*s/m per spring) can be set live; setting ``None``
-    makes the body follow the world's value again.
+    (N/m per spring), ``damping`` (N*s/m per spring) and the body-contact ``friction`` /
+    ``static_friction`` can be set live; setting ``None`` makes the body follow the world's
+    value again. ``collide`` and ``self_collision`` switch its contacts with other bodies
+    and with itself.
 
     Examples
     --------
@@ -208,6 +220,48 @@ class Body:
                        lambda self, v: self._set_param("damping", v,
                                                        lambda x: _non_negative(x, "damping", "N*s/m")),
                        doc="Spring damping kd of every spring, N*s/m.")
+    friction = property(lambda self: self._param("friction"),
+                        lambda self, v: self._set_param("friction", v,
+                                                        lambda x: _non_negative(x, "friction", "(dimensionless)")),
+                        doc="Dynamic Coulomb coefficient against other bodies and itself; two bodies "
+                            "mix theirs as sqrt(a * b). Colliders use their own.")
+    static_friction = property(lambda self: self._param("static_friction"),
+                               lambda self, v: self._set_param(
+                                   "static_friction", v, lambda x: _non_negative(x, "static_friction",
+                                                                                 "(dimensionless)")),
+                               doc="Static Coulomb coefficient against other bodies and itself, mixed "
+                                   "as sqrt(a * b).")
+
+    @property
+    def collide(self) -> bool:
+        """Whether the body touches other bodies (both must have it on)."""
+        return self._overrides["collide"]
+
+    @collide.setter
+    def collide(self, value):
+        self._set_switch("collide", value)
+
+    @property
+    def self_collision(self) -> bool:
+        """Whether the body touches itself (a fold of its outline against another part of it)."""
+        return self._overrides["self_collision"]
+
+    @self_collision.setter
+    def self_collision(self, value):
+        self._set_switch("self_collision", value)
+
+    def _set_switch(self, name, value):
+        value = _switch(value, name)
+        world = self._check()
+        if value and name == "collide":
+            world._check_no_overlap(self)
+        self._overrides[name] = value
+        world._apply_body_parameters(self._index)
+
+    @property
+    def contact_thickness(self) -> float:
+        """The contact thickness this body uses, metres (the world's, or its automatic value)."""
+        return self._check()._body_thickness(self)
 
     def __repr__(self) -> str:
         if self._world is None:
@@ -238,7 +292,7 @@ class Grab:
 class _StepInputs:
     """What the integrator reads besides the model and the state (see integrators.StepInputs)."""
 
-    __slots__ = ("gravity", "rects", "grab_slot", "grab_pull", "max_speed")
+    __slots__ = ("gravity", "rects", "hits", "grab_slot", "grab_pull", "max_speed", "contact_scratch", "contacts")
 
 
 class World:
@@ -267,6 +321,11 @@ class World:
         check only for NaN/inf).
     integrator : str, optional
         Time integrator by name; see ``deforma.physics.available_integrators()``.
+    contact_thickness : float or None, optional
+        How far apart touching bodies stay, metres (> 0, below every colliding body's
+        shortest boundary edge). ``None`` (default): each body uses 5% of its median
+        boundary edge (``body.contact_thickness``), which keeps bodies of any size visibly
+        touching. Contacts are explained in ``docs/physics.md``.
 
     Every parameter is also a settable attribute, validated the same way, and takes effect
     at the next step (bodies and colliders that do not override it follow the world).
@@ -286,7 +345,7 @@ class World:
 
     def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps=1, mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
-                 integrator="symplectic-euler"):
+                 integrator="symplectic-euler", contact_thickness=None):
         self._inputs = _StepInputs()
         self._bodies: list[Body] = []
         self._colliders: list[Rect] = []
@@ -295,6 +354,9 @@ class World:
         self._grabs_dirty = True
         self._model = Model([], masses=[], stiffness=[], damping=[])
         self._state = State.empty()
+        self._contact_thickness = None
+        self._contact_failsafe = 0
+        self._make_contact_scratch()
         self.time = 0.0
         self.step_count = 0
         self.gravity = gravity
@@ -308,6 +370,7 @@ class World:
         self.grab_strength = grab_strength
         self.max_speed = max_speed
         self.integrator = integrator
+        self.contact_thickness = contact_thickness
 
     # -- parameters -------------------------------------------------------------------------
     @property
@@ -345,10 +408,9 @@ class World:
 
         def set_(self, value):
             setattr(self, "_" + name, check(value, name, unit))
-            if name in ("mass", "stiffness", "damping"):
-                for b in range(len(self._bodies)):
-                    self._apply_body_parameters(b)
-            else:
+            for b in range(len(self._bodies)):  # bodies that follow the world (friction: body contacts)
+                self._apply_body_parameters(b)
+            if name in ("friction", "static_friction"):
                 self._packed_colliders = None
         return property(get, set_, doc=f"World default {name} ({unit}).")
 
@@ -384,6 +446,43 @@ class World:
         self._inputs.max_speed = v
 
     @property
+    def contact_thickness(self) -> float | None:
+        """Contact thickness in metres, or ``None`` for each body's automatic value."""
+        return self._contact_thickness
+
+    @contact_thickness.setter
+    def contact_thickness(self, value):
+        if value is None:
+            self._contact_thickness = None
+        else:
+            t = _positive(value, "contact_thickness", "m")
+            for body in self._bodies:
+                self._check_thickness(body, t)
+            self._contact_thickness = t
+        for b in range(len(self._bodies)):
+            self._apply_body_parameters(b)
+
+    def _check_thickness(self, body, t) -> None:
+        lengths = body.topology.boundary_edge_lengths
+        if not len(lengths) or not (body._overrides["collide"] or body._overrides["self_collision"]):
+            return
+        shortest = float(lengths.min())
+        if t >= shortest:
+            which = f"body {body._index}" if body._world is self and body in self._bodies else "the new body"
+            raise ValueError(
+                f"contact_thickness {t:g} m is not below the shortest boundary edge of {which} ({shortest:.3g} m): "
+                f"touching bodies would hover apart by more than their own mesh spacing; use a value below "
+                f"{shortest:.3g} m (it is in metres) or None for 5% of each body's median boundary edge")
+
+    def _body_thickness(self, body) -> float:
+        if self._contact_thickness is not None:
+            return self._contact_thickness
+        lengths = body.topology.boundary_edge_lengths
+        if not len(lengths):
+            return 0.0
+        return float(min(AUTO_THICKNESS * np.median(lengths), 0.5 * lengths.min()))
+
+    @property
     def integrator(self) -> str:
         """Name of the time integrator."""
         return self._integrator.name
@@ -398,7 +497,8 @@ class World:
         """The bodies, in the order added (a new list; use add_body / remove_body to change)."""
         return list(self._bodies)
 
-    def add_body(self, mesh, *, position=None, mass=None, stiffness=None, damping=None) -> Body:
+    def add_body(self, mesh, *, position=None, mass=None, stiffness=None, damping=None, collide=True,
+                 self_collision=True, friction=None, static_friction=None) -> Body:
         """Make a soft body from a mesh: a mass per vertex, a spring per unique edge.
 
         Parameters
@@ -410,10 +510,25 @@ class World:
             Where the mesh's bounding-box centre goes, metres; ``None`` keeps its coordinates.
         mass, stiffness, damping : float, optional
             Total mass (kg), spring constant (N/m) and damping (N*s/m); ``None`` follows the world.
+        collide : bool, optional
+            Touch other bodies (default). Off, the body passes through every other body.
+        self_collision : bool, optional
+            Touch itself (default): its outline cannot fold through itself. Off, it saves
+            the self-contact tests of its boundary (about a tenth of a plain step for a body
+            alone; see ``docs/benchmarks.md``).
+        friction, static_friction : float, optional
+            Coulomb coefficients against other bodies and itself (>= 0); ``None`` follows the
+            world's. Two bodies use ``sqrt(a * b)`` of theirs; colliders use their own.
 
         Returns
         -------
         Body
+
+        Raises
+        ------
+        ValueError
+            Bad values, or a colliding body placed where it overlaps another colliding body
+            (their outlines cross or one lies inside the other): bodies must start apart.
 
         Examples
         --------
@@ -436,8 +551,17 @@ class World:
             "mass": None if mass is None else _positive(mass, "mass", "kg"),
             "stiffness": None if stiffness is None else _non_negative(stiffness, "stiffness", "N/m"),
             "damping": None if damping is None else _non_negative(damping, "damping", "N*s/m"),
+            "friction": None if friction is None else _non_negative(friction, "friction", "(dimensionless)"),
+            "static_friction": None if static_friction is None
+            else _non_negative(static_friction, "static_friction", "(dimensionless)"),
+            "collide": _switch(collide, "collide"),
+            "self_collision": _switch(self_collision, "self_collision"),
         }
         body = Body(self, len(self._bodies), mesh, topo, overrides)
+        if self._contact_thickness is not None:
+            self._check_thickness(body, self._contact_thickness)
+        if overrides["collide"]:
+            self._check_no_overlap(body, topo.rest_positions)
         xs = [self._state.x, topo.rest_positions]
         vs = [self._state.v, np.zeros_like(topo.rest_positions)]
         self._bodies.append(body)
@@ -475,13 +599,69 @@ class World:
         tops = [b.topology for b in self._bodies]
         self._model = Model(tops, masses=[b.mass for b in self._bodies],
                             stiffness=[b.stiffness for b in self._bodies],
-                            damping=[b.damping for b in self._bodies])
+                            damping=[b.damping for b in self._bodies],
+                            contact=[self._contact_parameters(b) for b in self._bodies])
         self._state = State(x, v, self._model.body_vertex_offsets)
         self._grabs_dirty = True
+        self._make_contact_scratch()
+
+    def _make_contact_scratch(self):
+        c = self._model.contact
+        self._inputs.contact_scratch = _contacts.make_scratch(len(c.cv_vertex), len(c.ce_a))
+        self._inputs.contacts = _contacts.make_buffer(len(c.cv_vertex) + 64, 4 * len(c.cv_vertex) + 64)
+        self._inputs.hits = make_hits(self._model.n_vertices)
+
+    def _contact_parameters(self, body) -> dict:
+        o = body._overrides
+        return dict(collide=o["collide"], self_collision=o["self_collision"], friction=body.friction,
+                    static_friction=body.static_friction, thickness=self._body_thickness(body))
 
     def _apply_body_parameters(self, b: int) -> None:
         body = self._bodies[b]
         self._model.set_body_parameters(b, mass=body.mass, stiffness=body.stiffness, damping=body.damping)
+        self._model.set_contact_parameters(b, **self._contact_parameters(body))
+
+    def _check_no_overlap(self, body, x=None) -> None:
+        """Refuse a colliding body that overlaps another colliding body (bodies must start apart)."""
+        topo = body.topology
+        if not len(topo.boundary_edges):
+            return
+        if x is None:
+            x = body.positions
+        for other in self._bodies:
+            if other is body or not other._overrides["collide"] or not len(other.topology.boundary_edges):
+                continue
+            if _contacts.outlines_overlap(x, topo.boundary_edges, other.positions, other.topology.boundary_edges):
+                which = f"body {body._index}" if body in self._bodies else f"the new body ({len(self._bodies)})"
+                raise ValueError(
+                    f"{which} would overlap body {other._index} (their outlines cross or one lies inside the "
+                    f"other): colliding bodies must start apart; move it, or give it collide=False")
+
+    @property
+    def contacts(self) -> "_contacts.Contacts":
+        """The contacts of the last substep: with colliders, other bodies and itself.
+
+        A struct of arrays (see :class:`~deforma.physics.contacts.Contacts`); collider
+        contacts have ``collider >= 0``, body contacts ``collider == -1`` and an ``edge``.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> _ = w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0.0))
+        >>> box = deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2, edges=True)
+        >>> a = w.add_body(box, position=(0, 0.52))
+        >>> b = w.add_body(box, position=(0, 1.6))
+        >>> for _ in range(600):
+        ...     w.step()
+        >>> c = w.contacts
+        >>> sorted(set(c.collider.tolist())), bool((c.normal[c.collider == -1, 1] > 0.99).any())
+        ([-1, 0], True)
+        """
+        if self._packed_colliders is None or self._packed_colliders != self._colliders:
+            self._pack_colliders()
+        return _contacts.snapshot(self._model.contact, self._inputs.contact_scratch, self._inputs.contacts,
+                                  self._inputs.hits, self._inputs.rects)
 
     # -- colliders --------------------------------------------------------------------------
     @property
@@ -658,8 +838,19 @@ class World:
         if self._grabs_dirty:
             self._rebuild_grabs()
         if self._model.n_vertices:
-            bad = self._integrator.advance(self._model, self._state, self._inputs,
-                                           self._dt / self._substeps, self._substeps)
+            status = self._inputs.contact_scratch.status
+            while True:
+                status[_contacts.ST_NEEDED] = status[_contacts.ST_PAIRS_NEEDED] = 0
+                bad = self._integrator.advance(self._model, self._state, self._inputs,
+                                               self._dt / self._substeps, self._substeps)
+                need_c, need_p = int(status[_contacts.ST_NEEDED]), int(status[_contacts.ST_PAIRS_NEEDED])
+                if not (need_c or need_p):
+                    break
+                # the contact buffer was too small: grow it and run the step again from its start
+                self._state.restore()
+                buf = self._inputs.contacts
+                self._inputs.contacts = _contacts.make_buffer(max(2 * need_c, len(buf.vertex)),
+                                                              max(2 * need_p, len(buf.pair_vertex)))
             if bad:
                 self._fail()
         self.time += self._dt

@@ -39,12 +39,13 @@ import numpy as np
 from numba import njit
 
 from .colliders import finish_position_step
+from .contacts import ST_STAMP, contact_stage, gather_start
 from .integrators import register_integrator
 
 
 @njit(cache=True)
 def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, spring_j, rest, ks, kd,
-                  gx, gy, grab_slot, grab_pull, rects, h, substeps, iterations, vmax2):
+                  gx, gy, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
     """``substeps`` XPBD substeps of ``h`` s with ``iterations`` Gauss-Seidel sweeps each.
 
     Parameters
@@ -71,6 +72,10 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
         ``(S, S tx, S ty)`` per grab entry (N/m, N).
     rects : (R, RECT_COLUMNS) float64
         Packed colliders.
+    hits : ColliderHits
+        Collider contacts, per vertex.
+    ctopo, cscr, cbuf : namedtuples
+        The contact stage's topology, scratch and buffer (:mod:`deforma.physics.contacts`).
     h : float
         Substep (s).
     substeps, iterations : int
@@ -87,11 +92,14 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
     Examples
     --------
     >>> import numpy as np
+    >>> from deforma.physics.contacts import empty_topology, make_buffer, make_scratch
+    >>> from deforma.physics.colliders import make_hits
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
     >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
     ...                     np.zeros(1), 0.0, 0.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
-    ...                     np.zeros((0, 13)), 0.01, 1, 1, 1e6)
+    ...                     np.zeros((0, 13)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
+    ...                     0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
     1.0
     """
@@ -142,9 +150,12 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
                 x[i, 1] -= wi * ny * dlam
                 x[j, 0] += wj * nx * dlam
                 x[j, 1] += wj * ny * dlam
-        bad = finish_position_step(x, v, x_prev, rects, h, vmax2)
+        bad = finish_position_step(x, v, x_prev, rects, hits, cscr.status[ST_STAMP] + 1, h, vmax2)
         if bad:
             return bad
+        gather_start(x_prev, ctopo, cscr)
+        if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
+            return 0  # the contact buffer is too small; the world grows it and repeats the step
     return 0
 
 
@@ -188,5 +199,6 @@ class XPBD:
         return xpbd_substeps(state.x, state.v, state.x_start, state.v_start, self._x_prev, self._lam,
                              model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              model.spring_stiffness, model.spring_damping, float(gx), float(gy),
-                             inputs.grab_slot, inputs.grab_pull, inputs.rects, float(h), int(substeps),
+                             inputs.grab_slot, inputs.grab_pull, inputs.rects, inputs.hits, model.contact,
+                             inputs.contact_scratch, inputs.contacts, float(h), int(substeps),
                              int(self.iterations), float(inputs.max_speed) ** 2)

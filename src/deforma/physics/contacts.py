@@ -1,0 +1,934 @@
+"""Body-body and self contacts: collide (broad + narrow phase), then solve, then make sure.
+
+Every body with triangles has an *outline*: the mesh edges used by one triangle, directed so
+that the body is on their left (outer outlines counter-clockwise, holes clockwise). Its
+vertices are the *collision vertices*. A contact is a collision vertex ``p`` against an
+outline edge ``(a, b)`` of another body, or of its own body (self contact) if ``p`` is not
+one of its ends. The stage runs once per substep, after the integrator has moved every
+vertex from ``x_prev`` to ``x``; the motion in between is taken as a straight line.
+
+1. **Broad phase.** The swept box of every outline edge (its ends at both times, grown by
+   a margin, the largest contact thickness) goes into a uniform grid hashed into a table
+   twice as long as there are edges, with cells about the mean box size. Each collision
+   vertex looks up the cells its own swept box, grown by its thickness, covers; a pair is
+   listed once, in the cell of the low corner of the two boxes' overlap. Rebuilt every
+   substep: linear in the number of outline vertices, and nothing can go stale.
+2. **Narrow phase.** ``d`` is the signed distance of ``p`` from the edge's line (positive in
+   front, outside the edge's body) and ``s`` where its foot lies on the edge (0 at ``a``,
+   1 at ``b``), at the start (``d0``) and end (``d1``, ``s1``) of the substep. The side
+   ``p`` starts on is the exact sign of ``d0``. A pair is a contact if ``p`` started in
+   front and ended closer than the contact thickness with its foot on the segment
+   (``PROXIMITY``), or if its straight-line motion crossed the segment itself
+   (``CROSSING``: continuous collision detection; the time at which ``p`` and the moving
+   edge are collinear is a root of a quadratic, found by bisection on its sign change, and
+   ``s`` at that time must lie in [0, 1]). A vertex that started behind an edge of another
+   body is inside that body (only an overlap set up by hand does that) and may leave. A
+   vertex behind an edge of its own body lies across a part of that body and must stay
+   there, so self pairs are watched from both sides.
+3. **Solve** (Gauss-Seidel over the contacts). Velocities first, once: the relative
+   velocity ``v_p - (1 - s) v_a - s v_b`` loses its inward normal part and gets Coulomb
+   friction (:func:`deforma.physics.friction.coulomb`, the rule colliders use), through one
+   impulse split by inverse mass (``w_p``, ``(1 - s) w_a``, ``s w_b``), so that linear
+   momentum is kept exactly; every vertex also moves by ``h`` times its velocity change, so
+   that a stuck vertex does not creep (the collider response's rule). Then positions, in
+   ``CONTACT_ITERATIONS`` sweeps: a vertex closer than its target is pushed out to it, split
+   by inverse mass the same way (positions only: no velocity, no momentum). A proximity
+   contact's target is the thickness. A crossing goes back to the distance it started at,
+   at most the thickness (and a hair off the line): every pair had its start distance at
+   once, so these targets never contradict each other, while two corners that meet level
+   cannot both be a thickness in front of the other's edge.
+4. **Verify.** Crossings are looked for again among the first pass's candidate pairs, but
+   only those with a vertex the response moved (a pair it left alone keeps its first
+   answer); a vertex moved further than the margin rebuilds the grid first. Crossings
+   found are solved together with those of earlier rounds (two that hold each other
+   converge only together), up to ``VERIFY_ROUNDS`` times. Then a fail-safe makes the
+   result crossing-free for sure: *impact zones* (Bridson, Fedkiw and Anderson 2002, with
+   translations only). The vertices of each remaining crossing merge into a zone that
+   moves as one rigid translation from its start positions at its mass-weighted mean
+   velocity (linear momentum kept); zones grow until no crossing is left. The start of the
+   substep had none and a translated zone keeps its members' relative positions, so this
+   ends, at worst with every collision vertex in one zone. A zone that the translation
+   would push into a collider stays where it started. It is needed where the response
+   cannot converge, e.g. a vertex at the tip of an outline crushed into a hairpin, which
+   would have to be in front of both faces at once.
+
+What is guaranteed: at the end of every substep no outline crosses another or itself, if
+none did at its start. An interior vertex can still leave its own body through inverted
+triangles (the springs model lets a mesh fold; see ``docs/physics.md``).
+
+The contact thickness keeps resting bodies a hair apart, so resting contact is found by the
+cheap proximity test and the crossing test is the exception.
+
+Everything here is a pure kernel over arrays; :class:`ContactTopology`,
+:class:`ContactScratch` and :class:`ContactBuffer` are namedtuples of arrays that
+:class:`~deforma.physics.model.Model`, the world and the integrators own. Units: m, m/s, kg.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from .colliders import (RECT_FRICTION, RECT_STATIC_FRICTION, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, _inside,
+                        collide_point, record_hit)
+from .friction import coulomb, mix
+
+# Bits of ContactTopology.body_flags.
+COLLIDE = 1          # touches other bodies
+SELF_COLLIDE = 2     # touches itself
+
+CONTACT_ITERATIONS = 2   # position sweeps over the contacts per substep
+VERIFY_ROUNDS = 3        # crossing checks (and re-solves) before the fail-safe
+SIDE_MARGIN = 1e-3       # a crossing is put back at least this fraction of the thickness off the line
+
+# Contact kinds in ContactBuffer.kind.
+PROXIMITY = 1
+CROSSING = 2
+
+# Slots of ContactScratch.status.
+ST_CONTACTS = 0      # contacts found by the first narrow phase of the last substep
+ST_NEEDED = 1        # > 0: the buffer's contact arrays were too small, this many are needed
+ST_PAIRS_NEEDED = 2  # > 0: ... its candidate pair arrays
+ST_FAILSAFE = 3      # substeps that needed the impact-zone fail-safe (cumulative)
+ST_STAMP = 4         # substeps run through the stage (cumulative)
+ST_PAIRS = 5         # candidate pairs of the last substep
+
+ContactTopology = namedtuple("ContactTopology", [
+    "cv_vertex",        # (V,) int32: global vertex index of each collision vertex
+    "cv_body",          # (V,) int32: its body
+    "ce_a", "ce_b",     # (Ec,) int32: outline edge ends, as collision-vertex indices
+    "ce_body",          # (Ec,) int32: the edge's body
+    "thick_other",      # (V,) float64: contact thickness against other bodies (m)
+    "thick_self",       # (V,) float64: ... against its own body (m)
+    "body_flags",       # (B,) int32: COLLIDE | SELF_COLLIDE
+    "body_friction",    # (B, 2) float64: dynamic, static coefficient for body contacts
+    "margin",           # (1,) float64: growth of the edge boxes (m), the largest thickness
+])
+
+ContactScratch = namedtuple("ContactScratch", [
+    "xp",               # (V, 2): collision vertices at the start of the substep
+    "xq",               # (V, 2): ... when the grid was built
+    "xs",               # (V, 2): ... when crossings were last checked
+    "moved",            # (V,) uint8: moved since then
+    "ebox",             # (Ec, 4) float64: edge boxes xmin, ymin, xmax, ymax as in the grid
+    "ecell",            # (Ec, 4) int64: the cells they cover, ix0, iy0, ix1, iy1
+    "cell_start",       # (T + 1,) int64: bucket starts (T a power of two)
+    "cell_fill",        # (T,) int64: fill cursors
+    "cell_items",       # (I,) int32: edge indices by bucket
+    "grid",             # (3,) float64: origin x, origin y, 1 / cell size
+    "parent",           # (V,) int32: impact zones (union-find)
+    "zone",             # (V, 5) float64: zone sums m vx, m vy, m, members, still
+    "status",           # (6,) int64: see ST_*
+])
+
+ContactBuffer = namedtuple("ContactBuffer", [
+    "vertex", "edge",   # (C,) int32: collision vertex, outline edge
+    "s",                # (C,): position along the edge, 0 at ce_a, 1 at ce_b
+    "normal",           # (C, 2): unit normal toward the side the vertex must stay on
+    "depth",            # (C,): how far (m) the vertex was from its target at detection
+    "target",           # (C,): distance (m) from the edge's line that the response restores
+    "mu",               # (C, 2): dynamic, static friction
+    "kind",             # (C,) int8: PROXIMITY or CROSSING
+    "pair_vertex",      # (P,) int32: candidate pairs of the first narrow phase
+    "pair_edge",        # (P,) int32
+])
+
+
+def empty_topology(n_bodies: int = 0) -> ContactTopology:
+    """A topology without collision vertices (no body collides)."""
+    i32, f64 = np.zeros(0, np.int32), np.zeros(0)
+    return ContactTopology(i32, i32, i32, i32, i32, f64, f64, np.zeros(n_bodies, np.int32), np.zeros((n_bodies, 2)),
+                           np.zeros(1))
+
+
+def make_scratch(n_vertices: int, n_edges: int) -> ContactScratch:
+    """Scratch arrays for ``n_vertices`` collision vertices and ``n_edges`` outline edges."""
+    t = 16
+    while t < 2 * n_edges:
+        t *= 2
+    v = n_vertices
+    return ContactScratch(np.zeros((v, 2)), np.zeros((v, 2)), np.zeros((v, 2)), np.zeros(v, np.uint8),
+                          np.zeros((n_edges, 4)), np.zeros((n_edges, 4), np.int64), np.zeros(t + 1, np.int64),
+                          np.zeros(t, np.int64), np.zeros(16 * n_edges + 64, np.int32), np.zeros(3),
+                          np.zeros(v, np.int32), np.zeros((v, 5)), np.zeros(6, np.int64))
+
+
+def make_buffer(contacts: int, pairs: int) -> ContactBuffer:
+    """Room for ``contacts`` contacts and ``pairs`` candidate pairs."""
+    c = max(int(contacts), 16)
+    p = max(int(pairs), 16)
+    return ContactBuffer(np.zeros(c, np.int32), np.zeros(c, np.int32), np.zeros(c), np.zeros((c, 2)), np.zeros(c),
+                         np.zeros(c), np.zeros((c, 2)), np.zeros(c, np.int8), np.zeros(p, np.int32),
+                         np.zeros(p, np.int32))
+
+
+# -- broad phase -------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _bucket(ix, iy, mask):
+    return ((ix * np.int64(73856093)) ^ (iy * np.int64(19349663))) & mask
+
+
+@njit(cache=True)
+def build_grid(x, topo, scr, margin):
+    """Hash the swept box of every active outline edge (grown by ``margin`` m) into the grid.
+
+    The swept box spans the edge's ends at the start (``scr.xp``) and now (``x``). Returns
+    the number of edges in the grid.
+    """
+    ce_a, ce_b, cv = topo.ce_a, topo.ce_b, topo.cv_vertex
+    flags = topo.body_flags
+    xp, ebox, ecell = scr.xp, scr.ebox, scr.ecell
+    n_edges = ce_a.shape[0]
+    active = 0
+    extent = 0.0
+    ox = np.inf
+    oy = np.inf
+    for j in range(n_edges):
+        if flags[topo.ce_body[j]] == 0:
+            ebox[j, 0] = np.inf  # never overlaps anything
+            continue
+        a = ce_a[j]
+        b = ce_b[j]
+        ia = cv[a]
+        ib = cv[b]
+        x0 = min(min(xp[a, 0], xp[b, 0]), min(x[ia, 0], x[ib, 0])) - margin
+        x1 = max(max(xp[a, 0], xp[b, 0]), max(x[ia, 0], x[ib, 0])) + margin
+        y0 = min(min(xp[a, 1], xp[b, 1]), min(x[ia, 1], x[ib, 1])) - margin
+        y1 = max(max(xp[a, 1], xp[b, 1]), max(x[ia, 1], x[ib, 1])) + margin
+        ebox[j, 0] = x0
+        ebox[j, 1] = y0
+        ebox[j, 2] = x1
+        ebox[j, 3] = y1
+        extent += max(x1 - x0, y1 - y0)
+        ox = min(ox, x0)
+        oy = min(oy, y0)
+        active += 1
+    if active == 0:
+        return 0
+    cell = extent / active
+    if not cell > 0.0:
+        cell = 1.0
+    t = scr.cell_fill.shape[0]
+    mask = np.int64(t - 1)
+    start, fill, items = scr.cell_start, scr.cell_fill, scr.cell_items
+    while True:  # a few fast edges can cover many small cells: coarsen until the items fit
+        inv = 1.0 / cell
+        total = 0
+        for j in range(n_edges):
+            if ebox[j, 0] == np.inf:
+                continue
+            ecell[j, 0] = np.int64((ebox[j, 0] - ox) * inv)  # >= 0: truncation is floor
+            ecell[j, 1] = np.int64((ebox[j, 1] - oy) * inv)
+            ecell[j, 2] = np.int64((ebox[j, 2] - ox) * inv)
+            ecell[j, 3] = np.int64((ebox[j, 3] - oy) * inv)
+            total += (ecell[j, 2] - ecell[j, 0] + 1) * (ecell[j, 3] - ecell[j, 1] + 1)
+        if total <= items.shape[0]:
+            break
+        cell *= 2.0
+    start[:] = 0
+    for j in range(n_edges):
+        if ebox[j, 0] == np.inf:
+            continue
+        for ix in range(ecell[j, 0], ecell[j, 2] + 1):
+            for iy in range(ecell[j, 1], ecell[j, 3] + 1):
+                start[_bucket(ix, iy, mask) + 1] += 1
+    for k in range(t):
+        start[k + 1] += start[k]
+        fill[k] = start[k]
+    for j in range(n_edges):  # edge by edge: an edge's entries in one bucket are adjacent
+        if ebox[j, 0] == np.inf:
+            continue
+        for ix in range(ecell[j, 0], ecell[j, 2] + 1):
+            for iy in range(ecell[j, 1], ecell[j, 3] + 1):
+                bk = _bucket(ix, iy, mask)
+                items[fill[bk]] = j
+                fill[bk] += 1
+    scr.grid[0] = ox
+    scr.grid[1] = oy
+    scr.grid[2] = inv
+    for k in range(topo.cv_vertex.shape[0]):
+        scr.xq[k, 0] = x[cv[k], 0]
+        scr.xq[k, 1] = x[cv[k], 1]
+    return active
+
+
+# -- narrow phase ------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _cross_at(t, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey):
+    qx = q0x + t * dqx
+    qy = q0y + t * dqy
+    ex = e0x + t * dex
+    ey = e0y + t * dey
+    return qx * ey - qy * ex
+
+
+@njit(cache=True)
+def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thickness, two_sided):
+    """Contact of a point moving ``p0 -> p1`` with an edge moving ``(a0, b0) -> (a1, b1)``.
+
+    The edge's body lies on its left; ``d`` is the point's signed distance from the edge's
+    line, positive in front. The side the point starts on is the exact sign of ``d0``.
+    Returns ``(kind, s, nx, ny, depth, target)``: ``kind`` is 0 (no contact),
+    ``PROXIMITY`` (started in front, ended within ``thickness`` m in front of the segment)
+    or ``CROSSING`` (crossed the segment: from the front, or with ``two_sided`` from
+    behind); ``s`` the foot's position along the edge; ``(nx, ny)`` the unit normal toward
+    the side the point must stay on; ``target`` the distance from the line along it that
+    the response restores, and ``depth`` how far the point is from it.
+
+    Examples
+    --------
+    The edge runs from (1, 0) to (0, 0), so its body lies below it:
+
+    >>> k, s, nx, ny, depth, target = pair_contact(0.5, 1, 0.5, -0.5, 1, 0, 1, 0, 0, 0, 0, 0, 0.01, False)
+    >>> k == CROSSING, s, (nx, ny), depth, target     # fell through the edge from above
+    (True, 0.5, (0.0, 1.0), 0.51, 0.01)
+    >>> pair_contact(0.5, 0.1, 0.5, 0.005, 1, 0, 1, 0, 0, 0, 0, 0, 0.01, False)[0] == PROXIMITY
+    True
+    >>> pair_contact(0.5, -0.1, 0.5, 0.2, 1, 0, 1, 0, 0, 0, 0, 0, 0.01, False)[0]  # left the body
+    0
+    """
+    e0x = b0x - a0x
+    e0y = b0y - a0y
+    l0 = e0x * e0x + e0y * e0y
+    e1x = b1x - a1x
+    e1y = b1y - a1y
+    l1 = e1x * e1x + e1y * e1y
+    if l0 <= 0.0 or l1 <= 0.0:
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0
+    q0x = p0x - a0x
+    q0y = p0y - a0y
+    f0 = q0x * e0y - q0y * e0x          # d0 * |e0|
+    front = f0 >= 0.0
+    if not front and not two_sided:
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # inside another body: leaving it is no crossing
+    q1x = p1x - a1x
+    q1y = p1y - a1y
+    f1 = q1x * e1y - q1y * e1x          # d1 * |e1|
+    if front and f1 >= 0.0:
+        if f1 * f1 >= thickness * thickness * l1:
+            return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # clear in front: the common case, no root taken
+        s1 = (q1x * e1x + q1y * e1y) / l1
+        if 0.0 <= s1 <= 1.0:
+            r1 = math.sqrt(l1)
+            return PROXIMITY, s1, e1y / r1, -e1x / r1, thickness - f1 / r1, thickness
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0
+    if not front and f1 < 0.0:
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # stayed behind
+    # the point changed sides of the line: did it cross the segment itself?
+    dqx = q1x - q0x
+    dqy = q1y - q0y
+    dex = e1x - e0x
+    dey = e1y - e0y
+    lo = 0.0
+    hi = 1.0
+    for _ in range(48):  # f(lo), f(hi) on either side of 0: one sign change of a quadratic in [0, 1]
+        mid = 0.5 * (lo + hi)
+        if (_cross_at(mid, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey) >= 0.0) == front:
+            lo = mid
+        else:
+            hi = mid
+    qx = q0x + hi * dqx
+    qy = q0y + hi * dqy
+    ex = e0x + hi * dex
+    ey = e0y + hi * dey
+    lt = ex * ex + ey * ey
+    if lt <= 0.0:
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0
+    s = (qx * ex + qy * ey) / lt
+    if s < 0.0 or s > 1.0:
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # passed the line beyond the segment's ends
+    r1 = math.sqrt(l1)
+    d1 = f1 / r1
+    nx = e1y / r1
+    ny = -e1x / r1
+    # Back to the distance it started at, at most the thickness, and a hair off the line so
+    # that the side is unambiguous: every pair had its start distance at once, so these
+    # targets never contradict each other.
+    d0 = f0 / math.sqrt(l0)
+    if front:
+        target = max(min(thickness, d0), SIDE_MARGIN * thickness)
+        return CROSSING, s, nx, ny, target - d1, target
+    target = max(-d0, SIDE_MARGIN * thickness)
+    return CROSSING, s, -nx, -ny, target + d1, target
+
+
+# The kernels below take the namedtuples once per call and unpack them: a compiled
+# helper called per pair with a namedtuple of arrays pays reference counting for every array
+# in it (measured: 11 ms instead of 0.4 ms for one narrow phase of a 14-body pile).
+
+@njit(cache=True)
+def narrow_phase(x, topo, scr, out):
+    """List the candidate pairs: a collision vertex and an outline edge whose boxes overlap.
+
+    The vertex's swept box is grown by its contact thickness; pairs the flags or the outline
+    rule exclude are left out. Writes ``out.pair_vertex`` / ``out.pair_edge``; returns their
+    number, or ``-(needed)`` if they did not fit.
+    """
+    cv, body, flags = topo.cv_vertex, topo.cv_body, topo.body_flags
+    ce_a, ce_b, ce_body = topo.ce_a, topo.ce_b, topo.ce_body
+    thick_other, thick_self = topo.thick_other, topo.thick_self
+    xp, ebox, ecell = scr.xp, scr.ebox, scr.ecell
+    start, items = scr.cell_start, scr.cell_items
+    pair_vertex, pair_edge = out.pair_vertex, out.pair_edge
+    ox, oy, inv = scr.grid[0], scr.grid[1], scr.grid[2]
+    mask = np.int64(scr.cell_fill.shape[0] - 1)
+    pcap = pair_vertex.shape[0]
+    n = 0
+    for k in range(cv.shape[0]):
+        bk = body[k]
+        fk = flags[bk]
+        if fk == 0:
+            continue
+        i = cv[k]
+        grow = max(thick_other[k], thick_self[k])
+        bx0 = min(xp[k, 0], x[i, 0]) - grow
+        bx1 = max(xp[k, 0], x[i, 0]) + grow
+        by0 = min(xp[k, 1], x[i, 1]) - grow
+        by1 = max(xp[k, 1], x[i, 1]) + grow
+        ix0 = np.int64(math.floor((bx0 - ox) * inv))
+        ix1 = np.int64(math.floor((bx1 - ox) * inv))
+        iy0 = np.int64(math.floor((by0 - oy) * inv))
+        iy1 = np.int64(math.floor((by1 - oy) * inv))
+        for ix in range(ix0, ix1 + 1):
+            for iy in range(iy0, iy1 + 1):
+                bucket = _bucket(ix, iy, mask)
+                prev = -1
+                for it in range(start[bucket], start[bucket + 1]):
+                    j = items[it]
+                    if j == prev:
+                        continue
+                    prev = j
+                    if ebox[j, 0] > bx1 or ebox[j, 2] < bx0 or ebox[j, 1] > by1 or ebox[j, 3] < by0:
+                        continue
+                    # take the pair only in the cell of the overlap's low corner
+                    if max(ix0, ecell[j, 0]) != ix or max(iy0, ecell[j, 1]) != iy:
+                        continue
+                    eb = ce_body[j]
+                    if eb == bk:
+                        if (fk & SELF_COLLIDE) == 0:
+                            continue
+                        if ce_a[j] == k or ce_b[j] == k:
+                            continue
+                    elif (fk & COLLIDE) == 0 or (flags[eb] & COLLIDE) == 0:
+                        continue
+                    if n < pcap:
+                        pair_vertex[n] = k
+                        pair_edge[n] = j
+                    n += 1
+    return n if n <= pcap else -n
+
+
+@njit(cache=True)
+def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
+    """Test candidate pairs (:func:`pair_contact`) and store their contacts in ``out`` from ``first``.
+
+    Only pairs with a vertex moved since the last check are tested, unless ``every``; with
+    ``crossings_only`` only ``CROSSING`` contacts are kept. Returns the index after the last
+    contact stored, or ``-(needed)`` if they did not fit.
+    """
+    cv, body = topo.cv_vertex, topo.cv_body
+    ce_a, ce_b, ce_body = topo.ce_a, topo.ce_b, topo.ce_body
+    thick_other, thick_self = topo.thick_other, topo.thick_self
+    friction = topo.body_friction
+    xp, xs, moved = scr.xp, scr.xs, scr.moved
+    pair_vertex, pair_edge = out.pair_vertex, out.pair_edge
+    o_vertex, o_edge, o_s, o_normal, o_depth, o_target, o_mu, o_kind = \
+        out.vertex, out.edge, out.s, out.normal, out.depth, out.target, out.mu, out.kind
+    cap = o_vertex.shape[0]
+    for k in range(cv.shape[0]):
+        i = cv[k]
+        moved[k] = 1 if every or x[i, 0] != xs[k, 0] or x[i, 1] != xs[k, 1] else 0
+        xs[k, 0] = x[i, 0]
+        xs[k, 1] = x[i, 1]
+    n = first
+    for m in range(n_pairs):
+        k = pair_vertex[m]
+        j = pair_edge[m]
+        a = ce_a[j]
+        b = ce_b[j]
+        if moved[k] == 0 and moved[a] == 0 and moved[b] == 0:
+            continue  # neither moved since the last check: its answer then still holds
+        bk = body[k]
+        eb = ce_body[j]
+        own = eb == bk
+        thick = thick_self[k] if own else thick_other[k]
+        i = cv[k]
+        ia = cv[a]
+        ib = cv[b]
+        kind, s, nx, ny, depth, target = pair_contact(xp[k, 0], xp[k, 1], x[i, 0], x[i, 1], xp[a, 0], xp[a, 1],
+                                                      x[ia, 0], x[ia, 1], xp[b, 0], xp[b, 1], x[ib, 0], x[ib, 1],
+                                                      thick, own)
+        if kind == 0 or (crossings_only and kind != CROSSING):
+            continue
+        if n < cap:
+            o_vertex[n] = k
+            o_edge[n] = j
+            o_s[n] = s
+            o_normal[n, 0] = nx
+            o_normal[n, 1] = ny
+            o_depth[n] = depth
+            o_target[n] = target
+            o_mu[n, 0] = mix(friction[bk, 0], friction[eb, 0])
+            o_mu[n, 1] = mix(friction[bk, 1], friction[eb, 1])
+            o_kind[n] = kind
+        n += 1
+    return n if n <= cap else -n
+
+
+# -- response ----------------------------------------------------------------------------------
+@njit(cache=True)
+def solve_contacts(x, v, inv_mass, topo, out, first, last, h, iterations):
+    """Impulses (once) and position corrections (``iterations`` sweeps) for contacts ``first:last``.
+
+    See the module docstring; linear momentum is kept exactly, since every impulse is split
+    between the vertex and the edge's ends by inverse mass.
+    """
+    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    for sweep in range(iterations):
+        for c in range(first, last):
+            ip = cv[out.vertex[c]]
+            ia = cv[ce_a[out.edge[c]]]
+            ib = cv[ce_b[out.edge[c]]]
+            s = out.s[c]
+            ca = 1.0 - s
+            wp = inv_mass[ip]
+            wa = inv_mass[ia] * ca
+            wb = inv_mass[ib] * s
+            w = wp + wa * ca + wb * s
+            if w <= 0.0:
+                continue  # both sides pinned
+            nx = out.normal[c, 0]
+            ny = out.normal[c, 1]
+            if sweep == 0:
+                rvx = v[ip, 0] - ca * v[ia, 0] - s * v[ib, 0]
+                rvy = v[ip, 1] - ca * v[ia, 1] - s * v[ib, 1]
+                vn = rvx * nx + rvy * ny
+                if vn < 0.0:
+                    vt = ny * rvx - nx * rvy        # along t = (ny, -nx)
+                    dvt = coulomb(vt, -vn, out.mu[c, 1], out.mu[c, 0]) - vt
+                    px = (-vn * nx + dvt * ny) / w  # the pair's impulse per unit inverse mass
+                    py = (-vn * ny - dvt * nx) / w
+                    v[ip, 0] += wp * px
+                    v[ip, 1] += wp * py
+                    v[ia, 0] -= wa * px
+                    v[ia, 1] -= wa * py
+                    v[ib, 0] -= wb * px
+                    v[ib, 1] -= wb * py
+                    # the positions follow the corrected velocities (no creep while stuck)
+                    x[ip, 0] += h * wp * px
+                    x[ip, 1] += h * wp * py
+                    x[ia, 0] -= h * wa * px
+                    x[ia, 1] -= h * wa * py
+                    x[ib, 0] -= h * wb * px
+                    x[ib, 1] -= h * wb * py
+            d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
+            gap = out.target[c] - d
+            if gap > 0.0:
+                lam = gap / w
+                x[ip, 0] += wp * lam * nx
+                x[ip, 1] += wp * lam * ny
+                x[ia, 0] -= wa * lam * nx
+                x[ia, 1] -= wa * lam * ny
+                x[ib, 0] -= wb * lam * nx
+                x[ib, 1] -= wb * lam * ny
+
+
+@njit(cache=True)
+def _find(parent, k):
+    while parent[k] != k:
+        parent[k] = parent[parent[k]]
+        k = parent[k]
+    return k
+
+
+@njit(cache=True)
+def _refresh(x, topo, scr, out, margin, n_pairs):
+    """Rebuild the grid and the candidate pairs if a vertex moved further than ``margin`` since
+    the grid was built; returns ``(pairs, rebuilt)`` (pairs negative if they did not fit)."""
+    cv, xq = topo.cv_vertex, scr.xq
+    for k in range(cv.shape[0]):
+        if abs(x[cv[k], 0] - xq[k, 0]) > margin or abs(x[cv[k], 1] - xq[k, 1]) > margin:
+            build_grid(x, topo, scr, margin)
+            return narrow_phase(x, topo, scr, out), True
+    return n_pairs, False
+
+
+@njit(cache=True)
+def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
+    """The fail-safe: merge crossing pairs into rigidly translating zones until none is left.
+
+    Returns the number of merge rounds, or ``-(needed)`` if ``out`` is too small (then
+    ``scr.status`` says which part).
+    """
+    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    parent, zone, xp = scr.parent, scr.zone, scr.xp
+    margin = topo.margin[0]
+    nv = cv.shape[0]
+    for k in range(nv):
+        parent[k] = k
+    for rounds in range(nv + 1):
+        n_pairs, rebuilt = _refresh(x, topo, scr, out, margin, n_pairs)
+        if n_pairs < 0:
+            scr.status[ST_PAIRS_NEEDED] = -n_pairs
+            return n_pairs
+        n = check_pairs(x, topo, scr, out, first, n_pairs, rebuilt, True)
+        if n < 0:
+            scr.status[ST_NEEDED] = -n
+            return n
+        if n == first:
+            return rounds
+        for c in range(first, n):
+            k = _find(parent, out.vertex[c])
+            for m in (ce_a[out.edge[c]], ce_b[out.edge[c]]):
+                r = _find(parent, m)
+                if r != k:
+                    parent[r] = k
+        # zone sums: m vx, m vy, m, members, still (1: a pinned member, 2: pushed into a collider)
+        zone[:, :] = 0.0
+        for k in range(nv):
+            r = _find(parent, k)
+            i = cv[k]
+            zone[r, 3] += 1.0
+            if inv_mass[i] == 0.0:
+                zone[r, 4] = 1.0
+            else:
+                m = 1.0 / inv_mass[i]
+                zone[r, 0] += m * v[i, 0]
+                zone[r, 1] += m * v[i, 1]
+                zone[r, 2] += m
+        frozen = False
+        for k in range(nv):
+            r = _find(parent, k)
+            if zone[r, 3] < 2.0:
+                continue
+            i = cv[k]
+            vx = 0.0
+            vy = 0.0
+            if zone[r, 4] == 0.0 and zone[r, 2] > 0.0:
+                vx = zone[r, 0] / zone[r, 2]
+                vy = zone[r, 1] / zone[r, 2]
+            v[i, 0] = vx
+            v[i, 1] = vy
+            x[i, 0] = xp[k, 0] + h * vx
+            x[i, 1] = xp[k, 1] + h * vy
+            for q in range(rects.shape[0]):
+                if _inside(rects, q, x[i, 0], x[i, 1]):
+                    zone[r, 4] = 2.0
+                    frozen = True
+        if frozen:  # a zone pushed into a collider stays where it started (outside, like every start)
+            for k in range(nv):
+                r = _find(parent, k)
+                if zone[r, 3] >= 2.0 and zone[r, 4] == 2.0:
+                    i = cv[k]
+                    v[i, 0] = 0.0
+                    v[i, 1] = 0.0
+                    x[i, 0] = xp[k, 0]
+                    x[i, 1] = xp[k, 1]
+    return nv + 1
+
+
+@njit(cache=True)
+def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h):
+    """Collide, solve and verify the body contacts of one substep (see the module docstring).
+
+    Call it after the integrator has moved the vertices, with ``scr.xp`` holding the
+    collision vertices' positions at the start of the substep (:func:`gather_start`).
+    Updates ``x`` and ``v`` in place. Returns the number of contacts found, or -1 if
+    ``out`` was too small (``scr.status[ST_NEEDED]`` / ``[ST_PAIRS_NEEDED]`` then say how
+    many are needed; the substep is incomplete).
+    """
+    status = scr.status
+    status[ST_STAMP] += 1
+    status[ST_CONTACTS] = 0
+    status[ST_PAIRS] = 0
+    cv = topo.cv_vertex
+    nv = cv.shape[0]
+    if nv == 0:
+        return 0
+    margin = topo.margin[0]
+    if build_grid(x, topo, scr, margin) == 0:
+        return 0
+    n_pairs = narrow_phase(x, topo, scr, out)
+    if n_pairs < 0:
+        status[ST_PAIRS_NEEDED] = -n_pairs
+        return -1
+    n0 = check_pairs(x, topo, scr, out, 0, n_pairs, True, False)
+    if n0 < 0:
+        status[ST_NEEDED] = -n0
+        return -1
+    status[ST_CONTACTS] = n0
+    status[ST_PAIRS] = n_pairs
+    if n0 == 0:
+        return 0  # no contact and no crossing (a crossing is a contact too): nothing moved
+    solve_contacts(x, v, inv_mass, topo, out, 0, n0, h, CONTACT_ITERATIONS)
+    end, n_pairs = _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h)
+    if end < 0:
+        return -1
+    # colliders have the last word (infinite mass): put back outside any vertex the response
+    # pushed into one, then make sure that opened no crossing (a zone that would enter a
+    # collider stays where it started, outside)
+    if _collider_pass(x, v, topo, scr, rects, hits, h):
+        r = impact_zones(x, v, inv_mass, topo, scr, out, end, n_pairs, rects, h)
+        if r < 0:
+            return -1
+        if r > 0:
+            status[ST_FAILSAFE] += 1
+    return n0
+
+
+@njit(cache=True)
+def _collider_pass(x, v, topo, scr, rects, hits, h):
+    """The collider response (:func:`~deforma.physics.colliders.collide_point`) for every
+    collision vertex inside a collider; returns how many it moved."""
+    cv, xp = topo.cv_vertex, scr.xp
+    moved = 0
+    for k in range(cv.shape[0]):
+        i = cv[k]
+        px, py = x[i, 0], x[i, 1]
+        for r in range(rects.shape[0]):
+            if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX] \
+                    and _inside(rects, r, px, py):
+                x[i, 0], x[i, 1], v[i, 0], v[i, 1], hit, nx, ny, depth = collide_point(
+                    xp[k, 0], xp[k, 1], px, py, v[i, 0], v[i, 1], rects, h)
+                record_hit(hits, i, scr.status[ST_STAMP], hit, nx, ny, depth)
+                moved += 1
+                break
+    return moved
+
+
+@njit(cache=True)
+def _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h):
+    """Step 4 of the module docstring; returns the end of the contacts stored (-1 if they did
+    not fit) and the number of candidate pairs (which a rebuilt grid changes)."""
+    status = scr.status
+    margin = topo.margin[0]
+    # Crossings left after the solve are solved again, together with those of earlier rounds:
+    # two that hold each other (each corner against the other's edge) converge only together.
+    end = n0
+    for _ in range(VERIFY_ROUNDS):
+        n_pairs, rebuilt = _refresh(x, topo, scr, out, margin, n_pairs)
+        if n_pairs < 0:
+            status[ST_PAIRS_NEEDED] = -n_pairs
+            return -1, n_pairs
+        n = check_pairs(x, topo, scr, out, end, n_pairs, rebuilt, True)
+        if n < 0:
+            status[ST_NEEDED] = -n
+            return -1, n_pairs
+        if n == end:
+            return end, n_pairs
+        end = n
+        solve_contacts(x, v, inv_mass, topo, out, n0, end, h, CONTACT_ITERATIONS)
+    r = impact_zones(x, v, inv_mass, topo, scr, out, end, n_pairs, rects, h)
+    if r < 0:
+        return -1, n_pairs
+    if r > 0:
+        status[ST_FAILSAFE] += 1
+    return end, n_pairs
+
+
+@njit(cache=True)
+def gather_start(x, topo, scr):
+    """Copy the collision vertices' positions into ``scr.xp`` (call at the start of a substep)."""
+    cv = topo.cv_vertex
+    for k in range(cv.shape[0]):
+        scr.xp[k, 0] = x[cv[k], 0]
+        scr.xp[k, 1] = x[cv[k], 1]
+
+
+@njit(cache=True)
+def rest_clearance(x, edges, reach):
+    """How far each outline vertex lies in front of the nearest other outline edge, at rest.
+
+    Only edges it is not an end of count, and only with its foot on the edge.
+
+    Parameters
+    ----------
+    x : (V, 2) float64
+        Rest positions of the outline vertices (m).
+    edges : (E, 2) int32
+        Directed outline edges into ``x`` (the body on their left).
+    reach : float
+        Distances at or beyond this (m) are reported as ``inf``.
+
+    Returns
+    -------
+    (V,) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0, 0], [2, 0], [2, 1], [1.0, 1.0], [1.0, 0.1], [0.9, 1.0], [0, 1]], float)
+    >>> e = np.array([[k, (k + 1) % 7] for k in range(7)], np.int32)  # a slit from the top
+    >>> round(float(rest_clearance(x, e, 10.0)[5]), 6)   # across the slit from edge 3-4
+    0.1
+    """
+    out = np.full(x.shape[0], np.inf)
+    for p in range(x.shape[0]):
+        px, py = x[p, 0], x[p, 1]
+        for j in range(edges.shape[0]):
+            a = edges[j, 0]
+            b = edges[j, 1]
+            if a == p or b == p:
+                continue
+            ax, ay, bx, by = x[a, 0], x[a, 1], x[b, 0], x[b, 1]
+            if px < min(ax, bx) - reach or px > max(ax, bx) + reach or py < min(ay, by) - reach \
+                    or py > max(ay, by) + reach:
+                continue
+            ex = bx - ax
+            ey = by - ay
+            l2 = ex * ex + ey * ey
+            s = ((px - ax) * ex + (py - ay) * ey) / l2
+            if s < 0.0 or s > 1.0:
+                continue
+            d = ((px - ax) * ey - (py - ay) * ex) / math.sqrt(l2)
+            if 0.0 <= d < out[p]:
+                out[p] = d
+    return out
+
+
+@dataclass(frozen=True)
+class Contacts:
+    """The contacts of the last substep, as arrays (struct of arrays, one row per contact).
+
+    Collider contacts come first: the vertices the collider response put back outside a
+    collider. Then body contacts: what the contact stage found before its response (a
+    vertex against another body's outline edge, or against its own).
+
+    Attributes
+    ----------
+    vertex : (C,) int64
+        World vertex index (rows of the world's state arrays).
+    collider : (C,) int64
+        Index into ``world.colliders``, or -1 for a body contact.
+    edge : (C, 2) int64
+        World vertex indices of the boundary edge's ends, or -1 for a collider contact.
+    weight : (C,) float64
+        Where the vertex's foot lies on the edge: 0 at ``edge[:, 0]``, 1 at ``edge[:, 1]``.
+    normal : (C, 2) float64
+        Unit normal pointing from the other side toward the vertex.
+    depth : (C,) float64
+        Metres the vertex had to move at detection: to its target distance from the edge
+        (the contact thickness, see ``docs/physics.md``) for body contacts, out of the
+        collider for collider contacts.
+    friction, static_friction : (C,) float64
+        The coefficients the contact used.
+    """
+
+    vertex: np.ndarray
+    collider: np.ndarray
+    edge: np.ndarray
+    weight: np.ndarray
+    normal: np.ndarray
+    depth: np.ndarray
+    friction: np.ndarray
+    static_friction: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.vertex)
+
+    @property
+    def body_contacts(self) -> np.ndarray:
+        """(C,) bool: rows that are body (edge) contacts."""
+        return self.collider < 0
+
+
+def snapshot(topo: ContactTopology, scr: ContactScratch, buf: ContactBuffer, hits, rects) -> Contacts:
+    """The contacts of the last substep as a :class:`Contacts`, in world vertex indices.
+
+    ``hits`` is the world's ``ColliderHits`` record and ``rects`` the packed colliders (for
+    the coefficients each collider contact used).
+    """
+    n = int(scr.status[ST_CONTACTS])
+    k = buf.vertex[:n]
+    j = buf.edge[:n]
+    cv = topo.cv_vertex.astype(np.int64)
+    edge = np.stack([cv[topo.ce_a[j]], cv[topo.ce_b[j]]], axis=1) if n else np.zeros((0, 2), np.int64)
+    touched = np.flatnonzero(hits.stamp == scr.status[ST_STAMP]) if scr.status[ST_STAMP] > 0 else np.zeros(0, int)
+    col = hits.collider[touched].astype(np.int64)
+    m = len(touched)
+    return Contacts(
+        vertex=np.concatenate([touched.astype(np.int64), cv[k]]),
+        collider=np.concatenate([col, np.full(n, -1, np.int64)]),
+        edge=np.concatenate([np.full((m, 2), -1, np.int64), edge]),
+        weight=np.concatenate([np.zeros(m), buf.s[:n]]),
+        normal=np.concatenate([hits.normal[touched], buf.normal[:n]]),
+        depth=np.concatenate([hits.depth[touched], buf.depth[:n]]),
+        friction=np.concatenate([rects[col, RECT_FRICTION], buf.mu[:n, 0]]),
+        static_friction=np.concatenate([rects[col, RECT_STATIC_FRICTION], buf.mu[:n, 1]]))
+
+
+@njit(cache=True)
+def _segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
+    d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+    d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+    return ((d1 > 0.0) != (d2 > 0.0) or d1 == 0.0 or d2 == 0.0) and \
+        ((d3 > 0.0) != (d4 > 0.0) or d3 == 0.0 or d4 == 0.0) and \
+        max(ax, bx) >= min(cx, dx) and max(cx, dx) >= min(ax, bx) and \
+        max(ay, by) >= min(cy, dy) and max(cy, dy) >= min(ay, by)
+
+
+@njit(cache=True)
+def _inside_outline(px, py, x, edges):
+    inside = False  # even-odd rule: holes are outlines too
+    for j in range(edges.shape[0]):
+        ax, ay = x[edges[j, 0], 0], x[edges[j, 0], 1]
+        bx, by = x[edges[j, 1], 0], x[edges[j, 1], 1]
+        if (ay > py) != (by > py):
+            if px < ax + (py - ay) * (bx - ax) / (by - ay):
+                inside = not inside
+    return inside
+
+
+@njit(cache=True)
+def outlines_overlap(xa, ea, xb, eb):
+    """Whether two bodies overlap: an outline segment of one touches one of the other, or a
+    boundary vertex of one lies inside the other's outlines (holes excluded).
+
+    Parameters
+    ----------
+    xa, xb : (N, 2) float64
+        Vertex positions (m).
+    ea, eb : (E, 2) int32
+        Boundary edges (vertex indices).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    >>> e = np.array([[0, 1], [1, 2], [2, 3], [3, 0]], np.int32)
+    >>> outlines_overlap(sq, e, sq + 0.5, e), outlines_overlap(sq, e, sq + 1.5, e)
+    (True, False)
+    >>> outlines_overlap(sq, e, 0.25 * sq + 0.3, e)   # one inside the other
+    True
+    """
+    lo_a = np.full(2, np.inf)
+    hi_a = np.full(2, -np.inf)
+    lo_b = np.full(2, np.inf)
+    hi_b = np.full(2, -np.inf)
+    for j in range(ea.shape[0]):
+        for c in range(2):
+            lo_a[c] = min(lo_a[c], xa[ea[j, 0], c])
+            hi_a[c] = max(hi_a[c], xa[ea[j, 0], c])
+    for j in range(eb.shape[0]):
+        for c in range(2):
+            lo_b[c] = min(lo_b[c], xb[eb[j, 0], c])
+            hi_b[c] = max(hi_b[c], xb[eb[j, 0], c])
+    if lo_a[0] > hi_b[0] or lo_b[0] > hi_a[0] or lo_a[1] > hi_b[1] or lo_b[1] > hi_a[1]:
+        return False
+    for i in range(ea.shape[0]):
+        ax, ay = xa[ea[i, 0], 0], xa[ea[i, 0], 1]
+        bx, by = xa[ea[i, 1], 0], xa[ea[i, 1], 1]
+        if max(ax, bx) < lo_b[0] or min(ax, bx) > hi_b[0] or max(ay, by) < lo_b[1] or min(ay, by) > hi_b[1]:
+            continue
+        for j in range(eb.shape[0]):
+            if _segments_cross(ax, ay, bx, by, xb[eb[j, 0], 0], xb[eb[j, 0], 1], xb[eb[j, 1], 0], xb[eb[j, 1], 1]):
+                return True
+    # no outline touches: overlapping only if one lies inside the other, then all its vertices do
+    return _inside_outline(xa[ea[0, 0], 0], xa[ea[0, 0], 1], xb, eb) or \
+        _inside_outline(xb[eb[0, 0], 0], xb[eb[0, 0], 1], xa, ea)
