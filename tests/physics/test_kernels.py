@@ -74,7 +74,7 @@ def test_parallel_and_serial_steps_agree_exactly():
         chunks, verts = integrators.spring_chunks(m.spring_i, m.spring_j, 3)
         for _ in range(50):
             kernel(s.x, s.v, s.x_start, s.v_start, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
-                   m.spring_stiffness, m.spring_damping, m.vertex_inv_mass, 0.0, -9.81, inp.grab_slot,
+                   m.spring_stiffness, m.spring_damping, m.vertex_inv_mass, 0.0, -9.81, 1.0, inp.grab_slot,
                    inp.grab_pull, inp.rects, inp.hits, m.contact, inp.contact_scratch, inp.contacts, 1e-3, 2, 1e6)
         assert not fbuf.any()  # scratch left zeroed
         runs.append((s.x.copy(), s.v.copy()))

@@ -188,6 +188,49 @@ def _inside(rects, r, px, py):
     return abs(dx * ux + dy * uy) < rects[r, RECT_HX] and abs(dy * ux - dx * uy) < rects[r, RECT_HY]
 
 
+@njit(cache=True, inline="always")
+def _exit_face(rects, r, x0, y0, px, py):
+    """The face of rectangle ``r`` by which a point inside it leaves (see the module docstring).
+
+    Returns ``(nx, ny, tx, ty, s, d, depth)``: the face's outward normal and tangent, the
+    point's coordinate along the tangent and the face's distance from the centre (so the
+    point on the face is ``centre + d n + s t``), and how deep the point is inside (m).
+    """
+    cx = rects[r, RECT_CX]
+    cy = rects[r, RECT_CY]
+    ux = rects[r, RECT_UX]
+    uy = rects[r, RECT_UY]
+    hx = rects[r, RECT_HX]
+    hy = rects[r, RECT_HY]
+    a = (px - cx) * ux + (py - cy) * uy
+    b = (py - cy) * ux - (px - cx) * uy
+    a0 = (x0 - cx) * ux + (y0 - cy) * uy
+    b0 = (y0 - cy) * ux - (x0 - cx) * uy
+    came_in = a0 >= hx or a0 <= -hx or b0 >= hy or b0 <= -hy
+    # faces: 0 = +x, 1 = -x, 2 = +y, 3 = -y (local); pick the least penetration
+    face = -1
+    best = np.inf
+    if (not came_in or a0 >= hx) and hx - a < best:
+        best = hx - a
+        face = 0
+    if (not came_in or a0 <= -hx) and hx + a < best:
+        best = hx + a
+        face = 1
+    if (not came_in or b0 >= hy) and hy - b < best:
+        best = hy - b
+        face = 2
+    if (not came_in or b0 <= -hy) and hy + b < best:
+        best = hy + b
+        face = 3
+    if face == 0:
+        return ux, uy, -uy, ux, b, hx, best
+    if face == 1:
+        return -ux, -uy, -uy, ux, b, hx, best
+    if face == 2:
+        return -uy, ux, ux, uy, a, hy, best
+    return uy, -ux, ux, uy, a, hy, best
+
+
 @njit(cache=True)
 def collide_point(x0, y0, px, py, vx, vy, rects, h):
     """Resolve one point against all rectangles.
@@ -225,41 +268,7 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
             if not _inside(rects, r, px, py):
                 continue
             hit = True
-            cx = rects[r, RECT_CX]
-            cy = rects[r, RECT_CY]
-            ux = rects[r, RECT_UX]
-            uy = rects[r, RECT_UY]
-            hx = rects[r, RECT_HX]
-            hy = rects[r, RECT_HY]
-            a = (px - cx) * ux + (py - cy) * uy
-            b = (py - cy) * ux - (px - cx) * uy
-            a0 = (x0 - cx) * ux + (y0 - cy) * uy
-            b0 = (y0 - cy) * ux - (x0 - cx) * uy
-            came_in = a0 >= hx or a0 <= -hx or b0 >= hy or b0 <= -hy
-            # faces: 0 = +x, 1 = -x, 2 = +y, 3 = -y (local); pick the least penetration
-            face = -1
-            best = np.inf
-            if (not came_in or a0 >= hx) and hx - a < best:
-                best = hx - a
-                face = 0
-            if (not came_in or a0 <= -hx) and hx + a < best:
-                best = hx + a
-                face = 1
-            if (not came_in or b0 >= hy) and hy - b < best:
-                best = hy - b
-                face = 2
-            if (not came_in or b0 <= -hy) and hy + b < best:
-                best = hy + b
-                face = 3
-            # outward normal n and tangent t of that face, and the point's coordinate along t
-            if face == 0:
-                nx, ny, tx, ty, s, d = ux, uy, -uy, ux, b, hx
-            elif face == 1:
-                nx, ny, tx, ty, s, d = -ux, -uy, -uy, ux, b, hx
-            elif face == 2:
-                nx, ny, tx, ty, s, d = -uy, ux, ux, uy, a, hy
-            else:
-                nx, ny, tx, ty, s, d = uy, -ux, ux, uy, a, hy
+            nx, ny, tx, ty, s, d, best = _exit_face(rects, r, x0, y0, px, py)
             vn = vx * nx + vy * ny
             vt = vx * tx + vy * ty
             jn = 0.0
@@ -273,8 +282,8 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
             hy_n = ny
             last_depth = best
             d += rects[r, RECT_SKIN]
-            px = cx + d * nx + s * tx
-            py = cy + d * ny + s * ty
+            px = rects[r, RECT_CX] + d * nx + s * tx
+            py = rects[r, RECT_CY] + d * ny + s * ty
             vx = vn * nx + vt_new * tx
             vy = vn * ny + vt_new * ty
         if not hit:

@@ -82,6 +82,7 @@ COLLIDE = 1          # touches other bodies
 SELF_COLLIDE = 2     # touches itself
 
 CONTACT_ITERATIONS = 2   # position sweeps over the contacts per substep
+SPECULATIVE = 2.0        # proximity contacts reach this many thicknesses (see solve_contacts)
 VERIFY_ROUNDS = 3        # crossing checks (and re-solves) before the fail-safe
 SIDE_MARGIN = 1e-3       # a crossing is put back at least this fraction of the thickness off the line
 
@@ -96,10 +97,14 @@ ST_PAIRS_NEEDED = 2  # > 0: ... its candidate pair arrays
 ST_FAILSAFE = 3      # substeps that needed the impact-zone fail-safe (cumulative)
 ST_STAMP = 4         # substeps run through the stage (cumulative)
 ST_PAIRS = 5         # candidate pairs of the last substep
+ST_ACTIVE = 6        # collision vertices tested in the last substep
 
 ContactTopology = namedtuple("ContactTopology", [
-    "cv_vertex",        # (V,) int32: global vertex index of each collision vertex
+    "cv_vertex",        # (V,) int32: global vertex index of each collision vertex: the outline
+                        #   vertices of every body, then every body's other vertices
     "cv_body",          # (V,) int32: its body
+    "body_outline",     # (B + 1,) int64: body b's outline vertices are cv[body_outline[b]:...[b + 1]]
+    "body_interior",    # (B + 1,) int64: ... its other vertices cv[body_interior[b]:...[b + 1]]
     "ce_a", "ce_b",     # (Ec,) int32: outline edge ends, as collision-vertex indices
     "ce_body",          # (Ec,) int32: the edge's body
     "thick_other",      # (V,) float64: contact thickness against other bodies (m)
@@ -111,6 +116,8 @@ ContactTopology = namedtuple("ContactTopology", [
 
 ContactScratch = namedtuple("ContactScratch", [
     "xp",               # (V, 2): collision vertices at the start of the substep
+    "active",           # (V,) int32: the collision vertices tested this substep (status[ST_ACTIVE] of them)
+    "body_box",         # (B, 4) float64: each body's swept box xmin, ymin, xmax, ymax
     "xq",               # (V, 2): ... when the grid was built
     "xs",               # (V, 2): ... when crossings were last checked
     "moved",            # (V,) uint8: moved since then
@@ -122,7 +129,7 @@ ContactScratch = namedtuple("ContactScratch", [
     "grid",             # (3,) float64: origin x, origin y, 1 / cell size
     "parent",           # (V,) int32: impact zones (union-find)
     "zone",             # (V, 5) float64: zone sums m vx, m vy, m, members, still
-    "status",           # (6,) int64: see ST_*
+    "status",           # (7,) int64: see ST_*
 ])
 
 ContactBuffer = namedtuple("ContactBuffer", [
@@ -140,21 +147,22 @@ ContactBuffer = namedtuple("ContactBuffer", [
 
 def empty_topology(n_bodies: int = 0) -> ContactTopology:
     """A topology without collision vertices (no body collides)."""
-    i32, f64 = np.zeros(0, np.int32), np.zeros(0)
-    return ContactTopology(i32, i32, i32, i32, i32, f64, f64, np.zeros(n_bodies, np.int32), np.zeros((n_bodies, 2)),
-                           np.zeros(1))
+    i32, f64, offsets = np.zeros(0, np.int32), np.zeros(0), np.zeros(n_bodies + 1, np.int64)
+    return ContactTopology(i32, i32, offsets, offsets, i32, i32, i32, f64, f64, np.zeros(n_bodies, np.int32),
+                           np.zeros((n_bodies, 2)), np.zeros(1))
 
 
-def make_scratch(n_vertices: int, n_edges: int) -> ContactScratch:
-    """Scratch arrays for ``n_vertices`` collision vertices and ``n_edges`` outline edges."""
+def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScratch:
+    """Scratch arrays for ``n_vertices`` collision vertices, ``n_edges`` outline edges, ``n_bodies`` bodies."""
     t = 16
     while t < 2 * n_edges:
         t *= 2
     v = n_vertices
-    return ContactScratch(np.zeros((v, 2)), np.zeros((v, 2)), np.zeros((v, 2)), np.zeros(v, np.uint8),
+    return ContactScratch(np.zeros((v, 2)), np.zeros(v, np.int32), np.zeros((n_bodies, 4)),
+                          np.zeros((v, 2)), np.zeros((v, 2)), np.zeros(v, np.uint8),
                           np.zeros((n_edges, 4)), np.zeros((n_edges, 4), np.int64), np.zeros(t + 1, np.int64),
                           np.zeros(t, np.int64), np.zeros(16 * n_edges + 64, np.int32), np.zeros(3),
-                          np.zeros(v, np.int32), np.zeros((v, 5)), np.zeros(6, np.int64))
+                          np.zeros(v, np.int32), np.zeros((v, 5)), np.zeros(7, np.int64))
 
 
 def make_buffer(contacts: int, pairs: int) -> ContactBuffer:
@@ -250,7 +258,8 @@ def build_grid(x, topo, scr, margin):
     scr.grid[0] = ox
     scr.grid[1] = oy
     scr.grid[2] = inv
-    for k in range(topo.cv_vertex.shape[0]):
+    for m in range(scr.status[ST_ACTIVE]):
+        k = scr.active[m]
         scr.xq[k, 0] = x[cv[k], 0]
         scr.xq[k, 1] = x[cv[k], 1]
     return active
@@ -309,7 +318,8 @@ def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thi
     q1y = p1y - a1y
     f1 = q1x * e1y - q1y * e1x          # d1 * |e1|
     if front and f1 >= 0.0:
-        if f1 * f1 >= thickness * thickness * l1:
+        reach = SPECULATIVE * thickness
+        if f1 * f1 >= reach * reach * l1:
             return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # clear in front: the common case, no root taken
         s1 = (q1x * e1x + q1y * e1y) / l1
         if 0.0 <= s1 <= 1.0:
@@ -377,12 +387,15 @@ def narrow_phase(x, topo, scr, out):
     ox, oy, inv = scr.grid[0], scr.grid[1], scr.grid[2]
     mask = np.int64(scr.cell_fill.shape[0] - 1)
     pcap = pair_vertex.shape[0]
+    n_outline = topo.body_interior[0]
     n = 0
-    for k in range(cv.shape[0]):
+    for m in range(scr.status[ST_ACTIVE]):
+        k = scr.active[m]
         bk = body[k]
         fk = flags[bk]
         if fk == 0:
             continue
+        inner = k >= n_outline  # not on the outline: only other bodies' outlines concern it
         i = cv[k]
         grow = max(thick_other[k], thick_self[k])
         bx0 = min(xp[k, 0], x[i, 0]) - grow
@@ -409,7 +422,7 @@ def narrow_phase(x, topo, scr, out):
                         continue
                     eb = ce_body[j]
                     if eb == bk:
-                        if (fk & SELF_COLLIDE) == 0:
+                        if inner or (fk & SELF_COLLIDE) == 0:
                             continue
                         if ce_a[j] == k or ce_b[j] == k:
                             continue
@@ -439,7 +452,8 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
     o_vertex, o_edge, o_s, o_normal, o_depth, o_target, o_mu, o_kind = \
         out.vertex, out.edge, out.s, out.normal, out.depth, out.target, out.mu, out.kind
     cap = o_vertex.shape[0]
-    for k in range(cv.shape[0]):
+    for m in range(scr.status[ST_ACTIVE]):
+        k = scr.active[m]
         i = cv[k]
         moved[k] = 1 if every or x[i, 0] != xs[k, 0] or x[i, 1] != xs[k, 1] else 0
         xs[k, 0] = x[i, 0]
@@ -480,14 +494,38 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
 
 
 # -- response ----------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _keep_out(x, v, i, x0, y0, rects, h):
+    # a vertex that the response moved into a collider meets it there and then: the collider
+    # response (infinite mass, its velocity rule and friction), after a bounding-box test
+    px, py = x[i, 0], x[i, 1]
+    for r in range(rects.shape[0]):
+        if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
+            x[i, 0], x[i, 1], v[i, 0], v[i, 1], _, _, _, _ = collide_point(x0, y0, px, py, v[i, 0], v[i, 1],
+                                                                           rects, h)
+            return
+
+
+@njit(cache=True, inline="always")
+def _keep_out_three(x, v, xp, rects, h, ip, ia, ib, k, a, b):
+    _keep_out(x, v, ip, xp[k, 0], xp[k, 1], rects, h)
+    _keep_out(x, v, ia, xp[a, 0], xp[a, 1], rects, h)
+    _keep_out(x, v, ib, xp[b, 0], xp[b, 1], rects, h)
+
+
 @njit(cache=True)
-def solve_contacts(x, v, inv_mass, topo, out, first, last, h, iterations):
+def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterations):
     """Impulses (once) and position corrections (``iterations`` sweeps) for contacts ``first:last``.
 
     See the module docstring; linear momentum is kept exactly, since every impulse is split
-    between the vertex and the edge's ends by inverse mass.
+    between the vertex and the edge's ends by inverse mass. A vertex the response moves into a
+    collider meets it at once (:func:`~deforma.physics.colliders.collide_point`), so that the
+    sweeps settle with the colliders in place.
     """
     cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    xp = scr.xp
+    check_rects = rects.shape[0] > 0
+    inv_h = 1.0 / h
     for sweep in range(iterations):
         for c in range(first, last):
             ip = cv[out.vertex[c]]
@@ -504,14 +542,20 @@ def solve_contacts(x, v, inv_mass, topo, out, first, last, h, iterations):
             nx = out.normal[c, 0]
             ny = out.normal[c, 1]
             if sweep == 0:
+                # Speculative: a pair still farther than its target may approach by what is
+                # left of the gap in the next substep, no more; closer pairs may not approach.
+                # So a resting pair's support never lapses (it would pop out and back in).
+                d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
+                allowed = -max(d - out.target[c], 0.0) * inv_h
                 rvx = v[ip, 0] - ca * v[ia, 0] - s * v[ib, 0]
                 rvy = v[ip, 1] - ca * v[ia, 1] - s * v[ib, 1]
                 vn = rvx * nx + rvy * ny
-                if vn < 0.0:
+                if vn < allowed:
+                    jn = allowed - vn
                     vt = ny * rvx - nx * rvy        # along t = (ny, -nx)
-                    dvt = coulomb(vt, -vn, out.mu[c, 1], out.mu[c, 0]) - vt
-                    px = (-vn * nx + dvt * ny) / w  # the pair's impulse per unit inverse mass
-                    py = (-vn * ny - dvt * nx) / w
+                    dvt = coulomb(vt, jn, out.mu[c, 1], out.mu[c, 0]) - vt
+                    px = (jn * nx + dvt * ny) / w   # the pair's impulse per unit inverse mass
+                    py = (jn * ny - dvt * nx) / w
                     v[ip, 0] += wp * px
                     v[ip, 1] += wp * py
                     v[ia, 0] -= wa * px
@@ -525,6 +569,8 @@ def solve_contacts(x, v, inv_mass, topo, out, first, last, h, iterations):
                     x[ia, 1] -= h * wa * py
                     x[ib, 0] -= h * wb * px
                     x[ib, 1] -= h * wb * py
+                    if check_rects:
+                        _keep_out_three(x, v, xp, rects, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]], ce_b[out.edge[c]])
             d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
             gap = out.target[c] - d
             if gap > 0.0:
@@ -535,6 +581,8 @@ def solve_contacts(x, v, inv_mass, topo, out, first, last, h, iterations):
                 x[ia, 1] -= wa * lam * ny
                 x[ib, 0] -= wb * lam * nx
                 x[ib, 1] -= wb * lam * ny
+                if check_rects:
+                    _keep_out_three(x, v, xp, rects, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]], ce_b[out.edge[c]])
 
 
 @njit(cache=True)
@@ -550,7 +598,8 @@ def _refresh(x, topo, scr, out, margin, n_pairs):
     """Rebuild the grid and the candidate pairs if a vertex moved further than ``margin`` since
     the grid was built; returns ``(pairs, rebuilt)`` (pairs negative if they did not fit)."""
     cv, xq = topo.cv_vertex, scr.xq
-    for k in range(cv.shape[0]):
+    for m in range(scr.status[ST_ACTIVE]):
+        k = scr.active[m]
         if abs(x[cv[k], 0] - xq[k, 0]) > margin or abs(x[cv[k], 1] - xq[k, 1]) > margin:
             build_grid(x, topo, scr, margin)
             return narrow_phase(x, topo, scr, out), True
@@ -565,12 +614,12 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
     ``scr.status`` says which part).
     """
     cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
-    parent, zone, xp = scr.parent, scr.zone, scr.xp
+    parent, zone, xp, active = scr.parent, scr.zone, scr.xp, scr.active
     margin = topo.margin[0]
-    nv = cv.shape[0]
-    for k in range(nv):
-        parent[k] = k
-    for rounds in range(nv + 1):
+    na = scr.status[ST_ACTIVE]
+    for m in range(na):
+        parent[active[m]] = active[m]
+    for rounds in range(na + 1):
         n_pairs, rebuilt = _refresh(x, topo, scr, out, margin, n_pairs)
         if n_pairs < 0:
             scr.status[ST_PAIRS_NEEDED] = -n_pairs
@@ -583,25 +632,28 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
             return rounds
         for c in range(first, n):
             k = _find(parent, out.vertex[c])
-            for m in (ce_a[out.edge[c]], ce_b[out.edge[c]]):
-                r = _find(parent, m)
+            for q in (ce_a[out.edge[c]], ce_b[out.edge[c]]):
+                r = _find(parent, q)
                 if r != k:
                     parent[r] = k
         # zone sums: m vx, m vy, m, members, still (1: a pinned member, 2: pushed into a collider)
-        zone[:, :] = 0.0
-        for k in range(nv):
+        for m in range(na):
+            zone[active[m], :] = 0.0
+        for m in range(na):
+            k = active[m]
             r = _find(parent, k)
             i = cv[k]
             zone[r, 3] += 1.0
             if inv_mass[i] == 0.0:
                 zone[r, 4] = 1.0
             else:
-                m = 1.0 / inv_mass[i]
-                zone[r, 0] += m * v[i, 0]
-                zone[r, 1] += m * v[i, 1]
-                zone[r, 2] += m
+                mass = 1.0 / inv_mass[i]
+                zone[r, 0] += mass * v[i, 0]
+                zone[r, 1] += mass * v[i, 1]
+                zone[r, 2] += mass
         frozen = False
-        for k in range(nv):
+        for m in range(na):
+            k = active[m]
             r = _find(parent, k)
             if zone[r, 3] < 2.0:
                 continue
@@ -620,7 +672,8 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
                     zone[r, 4] = 2.0
                     frozen = True
         if frozen:  # a zone pushed into a collider stays where it started (outside, like every start)
-            for k in range(nv):
+            for m in range(na):
+                k = active[m]
                 r = _find(parent, k)
                 if zone[r, 3] >= 2.0 and zone[r, 4] == 2.0:
                     i = cv[k]
@@ -628,7 +681,7 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
                     v[i, 1] = 0.0
                     x[i, 0] = xp[k, 0]
                     x[i, 1] = xp[k, 1]
-    return nv + 1
+    return na + 1
 
 
 @njit(cache=True)
@@ -645,9 +698,7 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h):
     status[ST_STAMP] += 1
     status[ST_CONTACTS] = 0
     status[ST_PAIRS] = 0
-    cv = topo.cv_vertex
-    nv = cv.shape[0]
-    if nv == 0:
+    if topo.cv_vertex.shape[0] == 0 or _activate(x, topo, scr) == 0:
         return 0
     margin = topo.margin[0]
     if build_grid(x, topo, scr, margin) == 0:
@@ -664,7 +715,7 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h):
     status[ST_PAIRS] = n_pairs
     if n0 == 0:
         return 0  # no contact and no crossing (a crossing is a contact too): nothing moved
-    solve_contacts(x, v, inv_mass, topo, out, 0, n0, h, CONTACT_ITERATIONS)
+    solve_contacts(x, v, inv_mass, topo, scr, out, 0, n0, rects, h, CONTACT_ITERATIONS)
     end, n_pairs = _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h)
     if end < 0:
         return -1
@@ -686,7 +737,8 @@ def _collider_pass(x, v, topo, scr, rects, hits, h):
     collision vertex inside a collider; returns how many it moved."""
     cv, xp = topo.cv_vertex, scr.xp
     moved = 0
-    for k in range(cv.shape[0]):
+    for m in range(scr.status[ST_ACTIVE]):
+        k = scr.active[m]
         i = cv[k]
         px, py = x[i, 0], x[i, 1]
         for r in range(rects.shape[0]):
@@ -721,7 +773,7 @@ def _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h):
         if n == end:
             return end, n_pairs
         end = n
-        solve_contacts(x, v, inv_mass, topo, out, n0, end, h, CONTACT_ITERATIONS)
+        solve_contacts(x, v, inv_mass, topo, scr, out, n0, end, rects, h, CONTACT_ITERATIONS)
     r = impact_zones(x, v, inv_mass, topo, scr, out, end, n_pairs, rects, h)
     if r < 0:
         return -1, n_pairs
@@ -731,12 +783,89 @@ def _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h):
 
 
 @njit(cache=True)
+def _colliding_bodies(topo):
+    n = 0
+    for b in range(topo.body_flags.shape[0]):
+        if topo.body_flags[b] & COLLIDE:
+            n += 1
+    return n
+
+
+@njit(cache=True)
 def gather_start(x, topo, scr):
-    """Copy the collision vertices' positions into ``scr.xp`` (call at the start of a substep)."""
-    cv = topo.cv_vertex
-    for k in range(cv.shape[0]):
-        scr.xp[k, 0] = x[cv[k], 0]
-        scr.xp[k, 1] = x[cv[k], 1]
+    """Note where the collision vertices are at the start of a substep (``scr.xp``).
+
+    Every outline vertex; the other vertices of colliding bodies too when two or more bodies
+    collide (they must not enter another body either, should their body fold), with each
+    body's box of them, which :func:`contact_stage` grows to the swept box.
+    """
+    cv, xp, box = topo.cv_vertex, scr.xp, scr.body_box
+    for k in range(topo.body_interior[0]):
+        xp[k, 0] = x[cv[k], 0]
+        xp[k, 1] = x[cv[k], 1]
+    if _colliding_bodies(topo) < 2:
+        return
+    for b in range(topo.body_flags.shape[0]):
+        box[b, 0] = np.inf
+        box[b, 1] = np.inf
+        box[b, 2] = -np.inf
+        box[b, 3] = -np.inf
+        if (topo.body_flags[b] & COLLIDE) == 0:
+            continue
+        for lo, hi in ((topo.body_outline[b], topo.body_outline[b + 1]),
+                       (topo.body_interior[b], topo.body_interior[b + 1])):
+            for k in range(lo, hi):
+                px = x[cv[k], 0]
+                py = x[cv[k], 1]
+                xp[k, 0] = px
+                xp[k, 1] = py
+                box[b, 0] = min(box[b, 0], px)
+                box[b, 1] = min(box[b, 1], py)
+                box[b, 2] = max(box[b, 2], px)
+                box[b, 3] = max(box[b, 3], py)
+
+
+@njit(cache=True)
+def _activate(x, topo, scr):
+    """List the collision vertices to test this substep in ``scr.active``; returns how many.
+
+    Every outline vertex of a body with contacts on, and the other vertices of each
+    colliding body whose swept box (grown by the margin) overlaps another colliding body's.
+    """
+    cv, flags, box, active = topo.cv_vertex, topo.body_flags, scr.body_box, scr.active
+    n = 0
+    for b in range(flags.shape[0]):
+        if flags[b] != 0:
+            for k in range(topo.body_outline[b], topo.body_outline[b + 1]):
+                active[n] = k
+                n += 1
+    nb = flags.shape[0]
+    if _colliding_bodies(topo) >= 2:
+        margin = topo.margin[0]
+        for b in range(nb):  # the start box (gather_start) grown to the end positions
+            if (flags[b] & COLLIDE) == 0:
+                continue
+            for lo, hi in ((topo.body_outline[b], topo.body_outline[b + 1]),
+                           (topo.body_interior[b], topo.body_interior[b + 1])):
+                for k in range(lo, hi):
+                    box[b, 0] = min(box[b, 0], x[cv[k], 0])
+                    box[b, 1] = min(box[b, 1], x[cv[k], 1])
+                    box[b, 2] = max(box[b, 2], x[cv[k], 0])
+                    box[b, 3] = max(box[b, 3], x[cv[k], 1])
+        for b in range(nb):
+            if (flags[b] & COLLIDE) == 0:
+                continue
+            for c in range(nb):
+                if c == b or (flags[c] & COLLIDE) == 0:
+                    continue
+                if box[b, 0] - margin <= box[c, 2] and box[c, 0] - margin <= box[b, 2] \
+                        and box[b, 1] - margin <= box[c, 3] and box[c, 1] - margin <= box[b, 3]:
+                    for k in range(topo.body_interior[b], topo.body_interior[b + 1]):
+                        active[n] = k
+                        n += 1
+                    break
+    scr.status[ST_ACTIVE] = n
+    return n
 
 
 @njit(cache=True)

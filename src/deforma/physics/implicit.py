@@ -228,8 +228,11 @@ class ImplicitEuler:
         vmax2 = float(inputs.max_speed) ** 2
         np.copyto(state.x_start, x)
         np.copyto(state.v_start, v)
+        keep = 1.0 / (1.0 + h * inputs.air_drag)
         for _ in range(substeps):
             np.copyto(x_n, x)
+            if keep != 1.0:  # air drag, split off before the solve (stable at any h)
+                v *= keep
             np.multiply(v, h, out=y)
             y += x
             y[:, 0] += h2 * gx

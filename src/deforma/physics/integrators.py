@@ -15,7 +15,7 @@ reports no explicit step limit for it.
 
 Semi-implicit (symplectic) Euler, per substep::
 
-    v += h * F(x, v) / m
+    v = (v + h * F(x, v) / m) / (1 + h * air_drag)
     x += h * v
     x, v = collide(x_before, x, v)              # colliders, per vertex
     x, v = contact_stage(x_before, x, v)        # bodies against bodies and themselves
@@ -56,6 +56,7 @@ class StepInputs(Protocol):
     """What a world hands an integrator each step (duck-typed; see ``World``)."""
 
     gravity: tuple[float, float]
+    air_drag: float            # 1/s: every velocity decays as dv/dt = -air_drag v
     rects: np.ndarray          # (R, RECT_COLUMNS) packed colliders
     hits: tuple                # colliders.ColliderHits: who touched which collider, per vertex
     contact_scratch: tuple     # contacts.ContactScratch
@@ -120,9 +121,10 @@ def make_integrator(name: str) -> Integrator:
 
 
 @njit(cache=True, inline="always")
-def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, h):
-    vx += h * (fx * inv_mass + gx)
-    vy += h * (fy * inv_mass + gy)
+def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, keep, h):
+    # keep = 1 / (1 + h air_drag): the drag -air_drag v taken at the end of the substep (stable at any h)
+    vx = (vx + h * (fx * inv_mass + gx)) * keep
+    vy = (vy + h * (fy * inv_mass + gy)) * keep
     return x0 + h * vx, y0 + h * vy, vx, vy
 
 
@@ -164,7 +166,8 @@ def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
 # Scalar-only helpers are free.
 
 def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
-                      inv_mass, gx, gy, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, vmax2):
+                      inv_mass, gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps,
+                      vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions.
 
     ``fbuf`` (T, N, 2) are zeroed force buffers, one per spring chunk ``chunk_ptr[t]:
@@ -210,7 +213,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
             if g >= 0:  # forces.grab_force
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
                 fy += grab_pull[g, 2] - grab_pull[g, 0] * y0
-            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass[i], gx, gy, h)
+            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass[i], gx, gy, keep, h)
             near = False
             for r in range(rects.shape[0]):  # broad phase: bounding boxes (a helper for these
                 # lines, even inlined, costs reference counting on rects per vertex: 2.5x slower)
@@ -356,7 +359,8 @@ class SymplecticEuler:
         start = time.perf_counter()
         bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks, self._chunk_vertices,
                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
-                     model.spring_damping, model.vertex_inv_mass, float(gx), float(gy), inputs.grab_slot,
+                     model.spring_damping, model.vertex_inv_mass, float(gx), float(gy),
+                     1.0 / (1.0 + float(h) * inputs.air_drag), inputs.grab_slot,
                      inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch, inputs.contacts,
                      float(h), int(substeps), float(inputs.max_speed) ** 2)
         if may_parallel:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contacts import COLLIDE, SELF_COLLIDE, ContactTopology, rest_clearance
+from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, ContactTopology, rest_clearance
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,8 +161,6 @@ class Model:
         Every body's boundary as the contact stage reads it (collision vertices, boundary
         edges, per-vertex contact thickness, per-body flags and friction); see
         :mod:`deforma.physics.contacts`.
-    body_contact_offsets : (B + 1,) int64
-        Where each body's collision vertices start in ``contact.cv_vertex``.
 
     Examples
     --------
@@ -208,28 +206,37 @@ class Model:
         self.adj_spring = np.ascontiguousarray(ids[order])
         self.adj_sign = np.ascontiguousarray(signs[order])
 
-        # the contact stage's view: every body's boundary, collision vertices numbered body by body
+        # The contact stage's view: the collision vertices are every body's outline vertices,
+        # body by body, then the other vertices of each body with triangles, body by body.
         nb = len(self.topologies)
-        nc = [len(t.boundary_vertices) for t in self.topologies]
-        self.body_contact_offsets = np.zeros(nb + 1, np.int64)
-        np.cumsum(nc, out=self.body_contact_offsets[1:])
+        outline = [t.boundary_vertices for t in self.topologies]
+        inner = [np.setdiff1d(np.arange(t.n_vertices if len(t.triangles) else 0, dtype=np.int32), o)
+                 for t, o in zip(self.topologies, outline)]
+        body_outline = np.zeros(nb + 1, np.int64)
+        np.cumsum([len(o) for o in outline], out=body_outline[1:])
+        body_interior = np.full(nb + 1, body_outline[-1], np.int64)
+        np.cumsum([len(i) for i in inner], out=body_interior[1:])
+        body_interior[1:] += body_outline[-1]
         cv, cb, ea, eb, ebody = [np.zeros(0, np.int32)], [np.zeros(0, np.int32)], [np.zeros(0, np.int32)], \
             [np.zeros(0, np.int32)], [np.zeros(0, np.int32)]
-        
         for b, t in enumerate(self.topologies):
             local = np.full(t.n_vertices, -1, np.int64)
-            local[t.boundary_vertices] = np.arange(nc[b]) + self.body_contact_offsets[b]
-            cv.append(t.boundary_vertices + self.body_vertex_offsets[b])
-            cb.append(np.full(nc[b], b))
+            local[outline[b]] = np.arange(len(outline[b])) + body_outline[b]
+            cv.append(outline[b] + self.body_vertex_offsets[b])
+            cb.append(np.full(len(outline[b]), b))
             ea.append(local[t.boundary_edges[:, 0]])
             eb.append(local[t.boundary_edges[:, 1]])
             ebody.append(np.full(len(t.boundary_edges), b))
-        v = int(self.body_contact_offsets[-1])
+        for b in range(nb):
+            cv.append(inner[b] + self.body_vertex_offsets[b])
+            cb.append(np.full(len(inner[b]), b))
+        v = int(body_interior[-1])
 
         def i32(parts):
             return np.ascontiguousarray(np.concatenate(parts), dtype=np.int32)
-        self.contact = ContactTopology(i32(cv), i32(cb), i32(ea), i32(eb), i32(ebody), np.zeros(v), np.zeros(v),
-                                       np.zeros(nb, np.int32), np.zeros((nb, 2)), np.zeros(1))
+        self.contact = ContactTopology(i32(cv), i32(cb), body_outline, body_interior, i32(ea), i32(eb), i32(ebody),
+                                       np.zeros(v), np.zeros(v), np.zeros(nb, np.int32), np.zeros((nb, 2)),
+                                       np.zeros(1))
         for b in range(nb):
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
@@ -269,8 +276,12 @@ class Model:
         c.body_flags[body] = (COLLIDE if collide else 0) | (SELF_COLLIDE if self_collision else 0)
         c.body_friction[body, 0] = friction
         c.body_friction[body, 1] = static_friction
-        k0, k1 = self.body_contact_offsets[body], self.body_contact_offsets[body + 1]
+        k0, k1 = c.body_outline[body], c.body_outline[body + 1]
         clear = self.topologies[body].boundary_clearance
         c.thick_other[k0:k1] = thickness
         c.thick_self[k0:k1] = np.minimum(thickness, 0.5 * clear)
+        # vertices off the outline only must not cross other bodies' outlines (should their body
+        # fold): a hair of thickness, so that their contacts are crossings, put back just in front
+        i0, i1 = c.body_interior[body], c.body_interior[body + 1]
+        c.thick_other[i0:i1] = SIDE_MARGIN * thickness
         c.margin[0] = float(c.thick_other.max()) if len(c.thick_other) else 0.0

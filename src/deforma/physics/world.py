@@ -292,7 +292,7 @@ class Grab:
 class _StepInputs:
     """What the integrator reads besides the model and the state (see integrators.StepInputs)."""
 
-    __slots__ = ("gravity", "rects", "hits", "grab_slot", "grab_pull", "max_speed", "contact_scratch", "contacts")
+    __slots__ = ("gravity", "air_drag", "rects", "hits", "grab_slot", "grab_pull", "max_speed", "contact_scratch", "contacts")
 
 
 class World:
@@ -312,6 +312,12 @@ class World:
         Default spring constant in N/m (>= 0).
     damping : float, optional
         Default spring damping in N*s/m (>= 0).
+    air_drag : float, optional
+        In 1/s (>= 0): every vertex's velocity decays as ``dv/dt = -air_drag v``, so a body
+        falls no faster than ``g / air_drag``. Spring damping acts on stretching only and is
+        proportional to stiffness, so it barely slows the slow sway of a tall stack or a
+        heap; a little air drag lets them come to rest (Box2D's ``linearDamping``, Matter.js's
+        ``frictionAir``). Default 0.
     friction, static_friction : float, optional
         Default dynamic and static Coulomb coefficients of colliders (>= 0).
     grab_strength : float, optional
@@ -345,7 +351,7 @@ class World:
 
     def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps=1, mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
-                 integrator="symplectic-euler", contact_thickness=None):
+                 integrator="symplectic-euler", contact_thickness=None, air_drag=0.0):
         self._inputs = _StepInputs()
         self._bodies: list[Body] = []
         self._colliders: list[Rect] = []
@@ -371,6 +377,7 @@ class World:
         self.max_speed = max_speed
         self.integrator = integrator
         self.contact_thickness = contact_thickness
+        self.air_drag = air_drag
 
     # -- parameters -------------------------------------------------------------------------
     @property
@@ -444,6 +451,15 @@ class World:
         if not v > 0:
             raise ValueError(f"max_speed must be > 0 m/s (inf allowed), got {value!r}")
         self._inputs.max_speed = v
+
+    @property
+    def air_drag(self) -> float:
+        """Air drag in 1/s: every velocity decays as ``dv/dt = -air_drag v``."""
+        return self._inputs.air_drag
+
+    @air_drag.setter
+    def air_drag(self, value):
+        self._inputs.air_drag = _non_negative(value, "air_drag", "1/s")
 
     @property
     def contact_thickness(self) -> float | None:
@@ -607,8 +623,9 @@ class World:
 
     def _make_contact_scratch(self):
         c = self._model.contact
-        self._inputs.contact_scratch = _contacts.make_scratch(len(c.cv_vertex), len(c.ce_a))
-        self._inputs.contacts = _contacts.make_buffer(len(c.cv_vertex) + 64, 4 * len(c.cv_vertex) + 64)
+        self._inputs.contact_scratch = _contacts.make_scratch(len(c.cv_vertex), len(c.ce_a), len(self._bodies))
+        n_outline = int(c.body_interior[0])
+        self._inputs.contacts = _contacts.make_buffer(n_outline + 64, 4 * n_outline + 64)
         self._inputs.hits = make_hits(self._model.n_vertices)
 
     def _contact_parameters(self, body) -> dict:

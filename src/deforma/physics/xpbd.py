@@ -3,7 +3,7 @@
 
 Per substep ``h``::
 
-    x_prev = x;  v += h g;  x += h v                   # predict
+    x_prev = x;  v = (v + h g) / (1 + h air_drag);  x += h v      # predict
     repeat iterations times (Gauss-Seidel, springs in order):
         C = |x_ij| - l,   d = x_ij / |x_ij|
         dlam = -(ks h^2 C + lam + kd h d . (dx_j - dx_i)) / ((ks h^2 + kd h)(w_i + w_j) + 1)
@@ -45,7 +45,7 @@ from .integrators import register_integrator
 
 @njit(cache=True)
 def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, spring_j, rest, ks, kd,
-                  gx, gy, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
+                  gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
     """``substeps`` XPBD substeps of ``h`` s with ``iterations`` Gauss-Seidel sweeps each.
 
     Parameters
@@ -66,6 +66,8 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
         Rest lengths (m), stiffness (N/m), damping (N*s/m).
     gx, gy : float
         Gravity (m/s^2).
+    keep : float
+        ``1 / (1 + h air_drag)``: the part of each velocity air drag leaves per substep.
     grab_slot : (N,) int32
         Grab entry per vertex or -1.
     grab_pull : (K, 3) float64
@@ -97,7 +99,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
     >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
-    ...                     np.zeros(1), 0.0, 0.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
+    ...                     np.zeros(1), 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
     ...                     np.zeros((0, 13)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
     ...                     0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
@@ -111,8 +113,8 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
         for i in range(n):
             x_prev[i, 0] = x[i, 0]
             x_prev[i, 1] = x[i, 1]
-            v[i, 0] += h * gx
-            v[i, 1] += h * gy
+            v[i, 0] = (v[i, 0] + h * gx) * keep
+            v[i, 1] = (v[i, 1] + h * gy) * keep
             px = x[i, 0] + h * v[i, 0]
             py = x[i, 1] + h * v[i, 1]
             g = grab_slot[i]
@@ -199,6 +201,7 @@ class XPBD:
         return xpbd_substeps(state.x, state.v, state.x_start, state.v_start, self._x_prev, self._lam,
                              model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              model.spring_stiffness, model.spring_damping, float(gx), float(gy),
+                             1.0 / (1.0 + float(h) * inputs.air_drag),
                              inputs.grab_slot, inputs.grab_pull, inputs.rects, inputs.hits, model.contact,
                              inputs.contact_scratch, inputs.contacts, float(h), int(substeps),
                              int(self.iterations), float(inputs.max_speed) ** 2)

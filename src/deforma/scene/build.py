@@ -106,7 +106,7 @@ def build(scene: Scene):
         world = World(gravity=p.gravity, dt=p.dt, substeps=p.substeps, mass=p.mass, stiffness=p.stiffness,
                       damping=p.damping, friction=p.friction, static_friction=p.static_friction,
                       grab_strength=scene.interaction.mouse_strength, max_speed=p.max_speed,
-                      integrator=p.integrator)
+                      integrator=p.integrator, contact_thickness=p.contact_thickness, air_drag=p.air_drag)
     except ValueError as e:
         raise SceneError(f"{source}: physics: {e}") from None
     bodies = []
@@ -114,7 +114,8 @@ def build(scene: Scene):
         try:
             m = make_mesh(spec)
             b = world.add_body(m, position=spec.position, mass=spec.mass, stiffness=spec.stiffness,
-                               damping=spec.damping)
+                               damping=spec.damping, collide=spec.collide, self_collision=spec.self_collision,
+                               friction=spec.friction, static_friction=spec.static_friction)
         except ValueError as e:
             raise SceneError(f"{source}: body[{i}]: {e}") from None
         bodies.append((weakref.ref(b), spec))
@@ -169,6 +170,8 @@ def scene_of(world) -> Scene:
         damping=float(world.damping), mass=float(world.mass), stiffness=float(world.stiffness),
         friction=float(world.friction), static_friction=float(world.static_friction),
         max_speed=float(world.max_speed), integrator=world.integrator,
+        contact_thickness=None if world.contact_thickness is None else float(world.contact_thickness),
+        air_drag=float(world.air_drag),
     )
     interaction = InteractionSettings(explosive_force=scene.interaction.explosive_force,
                                       mouse_strength=float(world.grab_strength))
@@ -188,12 +191,15 @@ def scene_of(world) -> Scene:
                             triangles=tuple(map(tuple, np.asarray(b.triangles).tolist())),
                             uv=None if uv is None else tuple(map(tuple, np.asarray(uv).tolist())))
         overrides = {}
-        for name in ("mass", "stiffness", "damping"):
+        for name in ("mass", "stiffness", "damping", "friction", "static_friction"):
             expected = getattr(spec, name)
             expected = getattr(world, name) if expected is None else expected
             actual = float(getattr(b, name))
             if actual != expected:
                 overrides[name] = actual
+        for name in ("collide", "self_collision"):
+            if getattr(b, name) != getattr(spec, name):
+                overrides[name] = getattr(b, name)
         bodies.append(replace(spec, **overrides) if overrides else spec)
     colour_of = {id(r): c for r, c in (rec.colliders if rec is not None else [])}
     colliders = []

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 __all__ = [
-    "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
+    "BodyPhysics", "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
     "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "parse_scene", "scene_to_dict",
 ]
 
@@ -117,13 +117,24 @@ class PhysicsSettings:
     mass: float = spec("float", 1.0, lo=0.0, lo_open=True, unit="kg",
                        doc="Total mass of a body; each vertex weighs mass / N.")
     stiffness: float = spec("float", 1000.0, lo=0.0, unit="N/m", doc="Spring constant ks.")
-    friction: float = spec("float", 0.3, lo=0.0, doc="Dynamic Coulomb friction coefficient of colliders.")
-    static_friction: float = spec("float", 0.5, lo=0.0, doc="Static Coulomb friction coefficient of colliders.")
+    friction: float = spec("float", 0.3, lo=0.0,
+                           doc="Dynamic Coulomb friction coefficient of colliders, and of bodies against each "
+                               "other unless they set their own.")
+    static_friction: float = spec("float", 0.5, lo=0.0,
+                                  doc="Static Coulomb friction coefficient of colliders, and of bodies against "
+                                      "each other unless they set their own.")
     max_speed: float = spec("float", 1000.0, lo=0.0, lo_open=True, unit="m/s",
                             doc="A vertex faster than this means the simulation became unstable.")
     integrator: str = spec("str", "symplectic-euler",
                            doc="Time integrator by name: symplectic-euler (explicit, the original's), "
                                "implicit-euler or xpbd (both stable at any dt; see docs/integrators.md).")
+    contact_thickness: float | None = spec("float", None, lo=0.0, lo_open=True, unit="m",
+                                           doc="How far apart touching bodies stay; below every colliding body's "
+                                               "shortest outline edge. Omit for 5% of each body's median outline "
+                                               "edge.")
+    air_drag: float = spec("float", 0.0, lo=0.0, unit="1/s",
+                           doc="Every velocity decays as dv/dt = -air_drag v; a little lets stacks and heaps come "
+                               "to rest.")
 
 
 @dataclass(frozen=True)
@@ -145,7 +156,23 @@ _BODY_COMMON_DOC = {
 
 
 @dataclass(frozen=True)
-class BoxBody:
+class BodyPhysics:
+    """The keys every ``[[body]]`` shares: per-body physics overrides and contact switches."""
+
+    mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
+    stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
+    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
+    collide: bool = spec("bool", True, doc="Touch other bodies (both must have it on).")
+    self_collision: bool = spec("bool", True, doc="Touch itself: its outline cannot fold through itself.")
+    friction: float | None = spec("float", None, lo=0.0,
+                                  doc="Overrides physics.friction against other bodies and itself; two bodies "
+                                      "use sqrt(a * b) of theirs.")
+    static_friction: float | None = spec("float", None, lo=0.0,
+                                         doc="Overrides physics.static_friction against other bodies and itself.")
+
+
+@dataclass(frozen=True)
+class BoxBody(BodyPhysics):
     """``[[body]]`` with ``shape = "box"``: a quadrilateral filled with points (the original's Square)."""
 
     shape: str = spec("str", "box", choices=("box", "image", "mesh"), doc="Which kind of body.")
@@ -156,13 +183,10 @@ class BoxBody:
     position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
     color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
     texture: str | None = spec("file", None, doc=_BODY_COMMON_DOC["texture"])
-    mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
-    stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
-    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
 
 
 @dataclass(frozen=True)
-class ImageBody:
+class ImageBody(BodyPhysics):
     """``[[body]]`` with ``shape = "image"``: a body traced from a picture (the original's textures)."""
 
     shape: str = spec("str", "image", choices=("box", "image", "mesh"), doc="Which kind of body.")
@@ -174,13 +198,10 @@ class ImageBody:
     position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
     color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
     texture: str | None = spec("file", None, doc="A different picture to draw; by default the source itself.")
-    mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
-    stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
-    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
 
 
 @dataclass(frozen=True)
-class MeshBody:
+class MeshBody(BodyPhysics):
     """``[[body]]`` with ``shape = "mesh"``: any mesh given by its arrays (what save_scene writes for
     bodies that were not made from a box or an image)."""
 
@@ -191,9 +212,6 @@ class MeshBody:
     position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
     color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
     texture: str | None = spec("file", None, doc=_BODY_COMMON_DOC["texture"])
-    mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
-    stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
-    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
 
 
 BODY_KINDS = {"box": BoxBody, "image": ImageBody, "mesh": MeshBody}
@@ -534,8 +552,10 @@ def scene_to_dict(scene: Scene, *, base_dir=None, full: bool = True) -> dict:
             for it in items:
                 keep = [f.name for f in fields(it)] if full else ()
                 rec = _record(it, base_dir=base, always=keep)
-                if isinstance(it, (BoxBody, ImageBody, MeshBody)):
-                    rec = {"shape": it.shape, **{k: v for k, v in rec.items() if k != "shape"}}
+                if isinstance(it, BodyPhysics):  # shape, the kind's own keys, then the shared ones
+                    shared = [f.name for f in fields(BodyPhysics)]
+                    rec = {"shape": it.shape, **{k: v for k, v in rec.items() if k != "shape" and k not in shared},
+                           **{k: rec[k] for k in shared if k in rec}}
                 recs.append(rec)
             doc[name] = recs
     return doc
