@@ -90,3 +90,18 @@ def test_float_filter_would_get_these_wrong():
             naive = (p[0] - c[0]) * (b[1] - c[1]) - (p[1] - c[1]) * (b[0] - c[0])
             wrong += sign(naive) != want
     assert wrong > 0  # the naive formula does fail here, so the test means something
+
+
+def test_signs_survive_products_below_the_smallest_double():
+    # Lattice points nudged by 7.6e-261 (found by the Delaunay property test): the large
+    # terms cancel exactly and the sign rests on eps**2 ~ 6e-521, below the smallest double.
+    eps = 7.616969426672526e-261
+    a, b, c = (eps, -2.0), (-1.0, eps), (-2.0, 2.0)  # collinear but for the nudges
+    assert orient_fraction(a, b, c) == 1
+    assert sign(orient2d_exact(*a, *b, *c, W)) == sign(orient2d(*a, *b, *c, W)) == 1
+    p, q, r, d = (-2.0, 2.0), (-2.0, -2.0), (-6.0, eps), (-1.0, eps)  # cocircular but for the nudges
+    if orient_fraction(p, q, r) < 0:
+        q, r = r, q
+    want = incircle_fraction(p, q, r, d)
+    assert want != 0
+    assert sign(incircle_exact(*p, *q, *r, *d, W)) == sign(incircle(*p, *q, *r, *d, W)) == want

@@ -24,6 +24,8 @@ array so that no call allocates (see :data:`SCRATCH_SIZE`).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -123,6 +125,18 @@ def _add_product(w, acc_len, a, b, c, d):
     """
     if a == 0.0 or b == 0.0 or c == 0.0 or d == 0.0:
         return acc_len
+    # largest factors first: ((a b) c) d then never passes below the smallest double on the
+    # way to a product that is in range (two tiny factors first would underflow)
+    if abs(a) < abs(b):
+        a, b = b, a
+    if abs(c) < abs(d):
+        c, d = d, c
+    if abs(a) < abs(c):
+        a, c = c, a
+    if abs(b) < abs(d):
+        b, d = d, b
+    if abs(b) < abs(c):
+        b, c = c, b
     x, y = _two_product(a, b)
     if y != 0.0:
         w[0] = y
@@ -157,9 +171,30 @@ def _sign_of(w, acc_len):
     return 1.0 if top > 0.0 else (-1.0 if top < 0.0 else 0.0)
 
 
+@njit(inline="always")
+def _upscale(m, target):
+    """A power of two that brings the largest input magnitude ``m`` up to about ``2**target``.
+
+    Expansion arithmetic is exact only while no product underflows: with inputs of
+    magnitude 1 and 1e-260 (a lattice point nudged by a tiny offset), the product of two
+    tiny ones is below the smallest double, and a determinant whose large terms cancel
+    exactly came out 0 instead of its true, tiny sign. Multiplying every input by the same
+    power of two is exact and keeps the sign; bringing the largest to ``2**target`` (500 for
+    the degree-2 orientation, 250 for the degree-4 in-circle test) keeps the largest
+    products below overflow and lifts the smallest into range. Only upward: the callers
+    scale their points to magnitude <= 1 first (see :func:`deforma.delaunay`).
+    """
+    if m == 0.0:
+        return 1.0
+    e = math.frexp(m)[1]
+    return math.ldexp(1.0, target - e) if e < target else 1.0
+
+
 @njit(cache=True)
 def orient2d_exact(ax, ay, bx, by, cx, cy, w):
     """Sign (+1, -1, 0) of the orientation determinant, always exact (stages 2 and 3)."""
+    k = _upscale(max(max(abs(ax), abs(ay)), max(max(abs(bx), abs(by)), max(abs(cx), abs(cy)))), 500)
+    ax, ay, bx, by, cx, cy = ax * k, ay * k, bx * k, by * k, cx * k, cy * k
     acx, e1 = _two_diff(ax, cx)
     bcx, e2 = _two_diff(bx, cx)
     acy, e3 = _two_diff(ay, cy)
@@ -235,6 +270,9 @@ def _ops_exact_incircle(adx, ady, bdx, bdy, cdx, cdy):
 @njit(cache=True)
 def incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, w):
     """Sign (+1, -1, 0) of the in-circle determinant, always exact (stages 2 and 3)."""
+    k = _upscale(max(max(max(abs(ax), abs(ay)), max(abs(bx), abs(by))),
+                     max(max(abs(cx), abs(cy)), max(abs(dx), abs(dy)))), 250)
+    ax, ay, bx, by, cx, cy, dx, dy = ax * k, ay * k, bx * k, by * k, cx * k, cy * k, dx * k, dy * k
     adx, adxt = _two_diff(ax, dx)
     ady, adyt = _two_diff(ay, dy)
     bdx, bdxt = _two_diff(bx, dx)
