@@ -118,6 +118,16 @@ def test_invalid_scene_file_names_the_key(tmp_path, capsys):
     assert "bad.toml: physics.dt: expected a number" in err
 
 
+def test_scene_with_overlapping_bodies_names_them_and_writes_nothing(tmp_path, capsys):
+    p = tmp_path / "overlap.toml"
+    p.write_text("[[body]]\ndetail = 3\nposition = [0, 2]\n\n[[body]]\ndetail = 3\nposition = [0.4, 2.5]\n")
+    out = tmp_path / "o.gif"
+    code, stdout, err = run(capsys, "run", str(p), "-o", str(out), *SMALL)
+    assert code == EXIT_ERROR
+    assert "body[1]: the new body (1) would overlap body 0" in err and err.count("\n") == 1
+    assert sorted(os.listdir(tmp_path)) == ["overlap.toml"]
+
+
 def test_missing_output_folder_is_reported_before_simulating(tmp_path, capsys, monkeypatch):
     import deforma.scene.schema as schema
 

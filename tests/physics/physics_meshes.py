@@ -7,15 +7,20 @@ import numpy as np
 from deforma.mesh import Mesh
 
 
-def grid_mesh(width, height, nx, ny, *, angle=0.0, center=(0.0, 0.0)):
+def grid_mesh(width, height, nx, ny, *, angle=0.0, center=(0.0, 0.0), alternate=False):
     """A width x height (m) rectangle of nx x ny vertices, split into right triangles,
-    rotated by ``angle`` degrees about its centre and centred on ``center``."""
+    rotated by ``angle`` degrees about its centre and centred on ``center``.
+
+    With ``alternate`` the cells' diagonals alternate like a checkerboard, so the spring
+    lattice is as stiff in one shear direction as in the other (one diagonal everywhere
+    makes a square shear and turn under load)."""
     xs, ys = np.meshgrid(np.linspace(-width / 2, width / 2, nx), np.linspace(-height / 2, height / 2, ny))
     v = np.c_[xs.ravel(), ys.ravel()]
     idx = np.arange(nx * ny).reshape(ny, nx)
     a, b = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()
     c, d = idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
-    tris = np.r_[np.c_[a, b, c], np.c_[a, c, d]]
+    flip = (np.add.outer(np.arange(ny - 1), np.arange(nx - 1)).ravel() % 2 == 1) & alternate
+    tris = np.r_[np.c_[a, b, np.where(flip, d, c)], np.c_[np.where(flip, b, a), c, d]]
     t = math.radians(angle)
     rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
     return Mesh(v @ rot.T + np.asarray(center, float), tris)

@@ -99,6 +99,19 @@ def test_live_changes_are_saved(tmp_path):
     np.testing.assert_array_equal(w2.bodies[1].triangles, w.bodies[1].triangles)
 
 
+def test_live_contact_settings_are_saved(tmp_path):
+    w = scenes.load_scene("jelly")
+    w.contact_thickness = 0.004
+    w.air_drag = 0.7
+    w.bodies[0].self_collision = False
+    w.bodies[1].collide = False
+    w.bodies[2].friction = 0.9
+    w2 = scenes.load_scene(scenes.save_scene(w, tmp_path / "contacts.toml"))
+    assert (w2.contact_thickness, w2.air_drag) == (0.004, 0.7)
+    assert [(b.collide, b.self_collision) for b in w2.bodies] == [(True, False), (False, True), (True, True)]
+    assert [b.friction for b in w2.bodies] == [w.friction, w.friction, 0.9]
+
+
 def test_relative_texture_paths_follow_the_file(tmp_path):
     from PIL import Image
 
@@ -154,6 +167,14 @@ BAD = [
     ("[physics]\nintegrator = 'rk99'\n",
      "physics.integrator: unknown value 'rk99'; allowed: symplectic-euler, implicit-euler, xpbd"),
     ("[physics]\nintegrator = 'xpdb'\n", "physics.integrator: unknown value 'xpdb'; did you mean 'xpbd'?"),
+    ("[physics]\ncontact_thickness = -0.001\n", "physics.contact_thickness: must be > 0 m, got -0.001"),
+    ("[physics]\ncontact_thickness = 0.5\n[[body]]\ndetail = 4\n",
+     "body[0]: contact_thickness 0.5 m is not below the shortest boundary edge of the new body"),
+    ("[physics]\nair_drag = -1\n", "physics.air_drag: must be >= 0 1/s, got -1"),
+    ("[[body]]\ncollide = 'yes'\n", "body[0].collide: expected true or false"),
+    ("[[body]]\nstatic_friction = -0.5\n", "body[0].static_friction: must be >= 0, got -0.5"),
+    ("[[body]]\nposition = [0, 0]\n[[body]]\nposition = [0.3, 0.2]\n",
+     "body[1]: the new body (1) would overlap body 0 (their outlines cross or one lies inside the other)"),
 ]
 
 

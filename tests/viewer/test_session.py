@@ -14,7 +14,7 @@ def test_every_original_inspector_value_is_a_parameter():
     assert {"detail", "edges", "scale", "resolution", "detect_edges", "edge_step", "dt", "gravity_x", "gravity_y",
             "damping", "mass", "stiffness", "static_friction", "friction", "explosive_force", "collider_x",
             "collider_y", "collider_width", "collider_height", "collider_angle", "mouse_strength"} <= names
-    assert [g for g, _ in GROUPS] == ["Square", "Texture", "Physics", "Collision", "Mouse"]
+    assert [g for g, _ in GROUPS] == ["Square", "Texture", "Physics", "Contact", "Collision", "Mouse"]
     s = Session("demo")
     for name in names:  # every parameter reads back from a live session
         assert s.get_param(name) is not None
@@ -27,14 +27,20 @@ def test_physics_values_apply_to_the_running_world():
     s.set_param("gravity_y", -3.0)
     s.set_param("mouse_strength", 80.0)
     s.set_param("substeps", 9.0)
+    s.set_param("air_drag", 0.5)
+    s.set_param("contact_thickness", 0.003)
+    s.set_param("self_collision", False)
     assert s.world is world  # no rebuild
     assert (world.stiffness, world.gravity, world.grab_strength, world.substeps) == (2345.0, (0.0, -3.0), 80.0, 9)
+    assert (world.air_drag, world.contact_thickness, world.bodies[0].self_collision) == (0.5, 0.003, False)
+    assert s.get_param("self_collision") is False and s.get_param("collide") is True
 
 
 @pytest.mark.parametrize("name, value", [("stiffness", -1.0), ("mass", 0.0), ("dt", float("nan")),
                                          ("detail", 5000), ("resolution", 1), ("scale", 0.0), ("substeps", 2.5),
                                          ("collider_width", -2.0), ("collider_angle", 1000.0),
-                                         ("explosive_force", -1.0)])
+                                         ("explosive_force", -1.0), ("air_drag", -1.0),
+                                         ("contact_thickness", 1.0)])
 def test_invalid_values_are_refused_and_change_nothing(name, value):
     s = Session("demo")
     before = s.scene

@@ -73,8 +73,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .colliders import (RECT_FRICTION, RECT_STATIC_FRICTION, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, _inside,
-                        collide_point, record_hit)
+from .colliders import (RECT_FRICTION, RECT_STATIC_FRICTION, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN,
+                        collide_point, jump_reach, path_hits, record_hit)
 from .friction import coulomb, mix
 
 # Bits of ContactTopology.body_flags.
@@ -98,29 +98,44 @@ ST_FAILSAFE = 3      # substeps that needed the impact-zone fail-safe (cumulativ
 ST_STAMP = 4         # substeps run through the stage (cumulative)
 ST_PAIRS = 5         # candidate pairs of the last substep
 ST_ACTIVE = 6        # collision vertices tested in the last substep
+ST_DIRTY = 7         # length of ContactScratch.dirty
+ST_GEN = 8           # generations of checks (cumulative)
+ST_TOUCHED = 9       # length of ContactScratch.touched
 
 ContactTopology = namedtuple("ContactTopology", [
     "cv_vertex",        # (V,) int32: global vertex index of each collision vertex: the outline
                         #   vertices of every body, then every body's other vertices
     "cv_body",          # (V,) int32: its body
+    "vertex_cv",        # (N,) int32: the collision vertex of each world vertex (-1: none)
     "body_outline",     # (B + 1,) int64: body b's outline vertices are cv[body_outline[b]:...[b + 1]]
     "body_interior",    # (B + 1,) int64: ... its other vertices cv[body_interior[b]:...[b + 1]]
+    "tri",              # (T, 3) int32: every body's triangles, global vertex indices
+    "body_tri",         # (B + 1,) int64: body b's triangles are tri[body_tri[b]:body_tri[b + 1]]
     "ce_a", "ce_b",     # (Ec,) int32: outline edge ends, as collision-vertex indices
     "ce_body",          # (Ec,) int32: the edge's body
-    "thick_other",      # (V,) float64: contact thickness against other bodies (m)
+    "thick_other",      # (V,) float64: contact thickness against other bodies (m); a pair of two
+                        #   outlines uses the larger of its two bodies' (body_thickness)
     "thick_self",       # (V,) float64: ... against its own body (m)
     "body_flags",       # (B,) int32: COLLIDE | SELF_COLLIDE
+    "body_thickness",   # (B,) float64: each body's contact thickness (m)
     "body_friction",    # (B, 2) float64: dynamic, static coefficient for body contacts
-    "margin",           # (1,) float64: growth of the edge boxes (m), the largest thickness
+    "margin",           # (1,) float64: growth of the edge boxes (m): SPECULATIVE times the largest thickness
 ])
 
 ContactScratch = namedtuple("ContactScratch", [
     "xp",               # (V, 2): collision vertices at the start of the substep
     "active",           # (V,) int32: the collision vertices tested this substep (status[ST_ACTIVE] of them)
+    "mark",             # (V,) int64: the substep a vertex was last listed in active
     "body_box",         # (B, 4) float64: each body's swept box xmin, ymin, xmax, ymax
     "xq",               # (V, 2): ... when the grid was built
-    "xs",               # (V, 2): ... when crossings were last checked
-    "moved",            # (V,) uint8: moved since then
+    "dirty",            # (V,) int32: vertices the response moved since the last check (status[ST_DIRTY])
+    "dirty_mark",       # (V,) int64: the check generation (status[ST_GEN]) a vertex was listed in dirty
+    "touched",          # (V,) int32: every vertex the stage moved this substep (status[ST_TOUCHED])
+    "touched_mark",     # (V,) int64: the substep (status[ST_STAMP]) a vertex was listed in touched
+    "pair_ptr",         # (V + 1,) int64: CSR, the candidate pairs each vertex is part of (out.pair_index)
+    "pair_fill",        # (V,) int64: fill cursors for it
+    "zone_list",        # (V,) int32: the vertices in impact zones
+    "zone_mark",        # (V,) int64: the fail-safe call (status[ST_GEN]) a vertex joined a zone in
     "ebox",             # (Ec, 4) float64: edge boxes xmin, ymin, xmax, ymax as in the grid
     "ecell",            # (Ec, 4) int64: the cells they cover, ix0, iy0, ix1, iy1
     "cell_start",       # (T + 1,) int64: bucket starts (T a power of two)
@@ -129,7 +144,7 @@ ContactScratch = namedtuple("ContactScratch", [
     "grid",             # (3,) float64: origin x, origin y, 1 / cell size
     "parent",           # (V,) int32: impact zones (union-find)
     "zone",             # (V, 5) float64: zone sums m vx, m vy, m, members, still
-    "status",           # (7,) int64: see ST_*
+    "status",           # (10,) int64: see ST_*
 ])
 
 ContactBuffer = namedtuple("ContactBuffer", [
@@ -142,14 +157,18 @@ ContactBuffer = namedtuple("ContactBuffer", [
     "kind",             # (C,) int8: PROXIMITY or CROSSING
     "pair_vertex",      # (P,) int32: candidate pairs of the first narrow phase
     "pair_edge",        # (P,) int32
+    "pair_index",       # (3P,) int32: the pairs by vertex (ContactScratch.pair_ptr)
+    "pair_mark",        # (P,) int64: the check generation a pair was last selected in
+    "pair_sel",         # (P,) int32: the pairs one check tests
 ])
 
 
 def empty_topology(n_bodies: int = 0) -> ContactTopology:
     """A topology without collision vertices (no body collides)."""
     i32, f64, offsets = np.zeros(0, np.int32), np.zeros(0), np.zeros(n_bodies + 1, np.int64)
-    return ContactTopology(i32, i32, offsets, offsets, i32, i32, i32, f64, f64, np.zeros(n_bodies, np.int32),
-                           np.zeros((n_bodies, 2)), np.zeros(1))
+    return ContactTopology(i32, i32, i32, offsets, offsets, np.zeros((0, 3), np.int32), offsets, i32, i32, i32, f64,
+                           f64, np.zeros(n_bodies, np.int32),
+                           np.zeros(n_bodies), np.zeros((n_bodies, 2)), np.zeros(1))
 
 
 def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScratch:
@@ -158,11 +177,13 @@ def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScr
     while t < 2 * n_edges:
         t *= 2
     v = n_vertices
-    return ContactScratch(np.zeros((v, 2)), np.zeros(v, np.int32), np.zeros((n_bodies, 4)),
-                          np.zeros((v, 2)), np.zeros((v, 2)), np.zeros(v, np.uint8),
+    never = np.full(v, -1, np.int64)
+    return ContactScratch(np.zeros((v, 2)), np.zeros(v, np.int32), never.copy(), np.zeros((n_bodies, 4)),
+                          np.zeros((v, 2)), np.zeros(v, np.int32), never.copy(), np.zeros(v, np.int32), never.copy(),
+                          np.zeros(v + 1, np.int64), np.zeros(v, np.int64), np.zeros(v, np.int32), never.copy(),
                           np.zeros((n_edges, 4)), np.zeros((n_edges, 4), np.int64), np.zeros(t + 1, np.int64),
                           np.zeros(t, np.int64), np.zeros(16 * n_edges + 64, np.int32), np.zeros(3),
-                          np.zeros(v, np.int32), np.zeros((v, 5)), np.zeros(7, np.int64))
+                          np.zeros(v, np.int32), np.zeros((v, 5)), np.zeros(10, np.int64))
 
 
 def make_buffer(contacts: int, pairs: int) -> ContactBuffer:
@@ -171,6 +192,7 @@ def make_buffer(contacts: int, pairs: int) -> ContactBuffer:
     p = max(int(pairs), 16)
     return ContactBuffer(np.zeros(c, np.int32), np.zeros(c, np.int32), np.zeros(c), np.zeros((c, 2)), np.zeros(c),
                          np.zeros(c), np.zeros((c, 2)), np.zeros(c, np.int8), np.zeros(p, np.int32),
+                         np.zeros(p, np.int32), np.zeros(3 * p, np.int32), np.full(p, -1, np.int64),
                          np.zeros(p, np.int32))
 
 
@@ -397,7 +419,7 @@ def narrow_phase(x, topo, scr, out):
             continue
         inner = k >= n_outline  # not on the outline: only other bodies' outlines concern it
         i = cv[k]
-        grow = max(thick_other[k], thick_self[k])
+        grow = SPECULATIVE * max(thick_other[k], thick_self[k])
         bx0 = min(xp[k, 0], x[i, 0]) - grow
         bx1 = max(xp[k, 0], x[i, 0]) + grow
         by0 = min(xp[k, 1], x[i, 1]) - grow
@@ -436,40 +458,90 @@ def narrow_phase(x, topo, scr, out):
 
 
 @njit(cache=True)
+def index_pairs(topo, scr, out, n_pairs):
+    """For each collision vertex, the candidate pairs it is part of (as the vertex or an end of
+    the edge): a CSR in ``scr.pair_ptr`` / ``out.pair_index``."""
+    ptr, fill, index = scr.pair_ptr, scr.pair_fill, out.pair_index
+    pv, pe, ce_a, ce_b = out.pair_vertex, out.pair_edge, topo.ce_a, topo.ce_b
+    ptr[:] = 0
+    for m in range(n_pairs):
+        ptr[pv[m] + 1] += 1
+        ptr[ce_a[pe[m]] + 1] += 1
+        ptr[ce_b[pe[m]] + 1] += 1
+    for k in range(ptr.shape[0] - 1):
+        ptr[k + 1] += ptr[k]
+        fill[k] = ptr[k]
+    for m in range(n_pairs):
+        for k in (pv[m], ce_a[pe[m]], ce_b[pe[m]]):
+            index[fill[k]] = m
+            fill[k] += 1
+
+
+@njit(cache=True, inline="always")
+def _note_moved(k, dirty, dirty_mark, gen, touched, touched_mark, stamp, status):
+    # list vertex k as moved: for the next check (dirty) and for the collider pass (touched)
+    if dirty_mark[k] != gen:
+        dirty_mark[k] = gen
+        dirty[status[ST_DIRTY]] = k
+        status[ST_DIRTY] += 1
+    if touched_mark[k] != stamp:
+        touched_mark[k] = stamp
+        touched[status[ST_TOUCHED]] = k
+        status[ST_TOUCHED] += 1
+
+
+@njit(cache=True)
 def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
     """Test candidate pairs (:func:`pair_contact`) and store their contacts in ``out`` from ``first``.
 
-    Only pairs with a vertex moved since the last check are tested, unless ``every``; with
-    ``crossings_only`` only ``CROSSING`` contacts are kept. Returns the index after the last
-    contact stored, or ``-(needed)`` if they did not fit.
+    Every pair with ``every``; otherwise only the pairs of the vertices the response moved
+    since the last check (``scr.dirty``, found through the pair index of
+    :func:`index_pairs`), since a pair it left alone keeps its answer. With
+    ``crossings_only`` only ``CROSSING`` contacts are kept. Empties the dirty list. Returns
+    the index after the last contact stored, or ``-(needed)`` if they did not fit.
     """
     cv, body = topo.cv_vertex, topo.cv_body
     ce_a, ce_b, ce_body = topo.ce_a, topo.ce_b, topo.ce_body
-    thick_other, thick_self = topo.thick_other, topo.thick_self
+    thick_other, thick_self, body_thick = topo.thick_other, topo.thick_self, topo.body_thickness
+    n_outline = topo.body_interior[0]
     friction = topo.body_friction
-    xp, xs, moved = scr.xp, scr.xs, scr.moved
+    xp = scr.xp
     pair_vertex, pair_edge = out.pair_vertex, out.pair_edge
     o_vertex, o_edge, o_s, o_normal, o_depth, o_target, o_mu, o_kind = \
         out.vertex, out.edge, out.s, out.normal, out.depth, out.target, out.mu, out.kind
     cap = o_vertex.shape[0]
-    for m in range(scr.status[ST_ACTIVE]):
-        k = scr.active[m]
-        i = cv[k]
-        moved[k] = 1 if every or x[i, 0] != xs[k, 0] or x[i, 1] != xs[k, 1] else 0
-        xs[k, 0] = x[i, 0]
-        xs[k, 1] = x[i, 1]
+    status = scr.status
+    status[ST_GEN] += 1
+    n_sel = n_pairs
+    if not every:
+        gen = status[ST_GEN]
+        ptr, index, mark, sel, dirty = scr.pair_ptr, out.pair_index, out.pair_mark, out.pair_sel, scr.dirty
+        n_sel = 0
+        for d in range(status[ST_DIRTY]):
+            k = dirty[d]
+            for q in range(ptr[k], ptr[k + 1]):
+                m = index[q]
+                if mark[m] != gen:
+                    mark[m] = gen
+                    sel[n_sel] = m
+                    n_sel += 1
+    status[ST_DIRTY] = 0
     n = first
-    for m in range(n_pairs):
+    for q in range(n_sel):
+        m = q if every else out.pair_sel[q]
         k = pair_vertex[m]
         j = pair_edge[m]
         a = ce_a[j]
         b = ce_b[j]
-        if moved[k] == 0 and moved[a] == 0 and moved[b] == 0:
-            continue  # neither moved since the last check: its answer then still holds
         bk = body[k]
         eb = ce_body[j]
         own = eb == bk
-        thick = thick_self[k] if own else thick_other[k]
+        if own:
+            thick = thick_self[k]
+        elif k < n_outline:  # two outlines: both sides of the pair agree on the gap
+            thick = max(thick_other[k], body_thick[eb])
+        else:
+            thick = thick_other[k]
         i = cv[k]
         ia = cv[a]
         ib = cv[b]
@@ -495,22 +567,35 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
 
 # -- response ----------------------------------------------------------------------------------
 @njit(cache=True, inline="always")
-def _keep_out(x, v, i, x0, y0, rects, h):
-    # a vertex that the response moved into a collider meets it there and then: the collider
-    # response (infinite mass, its velocity rule and friction), after a bounding-box test
+def _keep_out(x, v, i, x0, y0, rects, reach2, h):
+    # A vertex that the response moved into a collider, or through a thin one since the start
+    # of the substep, meets it there and then: the collider response (infinite mass, its
+    # velocity rule and friction), after the same cheap tests as in the integrators' pass.
     px, py = x[i, 0], x[i, 1]
+    near = (px - x0) * (px - x0) + (py - y0) * (py - y0) > reach2
     for r in range(rects.shape[0]):
         if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
-            x[i, 0], x[i, 1], v[i, 0], v[i, 1], _, _, _, _ = collide_point(x0, y0, px, py, v[i, 0], v[i, 1],
-                                                                           rects, h)
-            return
+            near = True
+    if near:
+        x[i, 0], x[i, 1], v[i, 0], v[i, 1], _, _, _, _ = collide_point(x0, y0, px, py, v[i, 0], v[i, 1], rects, h)
 
 
 @njit(cache=True, inline="always")
-def _keep_out_three(x, v, xp, rects, h, ip, ia, ib, k, a, b):
-    _keep_out(x, v, ip, xp[k, 0], xp[k, 1], rects, h)
-    _keep_out(x, v, ia, xp[a, 0], xp[a, 1], rects, h)
-    _keep_out(x, v, ib, xp[b, 0], xp[b, 1], rects, h)
+def _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, k, a, b):
+    _keep_out(x, v, ip, xp[k, 0], xp[k, 1], rects, reach2, h)
+    _keep_out(x, v, ia, xp[a, 0], xp[a, 1], rects, reach2, h)
+    _keep_out(x, v, ib, xp[b, 0], xp[b, 1], rects, reach2, h)
+
+
+@njit(cache=True, inline="always")
+def _split(a, ip, ia, ib, wp, wa, wb, px, py):
+    # a change (px, py) of the pair, shared by the vertex and the edge's ends by inverse mass
+    a[ip, 0] += wp * px
+    a[ip, 1] += wp * py
+    a[ia, 0] -= wa * px
+    a[ia, 1] -= wa * py
+    a[ib, 0] -= wb * px
+    a[ib, 1] -= wb * py
 
 
 @njit(cache=True)
@@ -525,6 +610,14 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
     cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
     xp = scr.xp
     check_rects = rects.shape[0] > 0
+    reach2 = jump_reach(rects)
+    status = scr.status
+    dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
+    gen, stamp = status[ST_GEN], status[ST_STAMP]
+    for c in range(first, last):  # the vertices this solve may move
+        _note_moved(out.vertex[c], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
+        _note_moved(ce_a[out.edge[c]], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
+        _note_moved(ce_b[out.edge[c]], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
     inv_h = 1.0 / h
     for sweep in range(iterations):
         for c in range(first, last):
@@ -556,33 +649,19 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
                     dvt = coulomb(vt, jn, out.mu[c, 1], out.mu[c, 0]) - vt
                     px = (jn * nx + dvt * ny) / w   # the pair's impulse per unit inverse mass
                     py = (jn * ny - dvt * nx) / w
-                    v[ip, 0] += wp * px
-                    v[ip, 1] += wp * py
-                    v[ia, 0] -= wa * px
-                    v[ia, 1] -= wa * py
-                    v[ib, 0] -= wb * px
-                    v[ib, 1] -= wb * py
-                    # the positions follow the corrected velocities (no creep while stuck)
-                    x[ip, 0] += h * wp * px
-                    x[ip, 1] += h * wp * py
-                    x[ia, 0] -= h * wa * px
-                    x[ia, 1] -= h * wa * py
-                    x[ib, 0] -= h * wb * px
-                    x[ib, 1] -= h * wb * py
+                    _split(v, ip, ia, ib, wp, wa, wb, px, py)
+                    _split(x, ip, ia, ib, wp, wa, wb, h * px, h * py)  # positions follow: no creep
                     if check_rects:
-                        _keep_out_three(x, v, xp, rects, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]], ce_b[out.edge[c]])
+                        _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]],
+                                        ce_b[out.edge[c]])
             d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
             gap = out.target[c] - d
             if gap > 0.0:
                 lam = gap / w
-                x[ip, 0] += wp * lam * nx
-                x[ip, 1] += wp * lam * ny
-                x[ia, 0] -= wa * lam * nx
-                x[ia, 1] -= wa * lam * ny
-                x[ib, 0] -= wb * lam * nx
-                x[ib, 1] -= wb * lam * ny
+                _split(x, ip, ia, ib, wp, wa, wb, lam * nx, lam * ny)
                 if check_rects:
-                    _keep_out_three(x, v, xp, rects, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]], ce_b[out.edge[c]])
+                    _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]],
+                                    ce_b[out.edge[c]])
 
 
 @njit(cache=True)
@@ -596,13 +675,17 @@ def _find(parent, k):
 @njit(cache=True)
 def _refresh(x, topo, scr, out, margin, n_pairs):
     """Rebuild the grid and the candidate pairs if a vertex moved further than ``margin`` since
-    the grid was built; returns ``(pairs, rebuilt)`` (pairs negative if they did not fit)."""
+    the grid was built (only moved vertices can have); returns ``(pairs, rebuilt)`` (pairs
+    negative if they did not fit). After a rebuild every pair must be checked again."""
     cv, xq = topo.cv_vertex, scr.xq
-    for m in range(scr.status[ST_ACTIVE]):
-        k = scr.active[m]
+    for d in range(scr.status[ST_DIRTY]):
+        k = scr.dirty[d]
         if abs(x[cv[k], 0] - xq[k, 0]) > margin or abs(x[cv[k], 1] - xq[k, 1]) > margin:
             build_grid(x, topo, scr, margin)
-            return narrow_phase(x, topo, scr, out), True
+            n = narrow_phase(x, topo, scr, out)
+            if n >= 0:
+                index_pairs(topo, scr, out, n)
+            return n, True
     return n_pairs, False
 
 
@@ -610,37 +693,47 @@ def _refresh(x, topo, scr, out, margin, n_pairs):
 def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
     """The fail-safe: merge crossing pairs into rigidly translating zones until none is left.
 
-    Returns the number of merge rounds, or ``-(needed)`` if ``out`` is too small (then
-    ``scr.status`` says which part).
+    Checks the pairs of the vertices moved since the last check (``scr.dirty``), and keeps
+    its bookkeeping to the zones' members, so that a few crossings in a large heap cost
+    little. Returns the number of merge rounds, or ``-(needed)`` if ``out`` is too small
+    (then ``scr.status`` says which part).
     """
     cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
-    parent, zone, xp, active = scr.parent, scr.zone, scr.xp, scr.active
+    parent, zone, xp = scr.parent, scr.zone, scr.xp
+    zl, zm = scr.zone_list, scr.zone_mark
+    status = scr.status
+    dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
     margin = topo.margin[0]
-    na = scr.status[ST_ACTIVE]
-    for m in range(na):
-        parent[active[m]] = active[m]
-    for rounds in range(na + 1):
+    call = status[ST_GEN]  # marks this call's zone members
+    nz = 0
+    for rounds in range(status[ST_ACTIVE] + 1):
         n_pairs, rebuilt = _refresh(x, topo, scr, out, margin, n_pairs)
         if n_pairs < 0:
-            scr.status[ST_PAIRS_NEEDED] = -n_pairs
+            status[ST_PAIRS_NEEDED] = -n_pairs
             return n_pairs
         n = check_pairs(x, topo, scr, out, first, n_pairs, rebuilt, True)
         if n < 0:
-            scr.status[ST_NEEDED] = -n
+            status[ST_NEEDED] = -n
             return n
         if n == first:
             return rounds
         for c in range(first, n):
+            for q in (out.vertex[c], ce_a[out.edge[c]], ce_b[out.edge[c]]):
+                if zm[q] != call:
+                    zm[q] = call
+                    parent[q] = q
+                    zl[nz] = q
+                    nz += 1
             k = _find(parent, out.vertex[c])
             for q in (ce_a[out.edge[c]], ce_b[out.edge[c]]):
                 r = _find(parent, q)
                 if r != k:
                     parent[r] = k
         # zone sums: m vx, m vy, m, members, still (1: a pinned member, 2: pushed into a collider)
-        for m in range(na):
-            zone[active[m], :] = 0.0
-        for m in range(na):
-            k = active[m]
+        for m in range(nz):
+            zone[zl[m], :] = 0.0
+        for m in range(nz):
+            k = zl[m]
             r = _find(parent, k)
             i = cv[k]
             zone[r, 3] += 1.0
@@ -651,12 +744,11 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
                 zone[r, 0] += mass * v[i, 0]
                 zone[r, 1] += mass * v[i, 1]
                 zone[r, 2] += mass
+        gen, stamp = status[ST_GEN], status[ST_STAMP]
         frozen = False
-        for m in range(na):
-            k = active[m]
+        for m in range(nz):
+            k = zl[m]
             r = _find(parent, k)
-            if zone[r, 3] < 2.0:
-                continue
             i = cv[k]
             vx = 0.0
             vy = 0.0
@@ -667,21 +759,20 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
             v[i, 1] = vy
             x[i, 0] = xp[k, 0] + h * vx
             x[i, 1] = xp[k, 1] + h * vy
-            for q in range(rects.shape[0]):
-                if _inside(rects, q, x[i, 0], x[i, 1]):
-                    zone[r, 4] = 2.0
-                    frozen = True
+            _note_moved(k, dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
+            if path_hits(xp[k, 0], xp[k, 1], x[i, 0], x[i, 1], rects):
+                zone[r, 4] = 2.0
+                frozen = True
         if frozen:  # a zone pushed into a collider stays where it started (outside, like every start)
-            for m in range(na):
-                k = active[m]
-                r = _find(parent, k)
-                if zone[r, 3] >= 2.0 and zone[r, 4] == 2.0:
+            for m in range(nz):
+                k = zl[m]
+                if zone[_find(parent, k), 4] == 2.0:
                     i = cv[k]
                     v[i, 0] = 0.0
                     v[i, 1] = 0.0
                     x[i, 0] = xp[k, 0]
                     x[i, 1] = xp[k, 1]
-    return na + 1
+    return status[ST_ACTIVE] + 1
 
 
 @njit(cache=True)
@@ -698,6 +789,8 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h):
     status[ST_STAMP] += 1
     status[ST_CONTACTS] = 0
     status[ST_PAIRS] = 0
+    status[ST_DIRTY] = 0
+    status[ST_TOUCHED] = 0
     if topo.cv_vertex.shape[0] == 0 or _activate(x, topo, scr) == 0:
         return 0
     margin = topo.margin[0]
@@ -715,6 +808,7 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h):
     status[ST_PAIRS] = n_pairs
     if n0 == 0:
         return 0  # no contact and no crossing (a crossing is a contact too): nothing moved
+    index_pairs(topo, scr, out, n_pairs)
     solve_contacts(x, v, inv_mass, topo, scr, out, 0, n0, rects, h, CONTACT_ITERATIONS)
     end, n_pairs = _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h)
     if end < 0:
@@ -733,22 +827,28 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h):
 
 @njit(cache=True)
 def _collider_pass(x, v, topo, scr, rects, hits, h):
-    """The collider response (:func:`~deforma.physics.colliders.collide_point`) for every
-    collision vertex inside a collider; returns how many it moved."""
+    """The collider response (:func:`~deforma.physics.colliders.collide_point`) for every vertex
+    the stage moved into (or through) a collider; returns how many it moved, which it lists
+    as moved for the next check."""
     cv, xp = topo.cv_vertex, scr.xp
+    reach2 = jump_reach(rects)
+    status = scr.status
+    dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
     moved = 0
-    for m in range(scr.status[ST_ACTIVE]):
-        k = scr.active[m]
+    for m in range(status[ST_TOUCHED]):
+        k = touched[m]
         i = cv[k]
         px, py = x[i, 0], x[i, 1]
-        for r in range(rects.shape[0]):
-            if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX] \
-                    and _inside(rects, r, px, py):
-                x[i, 0], x[i, 1], v[i, 0], v[i, 1], hit, nx, ny, depth = collide_point(
-                    xp[k, 0], xp[k, 1], px, py, v[i, 0], v[i, 1], rects, h)
-                record_hit(hits, i, scr.status[ST_STAMP], hit, nx, ny, depth)
-                moved += 1
-                break
+        near = (px - xp[k, 0]) * (px - xp[k, 0]) + (py - xp[k, 1]) * (py - xp[k, 1]) > reach2
+        for r in range(rects.shape[0]):  # the integrators' cheap tests first
+            if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
+                near = True
+        if near and path_hits(xp[k, 0], xp[k, 1], px, py, rects):
+            x[i, 0], x[i, 1], v[i, 0], v[i, 1], hit, nx, ny, depth = collide_point(
+                xp[k, 0], xp[k, 1], px, py, v[i, 0], v[i, 1], rects, h)
+            record_hit(hits, i, status[ST_STAMP], hit, nx, ny, depth)
+            _note_moved(k, dirty, dirty_mark, status[ST_GEN], touched, touched_mark, status[ST_STAMP], status)
+            moved += 1
     return moved
 
 
@@ -826,11 +926,33 @@ def gather_start(x, topo, scr):
 
 
 @njit(cache=True)
+def _activate_folded(x, topo, scr, b, n):
+    """Append to ``scr.active`` the off-outline vertices of body ``b``'s turned-over triangles."""
+    tri, vertex_cv, active, mark = topo.tri, topo.vertex_cv, scr.active, scr.mark
+    n_outline = topo.body_interior[0]
+    stamp = scr.status[ST_STAMP]
+    for t in range(topo.body_tri[b], topo.body_tri[b + 1]):
+        i, j, k = tri[t, 0], tri[t, 1], tri[t, 2]
+        if (x[j, 0] - x[i, 0]) * (x[k, 1] - x[i, 1]) - (x[j, 1] - x[i, 1]) * (x[k, 0] - x[i, 0]) > 0.0:
+            continue
+        for q in (i, j, k):
+            c = vertex_cv[q]
+            if c >= n_outline and mark[c] != stamp:
+                mark[c] = stamp
+                active[n] = c
+                n += 1
+    return n
+
+
+@njit(cache=True)
 def _activate(x, topo, scr):
     """List the collision vertices to test this substep in ``scr.active``; returns how many.
 
-    Every outline vertex of a body with contacts on, and the other vertices of each
-    colliding body whose swept box (grown by the margin) overlaps another colliding body's.
+    Every outline vertex of a body with contacts on; and, of a colliding body whose swept
+    box (grown by the margin) overlaps another colliding body's, the other vertices of its
+    triangles that are turned over (or flat). Self contact keeps an outline from crossing
+    itself, and where no triangle is turned over a body lies inside its outline: only a
+    folded-over part can carry a vertex that is not on the outline into another body.
     """
     cv, flags, box, active = topo.cv_vertex, topo.body_flags, scr.body_box, scr.active
     n = 0
@@ -860,9 +982,7 @@ def _activate(x, topo, scr):
                     continue
                 if box[b, 0] - margin <= box[c, 2] and box[c, 0] - margin <= box[b, 2] \
                         and box[b, 1] - margin <= box[c, 3] and box[c, 1] - margin <= box[b, 3]:
-                    for k in range(topo.body_interior[b], topo.body_interior[b + 1]):
-                        active[n] = k
-                        n += 1
+                    n = _activate_folded(x, topo, scr, b, n)
                     break
     scr.status[ST_ACTIVE] = n
     return n

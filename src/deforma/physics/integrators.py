@@ -43,7 +43,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, record_hit
+from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, jump_reach, record_hit
 from .contacts import ST_STAMP, contact_stage, gather_start
 from .forces import spring_force
 from .jit import serial_and_parallel
@@ -183,6 +183,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
     across threads); both give the same result for the same chunks.
     """
     n_chunks = chunk_ptr.shape[0] - 1
+    reach2 = jump_reach(rects)
     for sub in range(substeps):
         gather_start(x, ctopo, cscr)
         stamp = cscr.status[ST_STAMP] + 1  # the contact stage counts this substep when it runs
@@ -219,7 +220,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
                 # lines, even inlined, costs reference counting on rects per vertex: 2.5x slower)
                 if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                     near = True
-            if near:
+            if near or (px - x0) * (px - x0) + (py - y0) * (py - y0) > reach2:  # or it may have jumped one
                 px, py, vx, vy, hit, nx, ny, depth = collide_point(x0, y0, px, py, vx, vy, rects, h)
                 if hit >= 0:
                     record_hit(hits, i, stamp, hit, nx, ny, depth)
@@ -361,7 +362,8 @@ class SymplecticEuler:
                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
                      model.spring_damping, model.vertex_inv_mass, float(gx), float(gy),
                      1.0 / (1.0 + float(h) * inputs.air_drag), inputs.grab_slot,
-                     inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch, inputs.contacts,
+                     inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch,
+                     inputs.contacts,
                      float(h), int(substeps), float(inputs.max_speed) ** 2)
         if may_parallel:
             took = (time.perf_counter() - start) / substeps

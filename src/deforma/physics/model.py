@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, ContactTopology, rest_clearance
+from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology, rest_clearance
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,9 +90,13 @@ class BodyTopology:
         if triangles is None:
             t = np.zeros((0, 3), np.int32)
         else:
-            t = np.ascontiguousarray(triangles, dtype=np.int32).reshape(-1, 3)
+            t = np.array(triangles, dtype=np.int32).reshape(-1, 3)  # a copy: oriented below
             if t.size and (t.min() < 0 or t.max() >= len(x)):
                 raise ValueError(f"triangle vertex indices must lie in [0, {len(x) - 1}]")
+            # counter-clockwise, as a Mesh stores them (any object with triangles is accepted)
+            a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
+            cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
+            t[cw] = t[cw][:, [0, 2, 1]]
         edges, verts, clearance = _boundary(x, t)
         return cls(x, np.ascontiguousarray(s), rest, t, edges, verts, clearance)
 
@@ -114,13 +118,10 @@ class BodyTopology:
 
 
 def _boundary(x: np.ndarray, t: np.ndarray):
-    """Directed boundary edges, boundary vertices and their rest clearances of one body."""
+    """Directed boundary edges, boundary vertices and their rest clearances of one body
+    (counter-clockwise triangles ``t``)."""
     if len(t) == 0:
         return np.zeros((0, 2), np.int32), np.zeros(0, np.int32), np.zeros(0)
-    t = t.copy()
-    a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
-    cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
-    t[cw] = t[cw][:, [0, 2, 1]]
     directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]).astype(np.int64)
     lo, hi = directed.min(axis=1), directed.max(axis=1)
     _, inverse, counts = np.unique(lo * len(x) + hi, return_inverse=True, return_counts=True)
@@ -231,12 +232,19 @@ class Model:
             cv.append(inner[b] + self.body_vertex_offsets[b])
             cb.append(np.full(len(inner[b]), b))
         v = int(body_interior[-1])
+        tris = [t.triangles + self.body_vertex_offsets[b] for b, t in enumerate(self.topologies)]
+        body_tri = np.zeros(nb + 1, np.int64)
+        np.cumsum([len(t) for t in tris], out=body_tri[1:])
+        tri = np.ascontiguousarray(np.concatenate([np.zeros((0, 3), np.int32)] + tris), dtype=np.int32)
 
         def i32(parts):
             return np.ascontiguousarray(np.concatenate(parts), dtype=np.int32)
-        self.contact = ContactTopology(i32(cv), i32(cb), body_outline, body_interior, i32(ea), i32(eb), i32(ebody),
-                                       np.zeros(v), np.zeros(v), np.zeros(nb, np.int32), np.zeros((nb, 2)),
-                                       np.zeros(1))
+        vertex_cv = np.full(n, -1, np.int32)
+        vertex_cv[i32(cv)] = np.arange(v, dtype=np.int32)
+        self.contact = ContactTopology(i32(cv), i32(cb), vertex_cv, body_outline, body_interior, tri, body_tri,
+                                       i32(ea), i32(eb), i32(ebody),
+                                       np.zeros(v), np.zeros(v), np.zeros(nb, np.int32), np.zeros(nb),
+                                       np.zeros((nb, 2)), np.zeros(1))
         for b in range(nb):
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
@@ -274,6 +282,7 @@ class Model:
         """
         c = self.contact
         c.body_flags[body] = (COLLIDE if collide else 0) | (SELF_COLLIDE if self_collision else 0)
+        c.body_thickness[body] = thickness
         c.body_friction[body, 0] = friction
         c.body_friction[body, 1] = static_friction
         k0, k1 = c.body_outline[body], c.body_outline[body + 1]
@@ -284,4 +293,4 @@ class Model:
         # fold): a hair of thickness, so that their contacts are crossings, put back just in front
         i0, i1 = c.body_interior[body], c.body_interior[body + 1]
         c.thick_other[i0:i1] = SIDE_MARGIN * thickness
-        c.margin[0] = float(c.thick_other.max()) if len(c.thick_other) else 0.0
+        c.margin[0] = SPECULATIVE * float(c.thick_other.max()) if len(c.thick_other) else 0.0

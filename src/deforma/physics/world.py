@@ -292,7 +292,8 @@ class Grab:
 class _StepInputs:
     """What the integrator reads besides the model and the state (see integrators.StepInputs)."""
 
-    __slots__ = ("gravity", "air_drag", "rects", "hits", "grab_slot", "grab_pull", "max_speed", "contact_scratch", "contacts")
+    __slots__ = ("gravity", "air_drag", "rects", "hits", "grab_slot", "grab_pull", "max_speed", "contact_scratch",
+                 "contacts")
 
 
 class World:

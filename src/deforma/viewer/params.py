@@ -69,11 +69,18 @@ GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
         Param("gravity_x", "Gravity x", "float", -20, 20, unit="m/s²"),
         Param("gravity_y", "Gravity y", "float", -20, 20, unit="m/s²"),
         Param("damping", "Damping", "float", 0.0, 10.0, unit="N·s/m", tip="spring damping kd"),
+        Param("air_drag", "Air drag", "float", 0.0, 5.0, unit="1/s", tip="velocities decay as -air_drag v"),
         Param("mass", "Mass", "float", 0.1, 20.0, log=True, unit="kg", tip="total mass of a body"),
         Param("stiffness", "Stiffness", "float", 10.0, 20000.0, log=True, unit="N/m", tip="spring constant ks"),
         Param("static_friction", "Static friction", "float", 0.0, 2.0),
         Param("friction", "Friction", "float", 0.0, 2.0),
         Param("explosive_force", "Explosive force", "float", 0.0, 30.0, unit="m/s", tip="the space key"),
+    )),
+    ("Contact", (
+        Param("contact_thickness", "Thickness", "float", 1e-4, 0.05, log=True, unit="m",
+              tip="how far apart touching bodies stay"),
+        Param("collide", "Collide", "bool", tip="the selected body touches other bodies"),
+        Param("self_collision", "Self collision", "bool", tip="the selected body touches itself"),
     )),
     ("Collision", (
         Param("collider_x", "Center x", "float", -20, 20, unit="m"),

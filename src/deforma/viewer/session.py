@@ -151,8 +151,14 @@ class Session:
         w = self.world
         if name in ("gravity_x", "gravity_y"):
             return w.gravity[0 if name == "gravity_x" else 1]
-        if name in ("dt", "substeps", "damping", "mass", "stiffness", "friction", "static_friction"):
+        if name in ("dt", "substeps", "damping", "mass", "stiffness", "friction", "static_friction", "air_drag"):
             return getattr(w, name)
+        if name == "contact_thickness":  # the world's, or the selected body's automatic one
+            if w.contact_thickness is not None or not w.bodies:
+                return w.contact_thickness
+            return w.bodies[self.body_index].contact_thickness
+        if name in ("collide", "self_collision"):
+            return getattr(w.bodies[self.body_index], name) if w.bodies else None
         if name == "explosive_force":
             return self.explosive_force
         if name == "mouse_strength":
@@ -184,8 +190,12 @@ class Session:
             if isinstance(value, float) and value.is_integer():
                 value = int(value)
             w.substeps = value
-        elif name in ("dt", "damping", "mass", "stiffness", "friction", "static_friction"):
+        elif name in ("dt", "damping", "mass", "stiffness", "friction", "static_friction", "air_drag",
+                      "contact_thickness"):
             setattr(w, name, value)
+        elif name in ("collide", "self_collision"):
+            if w.bodies:
+                setattr(w.bodies[self.body_index], name, bool(value))
         elif name == "explosive_force":
             v = float(value)
             if not (np.isfinite(v) and v >= 0):
