@@ -251,7 +251,10 @@ def _swept_entry(x0, y0, px, py, rects):
     first = 2.0
     t_in = 0.0
     t_out = 0.0
+    d2 = (px - x0) * (px - x0) + (py - y0) * (py - y0)
     for r in range(rects.shape[0]):
+        if d2 <= rects[r, RECT_REACH]:
+            continue  # moved less than this rectangle's half-thickness: it cannot have jumped it
         cx, cy, ux, uy = rects[r, RECT_CX], rects[r, RECT_CY], rects[r, RECT_UX], rects[r, RECT_UY]
         a0 = (x0 - cx) * ux + (y0 - cy) * uy
         b0 = (y0 - cy) * ux - (x0 - cx) * uy
@@ -329,12 +332,20 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
     >>> hit, round(py, 6), vy
     (0, 0.01, 0.0)
     """
-    inside = False
+    # the swept test only for a point that moved further than some rectangle's half-thickness
+    # (rare), and decided inline: a call per point would cost reference counting on rects
+    d2 = (px - x0) * (px - x0) + (py - y0) * (py - y0)
+    jumpy = False
     for r in range(rects.shape[0]):
-        if _inside(rects, r, px, py):
-            inside = True
-    if not inside:
-        px, py = _swept_entry(x0, y0, px, py, rects)
+        if d2 > rects[r, RECT_REACH]:
+            jumpy = True
+    if jumpy:
+        inside = False
+        for r in range(rects.shape[0]):
+            if _inside(rects, r, px, py):
+                inside = True
+        if not inside:
+            px, py = _swept_entry(x0, y0, px, py, rects)
     hit = False
     last = -1
     hx_n = 0.0
