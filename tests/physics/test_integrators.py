@@ -341,3 +341,17 @@ def test_runaway_under_a_stable_integrator_blames_the_force_not_dt(name):
         w.step()
     assert "has no step limit" in e.value.hint and "dt/substeps" not in e.value.hint
     assert np.isfinite(b.positions).all()
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_air_drag_slows_a_fall_to_the_terminal_speed_g_over_drag(name):
+    c = 2.0  # 1/s
+    w = deforma.World(dt=1 / 600, gravity=(0, -G), stiffness=100.0, damping=0.0, air_drag=c, integrator=name)
+    b = w.add_body(Chain([[0, 0], [1, 0]], [[0, 1]]), position=None)
+    for _ in range(300):  # 0.5 s: v(t) = -(g / c) (1 - exp(-c t)), met to O(h)
+        w.step()
+    assert b.velocities[:, 1].mean() == pytest.approx(-G / c * (1 - math.exp(-c * 0.5)), rel=2e-3)
+    for _ in range(3000):  # 5 s more: ten time constants
+        w.step()
+    assert b.velocities[:, 1].mean() == pytest.approx(-G / c, rel=1e-4)
+    assert np.abs(b.velocities[:, 0]).max() < 1e-12  # only along gravity

@@ -235,8 +235,8 @@ class ImplicitEuler:
                 v *= keep
             np.multiply(v, h, out=y)
             y += x
-            y[:, 0] += h2 * gx
-            y[:, 1] += h2 * gy
+            y[:, 0] += h2 * keep * gx  # so that free motion gives (v + h g) / (1 + h air_drag), as the
+            y[:, 1] += h2 * keep * gy  # other integrators do
             # x starts at x_n: the first iteration is then backward Euler linearised at the
             # start of the substep (Baraff & Witkin's one Newton step, with the directions
             # of x_n). Starting at the prediction y measured worse on impacts: y can already
