@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import deforma
+from deforma.physics import contacts
 from contact_checks import crossings, vertices_inside_other_bodies
 from physics_meshes import grid_mesh
 
@@ -243,6 +244,22 @@ def test_dragging_one_body_into_another_pushes_it_rather_than_passing_through():
     # the pull (50 N/m on 25 vertices, 2 m down) presses the box deep into the soft slab, whose
     # material flows aside; at no step did one pass through the other
     assert held.center_of_mass[1] < 0.8 and below.positions[:, 1].max() > 0.55
+
+
+def test_a_contact_buffer_too_small_grows_and_the_step_runs_again_from_its_start():
+    def world():
+        w = deforma.World(dt=1 / 600, substeps=4, stiffness=3000.0, damping=2.0)
+        w.add_collider(deforma.Rect((0, -0.5), (6, 1.0), 0.0))
+        for k in range(3):
+            w.add_body(grid_mesh(0.6, 0.3, 9, 5), position=(0.05 * k, 0.16 + 0.32 * k))
+        return w
+    roomy, tight = world(), world()
+    tight._inputs.contacts = contacts.make_buffer(16, 16)  # far fewer than these stacked bodies need
+    for _ in range(100):
+        roomy.step()
+        tight.step()
+    assert len(tight._inputs.contacts.pair_vertex) > 16 and len(tight._inputs.contacts.vertex) > 16
+    assert np.array_equal(tight._state.x, roomy._state.x)  # the same steps, bit for bit
 
 
 # -- switches and bad input ---------------------------------------------------------------------

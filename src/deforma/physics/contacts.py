@@ -1,60 +1,80 @@
 """Body-body and self contacts: collide (broad + narrow phase), then solve, then make sure.
 
 Every body with triangles has an *outline*: the mesh edges used by one triangle, directed so
-that the body is on their left (outer outlines counter-clockwise, holes clockwise). Its
-vertices are the *collision vertices*. A contact is a collision vertex ``p`` against an
-outline edge ``(a, b)`` of another body, or of its own body (self contact) if ``p`` is not
-one of its ends. The stage runs once per substep, after the integrator has moved every
+that the body is on their left (outer outlines counter-clockwise, holes clockwise). A
+contact is a vertex ``p`` against an outline edge ``(a, b)``: an outline vertex against the
+outline of another body, or of its own body (self contact) if ``p`` is not one of the
+edge's ends; and a vertex off the outline against another body's outline, where its body
+is folded (below). The stage runs once per substep, after the integrator has moved every
 vertex from ``x_prev`` to ``x``; the motion in between is taken as a straight line.
 
+0. **Which vertices.** Every outline vertex of a body with contacts on. Off the outline,
+   only the vertices of triangles turned over (or flat) in a body whose box overlaps
+   another colliding body's: self contact keeps an outline from crossing itself, and a body
+   whose triangles all keep their orientation lies inside its outline, so only a
+   folded-over part can carry such a vertex into another body. They get a hair of
+   thickness, so their contacts are crossings only.
 1. **Broad phase.** The swept box of every outline edge (its ends at both times, grown by
-   a margin, the largest contact thickness) goes into a uniform grid hashed into a table
-   twice as long as there are edges, with cells about the mean box size. Each collision
-   vertex looks up the cells its own swept box, grown by its thickness, covers; a pair is
-   listed once, in the cell of the low corner of the two boxes' overlap. Rebuilt every
-   substep: linear in the number of outline vertices, and nothing can go stale.
+   a margin: ``SPECULATIVE`` times the largest contact thickness) goes into a uniform grid
+   hashed into a table twice as long as there are edges, with cells about the mean box
+   size. Each vertex looks up the cells its own swept box (grown the same way by its own
+   thickness) covers; a pair is listed once, in the cell of the low corner of the two
+   boxes' overlap. Built anew every substep: linear in the number of outline vertices, and
+   nothing can go stale. (Keeping the pairs over several substeps in boxes grown by a
+   slack, as Box2D's fat boxes do, was measured and dropped: a heap of 200 bodies always
+   has a vertex that leaves its slack within a substep or two, and the stage per body grew
+   4x from the extra pairs.)
 2. **Narrow phase.** ``d`` is the signed distance of ``p`` from the edge's line (positive in
    front, outside the edge's body) and ``s`` where its foot lies on the edge (0 at ``a``,
    1 at ``b``), at the start (``d0``) and end (``d1``, ``s1``) of the substep. The side
    ``p`` starts on is the exact sign of ``d0``. A pair is a contact if ``p`` started in
-   front and ended closer than the contact thickness with its foot on the segment
+   front and ended within ``SPECULATIVE`` thicknesses in front, with its foot on the segment
    (``PROXIMITY``), or if its straight-line motion crossed the segment itself
    (``CROSSING``: continuous collision detection; the time at which ``p`` and the moving
    edge are collinear is a root of a quadratic, found by bisection on its sign change, and
    ``s`` at that time must lie in [0, 1]). A vertex that started behind an edge of another
    body is inside that body (only an overlap set up by hand does that) and may leave. A
    vertex behind an edge of its own body lies across a part of that body and must stay
-   there, so self pairs are watched from both sides.
+   there, so self pairs are watched from both sides. Two outlines use the larger of their
+   bodies' thicknesses, so that both sides of a pair agree on the gap.
 3. **Solve** (Gauss-Seidel over the contacts). Velocities first, once: the relative
-   velocity ``v_p - (1 - s) v_a - s v_b`` loses its inward normal part and gets Coulomb
-   friction (:func:`deforma.physics.friction.coulomb`, the rule colliders use), through one
-   impulse split by inverse mass (``w_p``, ``(1 - s) w_a``, ``s w_b``), so that linear
-   momentum is kept exactly; every vertex also moves by ``h`` times its velocity change, so
-   that a stuck vertex does not creep (the collider response's rule). Then positions, in
-   ``CONTACT_ITERATIONS`` sweeps: a vertex closer than its target is pushed out to it, split
-   by inverse mass the same way (positions only: no velocity, no momentum). A proximity
-   contact's target is the thickness. A crossing goes back to the distance it started at,
-   at most the thickness (and a hair off the line): every pair had its start distance at
-   once, so these targets never contradict each other, while two corners that meet level
-   cannot both be a thickness in front of the other's edge.
-4. **Verify.** Crossings are looked for again among the first pass's candidate pairs, but
-   only those with a vertex the response moved (a pair it left alone keeps its first
-   answer); a vertex moved further than the margin rebuilds the grid first. Crossings
-   found are solved together with those of earlier rounds (two that hold each other
-   converge only together), up to ``VERIFY_ROUNDS`` times. Then a fail-safe makes the
-   result crossing-free for sure: *impact zones* (Bridson, Fedkiw and Anderson 2002, with
-   translations only). The vertices of each remaining crossing merge into a zone that
-   moves as one rigid translation from its start positions at its mass-weighted mean
-   velocity (linear momentum kept); zones grow until no crossing is left. The start of the
-   substep had none and a translated zone keeps its members' relative positions, so this
-   ends, at worst with every collision vertex in one zone. A zone that the translation
-   would push into a collider stays where it started. It is needed where the response
-   cannot converge, e.g. a vertex at the tip of an outline crushed into a hairpin, which
-   would have to be in front of both faces at once.
+   velocity ``v_p - (1 - s) v_a - s v_b`` may approach the edge by what is left of the gap
+   to the target in the next substep, no more (a *speculative* contact: a loaded pair's
+   support never lapses, where it would pop out and back in); the excess goes, with
+   Coulomb friction (:func:`deforma.physics.friction.coulomb`, the rule colliders use),
+   through one impulse split by inverse mass (``w_p``, ``(1 - s) w_a``, ``s w_b``), so that
+   linear momentum is kept exactly. Every vertex also moves by ``h`` times its velocity
+   change, so that a stuck vertex does not creep (the collider response's rule). Then
+   positions, in ``CONTACT_ITERATIONS`` sweeps: a vertex closer than its target is pushed
+   out to it, split by inverse mass the same way (positions only: no velocity, no
+   momentum). A vertex this moves into (or through) a collider meets the collider at once
+   (:func:`~deforma.physics.colliders.collide_point`; colliders have infinite mass). A
+   proximity contact's target is the thickness. A crossing goes back to the distance it
+   started at, at most the thickness (and a hair off the line): every pair had its start
+   distance at once, so these targets never contradict each other, while two corners that
+   meet level cannot both be a thickness in front of the other's edge.
+4. **Verify.** Crossings are looked for again, among the candidate pairs of the vertices
+   the response moved (a pair it left alone keeps its answer; a vertex-to-pair index finds
+   them, so the work follows what moved, not the size of the world); a vertex moved
+   further than the margin rebuilds the grid first. Crossings found are solved together
+   with those of earlier rounds (two that hold each other converge only together), up to
+   ``VERIFY_ROUNDS`` times. Then a fail-safe makes the result crossing-free for sure:
+   *impact zones* (Bridson, Fedkiw and Anderson 2002, with translations only). The
+   vertices of each remaining crossing merge into a zone that moves as one rigid
+   translation from its start positions at its mass-weighted mean velocity (linear
+   momentum kept); zones grow until no crossing is left. The start of the substep had none
+   and a translated zone keeps its members' relative positions, so this ends. A zone that
+   the translation would push into (or through) a collider stays where it started. It is
+   needed where the response cannot converge, e.g. a vertex at the tip of an outline
+   crushed into a hairpin, which would have to be in front of both faces at once.
+5. **Colliders last.** Every vertex the stage moved and left in or through a collider gets
+   the collider response, and if that moved any, the check and fail-safe of step 4 run
+   again on what it moved.
 
-What is guaranteed: at the end of every substep no outline crosses another or itself, if
-none did at its start. An interior vertex can still leave its own body through inverted
-triangles (the springs model lets a mesh fold; see ``docs/physics.md``).
+What is guaranteed: if no outline crossed another or itself and no vertex lay inside
+another body at the start of a substep, the same holds at its end (tested at every step of
+the 10 s ``pile`` scene by ``tests/physics/contact_checks.py``, which is independent of this
+module).
 
 The contact thickness keeps resting bodies a hair apart, so resting contact is found by the
 cheap proximity test and the crossing test is the exception.
@@ -209,7 +229,7 @@ def build_grid(x, topo, scr, margin):
     The swept box spans the edge's ends at the start (``scr.xp``) and now (``x``). Returns
     the number of edges in the grid.
     """
-    ce_a, ce_b, cv = topo.ce_a, topo.ce_b, topo.cv_vertex
+    ce_a, ce_b, ce_body, cv = topo.ce_a, topo.ce_b, topo.ce_body, topo.cv_vertex
     flags = topo.body_flags
     xp, ebox, ecell = scr.xp, scr.ebox, scr.ecell
     n_edges = ce_a.shape[0]
@@ -218,7 +238,7 @@ def build_grid(x, topo, scr, margin):
     ox = np.inf
     oy = np.inf
     for j in range(n_edges):
-        if flags[topo.ce_body[j]] == 0:
+        if flags[ce_body[j]] == 0:
             ebox[j, 0] = np.inf  # never overlaps anything
             continue
         a = ce_a[j]
@@ -407,12 +427,13 @@ def narrow_phase(x, topo, scr, out):
     start, items = scr.cell_start, scr.cell_items
     pair_vertex, pair_edge = out.pair_vertex, out.pair_edge
     ox, oy, inv = scr.grid[0], scr.grid[1], scr.grid[2]
+    active = scr.active  # namedtuple fields read once: each read in a loop costs reference counting
     mask = np.int64(scr.cell_fill.shape[0] - 1)
     pcap = pair_vertex.shape[0]
     n_outline = topo.body_interior[0]
     n = 0
     for m in range(scr.status[ST_ACTIVE]):
-        k = scr.active[m]
+        k = active[m]
         bk = body[k]
         fk = flags[bk]
         if fk == 0:
@@ -510,6 +531,7 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
     o_vertex, o_edge, o_s, o_normal, o_depth, o_target, o_mu, o_kind = \
         out.vertex, out.edge, out.s, out.normal, out.depth, out.target, out.mu, out.kind
     cap = o_vertex.shape[0]
+    pair_sel = out.pair_sel
     status = scr.status
     status[ST_GEN] += 1
     n_sel = n_pairs
@@ -528,7 +550,7 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
     status[ST_DIRTY] = 0
     n = first
     for q in range(n_sel):
-        m = q if every else out.pair_sel[q]
+        m = q if every else pair_sel[q]
         k = pair_vertex[m]
         j = pair_edge[m]
         a = ce_a[j]
@@ -608,6 +630,7 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
     sweeps settle with the colliders in place.
     """
     cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    o_vertex, o_edge, o_s, o_normal, o_target, o_mu = out.vertex, out.edge, out.s, out.normal, out.target, out.mu
     xp = scr.xp
     check_rects = rects.shape[0] > 0
     reach2 = jump_reach(rects)
@@ -615,16 +638,16 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
     dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
     gen, stamp = status[ST_GEN], status[ST_STAMP]
     for c in range(first, last):  # the vertices this solve may move
-        _note_moved(out.vertex[c], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
-        _note_moved(ce_a[out.edge[c]], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
-        _note_moved(ce_b[out.edge[c]], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
+        _note_moved(o_vertex[c], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
+        _note_moved(ce_a[o_edge[c]], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
+        _note_moved(ce_b[o_edge[c]], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
     inv_h = 1.0 / h
     for sweep in range(iterations):
         for c in range(first, last):
-            ip = cv[out.vertex[c]]
-            ia = cv[ce_a[out.edge[c]]]
-            ib = cv[ce_b[out.edge[c]]]
-            s = out.s[c]
+            ip = cv[o_vertex[c]]
+            ia = cv[ce_a[o_edge[c]]]
+            ib = cv[ce_b[o_edge[c]]]
+            s = o_s[c]
             ca = 1.0 - s
             wp = inv_mass[ip]
             wa = inv_mass[ia] * ca
@@ -632,36 +655,36 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
             w = wp + wa * ca + wb * s
             if w <= 0.0:
                 continue  # both sides pinned
-            nx = out.normal[c, 0]
-            ny = out.normal[c, 1]
+            nx = o_normal[c, 0]
+            ny = o_normal[c, 1]
             if sweep == 0:
                 # Speculative: a pair still farther than its target may approach by what is
                 # left of the gap in the next substep, no more; closer pairs may not approach.
                 # So a resting pair's support never lapses (it would pop out and back in).
                 d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
-                allowed = -max(d - out.target[c], 0.0) * inv_h
+                allowed = -max(d - o_target[c], 0.0) * inv_h
                 rvx = v[ip, 0] - ca * v[ia, 0] - s * v[ib, 0]
                 rvy = v[ip, 1] - ca * v[ia, 1] - s * v[ib, 1]
                 vn = rvx * nx + rvy * ny
                 if vn < allowed:
                     jn = allowed - vn
                     vt = ny * rvx - nx * rvy        # along t = (ny, -nx)
-                    dvt = coulomb(vt, jn, out.mu[c, 1], out.mu[c, 0]) - vt
+                    dvt = coulomb(vt, jn, o_mu[c, 1], o_mu[c, 0]) - vt
                     px = (jn * nx + dvt * ny) / w   # the pair's impulse per unit inverse mass
                     py = (jn * ny - dvt * nx) / w
                     _split(v, ip, ia, ib, wp, wa, wb, px, py)
                     _split(x, ip, ia, ib, wp, wa, wb, h * px, h * py)  # positions follow: no creep
                     if check_rects:
-                        _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]],
-                                        ce_b[out.edge[c]])
+                        _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, o_vertex[c], ce_a[o_edge[c]],
+                                        ce_b[o_edge[c]])
             d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
-            gap = out.target[c] - d
+            gap = o_target[c] - d
             if gap > 0.0:
                 lam = gap / w
                 _split(x, ip, ia, ib, wp, wa, wb, lam * nx, lam * ny)
                 if check_rects:
-                    _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, out.vertex[c], ce_a[out.edge[c]],
-                                    ce_b[out.edge[c]])
+                    _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, o_vertex[c], ce_a[o_edge[c]],
+                                    ce_b[o_edge[c]])
 
 
 @njit(cache=True)
@@ -698,7 +721,7 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
     little. Returns the number of merge rounds, or ``-(needed)`` if ``out`` is too small
     (then ``scr.status`` says which part).
     """
-    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    cv, ce_a, ce_b, o_vertex, o_edge = topo.cv_vertex, topo.ce_a, topo.ce_b, out.vertex, out.edge
     parent, zone, xp = scr.parent, scr.zone, scr.xp
     zl, zm = scr.zone_list, scr.zone_mark
     status = scr.status
@@ -718,14 +741,14 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
         if n == first:
             return rounds
         for c in range(first, n):
-            for q in (out.vertex[c], ce_a[out.edge[c]], ce_b[out.edge[c]]):
+            for q in (o_vertex[c], ce_a[o_edge[c]], ce_b[o_edge[c]]):
                 if zm[q] != call:
                     zm[q] = call
                     parent[q] = q
                     zl[nz] = q
                     nz += 1
-            k = _find(parent, out.vertex[c])
-            for q in (ce_a[out.edge[c]], ce_b[out.edge[c]]):
+            k = _find(parent, o_vertex[c])
+            for q in (ce_a[o_edge[c]], ce_b[o_edge[c]]):
                 r = _find(parent, q)
                 if r != k:
                     parent[r] = k
@@ -885,8 +908,9 @@ def _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h):
 @njit(cache=True)
 def _colliding_bodies(topo):
     n = 0
-    for b in range(topo.body_flags.shape[0]):
-        if topo.body_flags[b] & COLLIDE:
+    flags = topo.body_flags
+    for b in range(flags.shape[0]):
+        if flags[b] & COLLIDE:
             n += 1
     return n
 
@@ -948,7 +972,8 @@ def _activate_folded(x, topo, scr, b, n):
 def _activate(x, topo, scr):
     """List the collision vertices to test this substep in ``scr.active``; returns how many.
 
-    Every outline vertex of a body with contacts on; and, of a colliding body whose swept
+    None if nothing can touch (no self contact and fewer than two colliding bodies). Else
+    every outline vertex of a body with contacts on; and, of a colliding body whose swept
     box (grown by the margin) overlaps another colliding body's, the other vertices of its
     triangles that are turned over (or flat). Self contact keeps an outline from crossing
     itself, and where no triangle is turned over a body lies inside its outline: only a
@@ -956,6 +981,12 @@ def _activate(x, topo, scr):
     """
     cv, flags, box, active = topo.cv_vertex, topo.body_flags, scr.body_box, scr.active
     n = 0
+    touching = _colliding_bodies(topo) >= 2
+    for b in range(flags.shape[0]):
+        touching = touching or (flags[b] & SELF_COLLIDE) != 0
+    if not touching:  # one colliding body, without self contact: nothing can touch
+        scr.status[ST_ACTIVE] = 0
+        return 0
     for b in range(flags.shape[0]):
         if flags[b] != 0:
             for k in range(topo.body_outline[b], topo.body_outline[b + 1]):

@@ -35,7 +35,7 @@ class BodyTopology:
         Edges used by one triangle, directed with the body on their left (outer outlines
         counter-clockwise, holes clockwise); empty without triangles.
     boundary_vertices : (V,) int32
-        The vertices on those edges, sorted: the body's collision vertices.
+        The vertices on those edges, sorted: the body's outline.
     boundary_clearance : (V,) float64
         Per boundary vertex, at rest: how far it lies in front of the nearest other boundary
         edge (``inf`` beyond twice the shortest boundary edge); see
@@ -159,9 +159,9 @@ class Model:
     body_vertex_offsets, body_spring_offsets : (B + 1,) int64
         Where each body's vertices and springs start.
     contact : ContactTopology
-        Every body's boundary as the contact stage reads it (collision vertices, boundary
-        edges, per-vertex contact thickness, per-body flags and friction); see
-        :mod:`deforma.physics.contacts`.
+        Every body as the contact stage reads it (outline and other vertices, outline edges,
+        triangles, per-vertex contact thickness, per-body flags, thickness and friction);
+        see :mod:`deforma.physics.contacts`.
 
     Examples
     --------

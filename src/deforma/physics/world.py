@@ -362,7 +362,6 @@ class World:
         self._model = Model([], masses=[], stiffness=[], damping=[])
         self._state = State.empty()
         self._contact_thickness = None
-        self._contact_failsafe = 0
         self._make_contact_scratch()
         self.time = 0.0
         self.step_count = 0
@@ -528,11 +527,13 @@ class World:
         mass, stiffness, damping : float, optional
             Total mass (kg), spring constant (N/m) and damping (N*s/m); ``None`` follows the world.
         collide : bool, optional
-            Touch other bodies (default). Off, the body passes through every other body.
+            Touch other bodies (default). Off, the body passes through every other body; in
+            a heap that saves most of the step (the contact stage is 80-90% of it there).
         self_collision : bool, optional
-            Touch itself (default): its outline cannot fold through itself. Off, it saves
-            the self-contact tests of its boundary (about a tenth of a plain step for a body
-            alone; see ``docs/benchmarks.md``).
+            Touch itself (default): its outline cannot fold through itself. A body at rest
+            pays nothing measurable (a 1e3- and a 1e5-vertex body: 1.00x and 1.03x the step
+            without it); a small body that flexes and touches itself most substeps pays
+            more (the ``demo`` scene's bunny: 1.6x; ``docs/benchmarks.md``).
         friction, static_friction : float, optional
             Coulomb coefficients against other bodies and itself (>= 0); ``None`` follows the
             world's. Two bodies use ``sqrt(a * b)`` of theirs; colliders use their own.
