@@ -15,6 +15,10 @@ body stays about the same from 10 to 200 bodies.
 half its stable step) with its self contact on (the default: the stage tests its 1,260
 outline vertices every substep) and off, timed the same way.
 
+*The demo's bunny.* The ``demo`` scene's first 4 s with the bunny's self contact on and
+off: a small body (~1,000 vertices) that flexes and touches itself most substeps, where the
+stage's fixed cost per substep shows.
+
 Command: ``python benchmarks/run.py --only contacts`` (``--quick`` stops at 50 bodies and a
 100 x 100 body).
 """
@@ -137,7 +141,30 @@ def run(quick: bool = False) -> list[Row]:
     rows.append(Row("contacts", f"one body, {body.n_vertices} vertices: step with self contact", on, "s",
                     f"{on / off:.2f}x the step without it", "<= 1.3x (with the stage on)", on / off <= 1.3))
     rows.append(Row("contacts", f"one body, {body.n_vertices} vertices: step, self contact off", off, "s"))
+    rows += demo_rows(rounds=3 if quick else 7)
     return rows
+
+
+def demo_rows(*, rounds: int) -> list[Row]:
+    """The ``demo`` scene's first 4 s (the bunny lands, flexes and rolls: self contacts most
+    substeps), with its self contact on and off, in turns from a fresh load."""
+    from deforma.scene.build import load_scene
+
+    times = {True: [], False: []}
+    for _ in range(rounds):
+        for on in (True, False):
+            w = load_scene("demo")
+            w.bodies[0].self_collision = on
+            n = round(4.0 / w.dt)
+            w.step()
+            t0 = time.perf_counter()
+            for _ in range(n):
+                w.step()
+            times[on].append(time.perf_counter() - t0)
+    on, off = statistics.median(times[True]), statistics.median(times[False])
+    return [Row("contacts", "demo scene, 4 s: physics with self contact", on, "s",
+                f"{on / off:.2f}x the same without it"),
+            Row("contacts", "demo scene, 4 s: physics, self contact off", off, "s")]
 
 
 if __name__ == "__main__":

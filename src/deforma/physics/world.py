@@ -530,10 +530,10 @@ class World:
             Touch other bodies (default). Off, the body passes through every other body; in
             a heap that saves most of the step (the contact stage is 80-90% of it there).
         self_collision : bool, optional
-            Touch itself (default): its outline cannot fold through itself. A body at rest
-            pays nothing measurable (a 1e3- and a 1e5-vertex body: 1.00x and 1.03x the step
-            without it); a small body that flexes and touches itself most substeps pays
-            more (the ``demo`` scene's bunny: 1.6x; ``docs/benchmarks.md``).
+            Touch itself (default): its outline cannot fold through itself. The cost follows
+            the outline, not the body: a 1e5-vertex body at rest measured 1.3x a bare step
+            without it (which is only ~2 ms); a small body that flexes and touches itself
+            most substeps pays about 2x (the ``demo`` scene's bunny; ``docs/benchmarks.md``).
         friction, static_friction : float, optional
             Coulomb coefficients against other bodies and itself (>= 0); ``None`` follows the
             world's. Two bodies use ``sqrt(a * b)`` of theirs; colliders use their own.
