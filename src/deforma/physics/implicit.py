@@ -27,19 +27,23 @@ rigid rotation (a spinning body keeps spinning).
 
 The mouse pull is in the matrix (it changes ``A``'s diagonal, so a new grab or release
 refactors; moving a held grab changes only the right-hand side). Gravity is in ``y``.
-Collisions and friction are the shared leaf :func:`~deforma.physics.colliders.collide_point`
-applied after each substep's solve with ``x_before = x_n`` and ``v = (x - x_n) / h``, as in
-the symplectic path.
+
+Collider contacts are inside the solve (the projective-dynamics way). The vertices whose
+prediction ``y`` lies inside a collider are listed with the plane of the face they would
+leave by (:func:`~deforma.physics.colliders.contact_planes`); each gets the term
+``k_c/2 |x - P(x)|^2``, ``k_c = contact_weight * A_ii``, whose local step
+(:func:`contact_rhs`) projects the iterate onto the outside of the plane with Coulomb
+friction at position level, and whose weight joins ``A``'s diagonal. A vertex already
+outside projects to itself, so an inactive contact exerts no force at convergence. A new
+contact set refactors; a resting or sliding body keeps its set, and its factor, for many
+steps (docs/integrators.md says why this and not an iterative solve). After the solve the
+shared collider response (:func:`~deforma.physics.colliders.finish_position_step`) and the
+body contact stage run as in the symplectic path, so nothing ends inside a collider or
+across an outline; body-body contacts act only there, after the solve.
 
 With a fixed number of iterations per substep (``iterations``, default 3) the solution is
 approximate where springs turn (the local step lags one iteration); along a spring it is
-exact after one iteration (two masses on one spring are solved exactly).
-
-Contacts are resolved after the solve, not inside it, so within one substep the solve does
-not know the floor: a body hitting a collider at speed ``u`` moves ``h u`` into it before
-the bottom vertices are put back. When ``h u`` is a good part of the spacing between
-vertices the bottom rows can be pushed through each other and the mesh folds (springs alone
-do not resist inversion); raise ``substeps`` for fast impacts (see ``docs/integrators.md``). Backward Euler is
+exact after one iteration (two masses on one spring are solved exactly). Backward Euler is
 unconditionally stable and dissipates: a mode of angular frequency ``omega`` loses the
 factor ``1 / (1 + (h omega)^2)`` of its energy per substep.
 
@@ -53,7 +57,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from .colliders import finish_position_step
+from .colliders import contact_planes, finish_position_step
 from .contacts import ST_STAMP, contact_stage, gather_start
 from .integrators import register_integrator
 
@@ -126,6 +130,47 @@ def implicit_rhs(x, x_n, y, vertex_mass, spring_i, spring_j, rest, wk, wd, grab_
         b[j, 1] += ty
 
 
+@njit(cache=True)
+def contact_rhs(x, x_n, planes, index, count, weight, b):
+    """Add the collider contacts' local step to ``b``: each listed vertex pulled, with its
+    ``weight`` (kg), to its projection onto the outside of its contact plane, with
+    Coulomb friction at position level.
+
+    ``push`` is how far the vertex is inside (0 if outside: an inactive contact projects
+    to itself and exerts no force at convergence). Along the plane the target is where
+    the vertex started the substep (it sticks) if that is within ``static_friction *
+    push``; otherwise the vertex is held back by ``friction * push``. Normal and
+    tangential pulls share the weight, so their ratio is the force ratio: Coulomb's cone.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> b = np.zeros((1, 2))
+    >>> x, x_n = np.array([[0.3, -0.1]]), np.array([[0.0, 0.5]])
+    >>> floor = np.array([[0.0, 1.0, 0.0, 0.5, 0.3]])
+    >>> contact_rhs(x, x_n, floor, np.zeros(1, np.int32), 1, np.array([2.0]), b)
+    >>> b.round(9).tolist()  # slid 0.3 m, more than 0.5 * 0.1: held back by 0.3 * 0.1
+    [[0.54, 0.0]]
+    """
+    for k in range(count):
+        i = index[k]
+        nx, ny = planes[k, 0], planes[k, 1]
+        gap = x[i, 0] * nx + x[i, 1] * ny - planes[k, 2]
+        px, py = x[i, 0], x[i, 1]
+        if gap < 0.0:
+            push = -gap
+            px += push * nx
+            py += push * ny
+            # tangential motion since the substep began (t = (-ny, nx))
+            slide = (x_n[i, 0] - x[i, 0]) * -ny + (x_n[i, 1] - x[i, 1]) * nx
+            if abs(slide) > planes[k, 3] * push:
+                slide = planes[k, 4] * push * (1.0 if slide > 0.0 else -1.0)
+            px -= slide * ny
+            py += slide * nx
+        b[i, 0] += weight[k] * px
+        b[i, 1] += weight[k] * py
+
+
 def system_matrix(model, grab_slot, grab_pull, h: float) -> sp.csc_matrix:
     """The constant global matrix ``M + L_w + h^2 S_grab`` (N x N, kg), sparse CSC.
 
@@ -168,9 +213,12 @@ class ImplicitEuler:
         one pair of triangular solves. Three keep a 1e5-vertex step at 1/60 s within 0.1 s
         here (0.071 s; four took 0.089 s) and measured within 0.3% of four in the resting
         height of a 1e4-vertex body (``benchmarks/bench_integrators.py --sag``).
+    contact_weight : float
+        Weight of a collider contact in the solve, in multiples of the vertex's own
+        diagonal entry (default 10; larger holds contacts tighter in few iterations).
     factorizations : int
-        How many times the matrix was factored (refactoring follows parameter, ``h`` and
-        grab changes).
+        How many times the matrix was factored (refactoring follows parameter, ``h``,
+        grab and collider-contact-set changes).
 
     Examples
     --------
@@ -184,31 +232,45 @@ class ImplicitEuler:
 
     def __init__(self):
         self.iterations = 3
+        self.contact_weight = 10.0
         self.factorizations = 0
         self._key = None
+        self._touching = None
         self._lu = None
         self._scratch_n = -1
 
-    def _factor_if_needed(self, model, inputs, h):
+    def _factor_if_needed(self, model, inputs, h, touching):
         # Everything the matrix depends on; compared by value every step (O(N + E), a few
-        # percent of a solve) so live parameter changes are never missed.
+        # percent of a solve) so live parameter changes are never missed. The vertices in
+        # collider contact add their weight to the diagonal: a new set refactors.
         key = self._key
-        if (key is None or key[0] is not model or key[1] != h
-                or not np.array_equal(key[2], model.vertex_mass)
-                or not np.array_equal(key[3], model.spring_stiffness)
-                or not np.array_equal(key[4], model.spring_damping)
-                or not np.array_equal(key[5], inputs.grab_slot)
-                or not np.array_equal(key[6], inputs.grab_pull[:, 0])):
-            a = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h)
-            # A is symmetric positive definite: no pivoting needed, and a symmetric ordering
-            # (minimum degree on A + A^T) gave 40% less fill than COLAMD on a 1e5 mesh.
-            self._lu = spla.splu(a, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                                 options=dict(SymmetricMode=True))
+        same_base = not (key is None or key[0] is not model or key[1] != h
+                         or not np.array_equal(key[2], model.vertex_mass)
+                         or not np.array_equal(key[3], model.spring_stiffness)
+                         or not np.array_equal(key[4], model.spring_damping)
+                         or not np.array_equal(key[5], inputs.grab_slot)
+                         or not np.array_equal(key[6], inputs.grab_pull[:, 0]))
+        if same_base and np.array_equal(self._touching, touching):
+            return
+        if not same_base:
+            self._a = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h)
+            self._diag = self._a.diagonal()
             self._key = (model, h, model.vertex_mass.copy(), model.spring_stiffness.copy(),
                          model.spring_damping.copy(), inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy())
             self._wk = h * h * model.spring_stiffness
             self._wd = h * model.spring_damping
-            self.factorizations += 1
+        self._touching = touching.copy()
+        self._contact_weight = self.contact_weight * self._diag[touching]
+        a = self._a
+        if len(touching):
+            extra = np.zeros(model.n_vertices)
+            extra[touching] = self._contact_weight
+            a = (a + sp.diags(extra)).tocsc()
+        # A is symmetric positive definite: no pivoting needed, and a symmetric ordering
+        # (minimum degree on A + A^T) gave 40% less fill than COLAMD on a 1e5 mesh.
+        self._lu = spla.splu(a, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                             options=dict(SymmetricMode=True))
+        self.factorizations += 1
 
     def advance(self, model, state, inputs, h, substeps):
         if isinstance(self.iterations, bool) or not isinstance(self.iterations, (int, np.integer)) \
@@ -219,8 +281,9 @@ class ImplicitEuler:
             self._x_n = np.empty((n, 2))
             self._y = np.empty((n, 2))
             self._b = np.empty((n, 2))
+            self._planes = np.empty((n, 5))
+            self._touch = np.empty(n, np.int32)
             self._scratch_n = n
-        self._factor_if_needed(model, inputs, h)
         x, v = state.x, state.v
         x_n, y, b = self._x_n, self._y, self._b
         gx, gy = inputs.gravity
@@ -229,6 +292,7 @@ class ImplicitEuler:
         np.copyto(state.x_start, x)
         np.copyto(state.v_start, v)
         keep = 1.0 / (1.0 + h * inputs.air_drag)
+        margin = 0.0  # only vertices headed inside: a listed one is held near its iterate
         for _ in range(substeps):
             np.copyto(x_n, x)
             if keep != 1.0:  # air drag, split off before the solve (stable at any h)
@@ -241,9 +305,13 @@ class ImplicitEuler:
             # start of the substep (Baraff & Witkin's one Newton step, with the directions
             # of x_n). Starting at the prediction y measured worse on impacts: y can already
             # have a row of vertices pushed through the next, and the iteration keeps it.
-            for _ in range(self.iterations):
+            count = contact_planes(x_n, y, inputs.rects, margin, self._planes, self._touch)
+            self._factor_if_needed(model, inputs, h, self._touch[:count])
+            for it in range(self.iterations):
                 implicit_rhs(x, x_n, y, model.vertex_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              self._wk, self._wd, inputs.grab_slot, inputs.grab_pull, h2, b)
+                # the first projection is of the prediction: where the vertex is headed
+                contact_rhs(y if it == 0 else x, x_n, self._planes, self._touch, count, self._contact_weight, b)
                 x[...] = self._lu.solve(b)
             scr = inputs.contact_scratch
             bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
