@@ -1,4 +1,5 @@
-"""Small meshes for the physics tests, built without deforma.mesh.box (not a dependency here)."""
+"""Small meshes for the physics tests, built without deforma.mesh.box (not a dependency here),
+and the slide measurement they share."""
 
 import math
 
@@ -42,3 +43,17 @@ def random_body(world, seed, *, self_collision=True):
     b.positions[:] += rng.normal(scale=0.03, size=b.positions.shape)
     b.velocities[:] = rng.normal(scale=0.5, size=b.velocities.shape)
     return b
+
+
+def slide_acceleration(world, body, along, *, steps, after):
+    """Step ``world`` ``steps`` times; the acceleration (m/s^2) of ``body``'s centre of mass
+    down the direction ``-along``, fitted as a parabola to the times past ``after`` s, and the
+    positions along ``along`` at every step."""
+    times, where = [], []
+    for _ in range(steps):
+        world.step()
+        times.append(world.time)
+        where.append(body.center_of_mass @ along)
+    times, where = np.array(times), np.array(where)
+    late = times > after
+    return -2 * np.polyfit(times[late], where[late], 2)[0], where[late]

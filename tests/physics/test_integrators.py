@@ -13,7 +13,7 @@ import pytest
 
 import deforma
 from deforma.physics import SimulationUnstable
-from physics_meshes import Chain, grid_mesh, random_body
+from physics_meshes import Chain, grid_mesh, random_body, slide_acceleration
 
 G = 9.81
 ALL = ["symplectic-euler", "implicit-euler", "xpbd"]
@@ -133,14 +133,7 @@ def test_block_on_gentle_slope_stays(name):
 @pytest.mark.parametrize("angle, mu_s, mu_d", [(35.0, 0.5, 0.3), (25.0, 0.0, 0.0)])
 def test_block_slides_with_acceleration_g_sin_minus_mu_cos(name, angle, mu_s, mu_d):
     w, b, n, t = slope_world(name, angle, mu_s=mu_s, mu_d=mu_d, dt=1 / 1000, damping=2.0)
-    times, along = [], []
-    for _ in range(1000):
-        w.step()
-        times.append(w.time)
-        along.append(b.center_of_mass @ t)
-    times, along = np.array(times), np.array(along)
-    late = times > 0.3
-    accel = -2 * np.polyfit(times[late], along[late], 2)[0]
+    accel, _ = slide_acceleration(w, b, t, steps=1000, after=0.3)
     a = math.radians(angle)
     assert accel == pytest.approx(G * (math.sin(a) - mu_d * math.cos(a)), rel=0.03)
     assert np.abs(b.positions @ n).min() < 1e-6

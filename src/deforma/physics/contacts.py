@@ -512,6 +512,79 @@ def _note_moved(k, dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
 
 
 @njit(cache=True)
+def _collide(x, topo, scr, out):
+    """Steps 0-2 of the module docstring for the motion from ``scr.xp`` to ``x``: the number
+    of contacts stored in ``out`` from 0 (-1 if ``out`` was too small; ``scr.status`` says
+    which part) and of candidate pairs."""
+    status = scr.status
+    if topo.cv_vertex.shape[0] == 0 or _activate(x, topo, scr) == 0:
+        return 0, 0
+    if build_grid(x, topo, scr, topo.margin[0]) == 0:
+        return 0, 0
+    n_pairs = narrow_phase(x, topo, scr, out)
+    if n_pairs < 0:
+        status[ST_PAIRS_NEEDED] = -n_pairs
+        return -1, 0
+    n = check_pairs(x, topo, scr, out, 0, n_pairs, True, False)
+    if n < 0:
+        status[ST_NEEDED] = -n
+        return -1, n_pairs
+    return n, n_pairs
+
+
+@njit(cache=True)
+def detect_contacts(x, topo, scr, out):
+    """Collide only (steps 0-2 of the module docstring): the contacts of the motion from
+    ``scr.xp`` to ``x``, stored in ``out`` from 0, nothing moved.
+
+    For solvers that hold contacts inside their solve (:mod:`~deforma.physics.xpbd`): they
+    call it with the predicted end of the substep, use the contacts as constraints, and the
+    full stage still runs after them. Returns the number of contacts, or -1 if ``out`` was
+    too small (as :func:`contact_stage`).
+    """
+    status = scr.status
+    # _activate dedupes folded vertices by the substep's stamp; a stamp of its own (negative,
+    # never a real one) keeps the stage that follows from skipping the ones listed here
+    stamp = status[ST_STAMP]
+    status[ST_STAMP] = -stamp - 2
+    n, _ = _collide(x, topo, scr, out)
+    status[ST_STAMP] = stamp
+    return n
+
+
+@njit(cache=True)
+def project_contacts(x, inv_mass, topo, out, count):
+    """One Gauss-Seidel pass of position projections over the contacts ``out[:count]``.
+
+    A vertex closer to its edge than the contact's target is pushed out to it, the
+    correction split by inverse mass (``w_p``, ``(1 - s) w_a``, ``s w_b``), so that linear
+    momentum is kept. Positions only: the solver derives velocities afterwards.
+    """
+    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    o_vertex, o_edge, o_s, o_normal, o_target = out.vertex, out.edge, out.s, out.normal, out.target
+    for c in range(count):
+        ip = cv[o_vertex[c]]
+        ia = cv[ce_a[o_edge[c]]]
+        ib = cv[ce_b[o_edge[c]]]
+        s = o_s[c]
+        ca = 1.0 - s
+        nx = o_normal[c, 0]
+        ny = o_normal[c, 1]
+        d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
+        gap = o_target[c] - d
+        if gap <= 0.0:
+            continue
+        wp = inv_mass[ip]
+        wa = inv_mass[ia] * ca
+        wb = inv_mass[ib] * s
+        w = wp + wa * ca + wb * s
+        if w <= 0.0:
+            continue
+        lam = gap / w
+        _split(x, ip, ia, ib, wp, wa, wb, lam * nx, lam * ny)
+
+
+@njit(cache=True)
 def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
     """Test candidate pairs (:func:`pair_contact`) and store their contacts in ``out`` from ``first``.
 
@@ -814,18 +887,8 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h):
     status[ST_PAIRS] = 0
     status[ST_DIRTY] = 0
     status[ST_TOUCHED] = 0
-    if topo.cv_vertex.shape[0] == 0 or _activate(x, topo, scr) == 0:
-        return 0
-    margin = topo.margin[0]
-    if build_grid(x, topo, scr, margin) == 0:
-        return 0
-    n_pairs = narrow_phase(x, topo, scr, out)
-    if n_pairs < 0:
-        status[ST_PAIRS_NEEDED] = -n_pairs
-        return -1
-    n0 = check_pairs(x, topo, scr, out, 0, n_pairs, True, False)
+    n0, n_pairs = _collide(x, topo, scr, out)
     if n0 < 0:
-        status[ST_NEEDED] = -n0
         return -1
     status[ST_CONTACTS] = n0
     status[ST_PAIRS] = n_pairs

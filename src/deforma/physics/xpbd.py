@@ -4,12 +4,16 @@
 Per substep ``h``::
 
     x_prev = x;  v = (v + h g) / (1 + h air_drag);  x += h v      # predict
-    repeat iterations times (Gauss-Seidel, springs in order):
-        C = |x_ij| - l,   d = x_ij / |x_ij|
-        dlam = -(ks h^2 C + lam + kd h d . (dx_j - dx_i)) / ((ks h^2 + kd h)(w_i + w_j) + 1)
-        lam += dlam;  x_j += w_j d dlam;  x_i -= w_i d dlam
+    list the collider and body contacts of the predicted motion
+    repeat iterations times (Gauss-Seidel):
+        project the collider contacts (out of the collider, with friction)
+        project the body contacts (split by inverse mass)
+        for each spring in order:
+            C = |x_ij| - l,   d = x_ij / |x_ij|
+            dlam = -(ks h^2 C + lam + kd h d . (dx_j - dx_i)) / ((ks h^2 + kd h)(w_i + w_j) + 1)
+            lam += dlam;  x_j += w_j d dlam;  x_i -= w_i d dlam
     v = (x - x_prev) / h
-    x, v = collide(x_prev, x, v)
+    x, v = collide(x_prev, x, v);  contact stage
 
 with ``w = 1/m`` and ``dx = x - x_prev``. This is Macklin's update with compliance
 ``alpha = 1 / ks`` and damping ``beta = kd`` (``alpha~ = alpha / h^2``, ``gamma = alpha~
@@ -22,6 +26,16 @@ stiffness term), so the same ``stiffness`` and ``damping`` mean the same materia
 The mouse pull ``S (target - x)`` is a zero-length spring to the target with compliance
 ``1/S``, solved per held vertex before the springs (exactly, as it involves one vertex),
 so a strong pull cannot blow up either. Gravity enters the prediction.
+
+Contacts are in the sweep (Macklin et al. 2020, "Detailed Rigid Body Simulation with
+Extended Position Based Dynamics"), so the floor's support and a neighbour's push travel
+through the body within it. A collider contact sticks or slides as decided once per substep
+from its predicted push (the collider rule's impulse): stuck, its tangential motion since the
+substep began is undone in every sweep; sliding, each sweep holds it back by ``friction``
+times that sweep's push. Body contacts are found for the predicted motion by the contact
+stage's own broad and narrow phase (:func:`~deforma.physics.contacts.detect_contacts`) and
+projected as the stage projects them. The full collider response and contact stage still
+run after the sweep.
 
 One Gauss-Seidel sweep per substep (``iterations = 1``, the "small steps" choice) carries
 a correction across about one spring per substep against the sweep order (and across the
@@ -38,13 +52,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .colliders import finish_position_step
-from .contacts import ST_STAMP, contact_stage, gather_start
+from .colliders import contact_planes, finish_position_step
+from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, project_contacts
 from .integrators import register_integrator
 
 
 @njit(cache=True)
-def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, spring_j, rest, ks, kd,
+def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j, rest, ks, kd,
                   gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
     """``substeps`` XPBD substeps of ``h`` s with ``iterations`` Gauss-Seidel sweeps each.
 
@@ -58,6 +72,9 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
         Scratch: positions at the start of the current substep.
     lam : (E,) float64
         Scratch: accumulated multipliers (N s^2).
+    planes, touch : (N, 6) float64, (N,) int32
+        Scratch: the collider contacts of the substep
+        (:func:`~deforma.physics.colliders.contact_planes`; column 5: 1 stuck, 0 sliding).
     inv_mass : (N,) float64
         1/kg.
     spring_i, spring_j : (E,) int32
@@ -97,7 +114,8 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
     >>> from deforma.physics.contacts import empty_topology, make_buffer, make_scratch
     >>> from deforma.physics.colliders import make_hits
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
-    >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.ones(2),
+    >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.zeros((2, 6)),
+    ...                     np.zeros(2, np.int32), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
     ...                     np.zeros(1), 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
     ...                     np.zeros((0, 14)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
@@ -107,6 +125,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
     """
     n = x.shape[0]
     h2 = h * h
+    margin = 0.0  # only vertices headed inside a collider are listed
     for i in range(n):
         x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
     for sub in range(substeps):
@@ -129,7 +148,35 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, inv_mass, spring_i, sprin
             x[i, 1] = py
         for e in range(spring_i.shape[0]):
             lam[e] = 0.0
+        count = contact_planes(x_prev, x, rects, margin, planes, touch)
+        for k in range(count):
+            planes[k, 5] = -1.0  # stick or slide: not decided yet
+        gather_start(x_prev, ctopo, cscr)
+        n_body = detect_contacts(x, ctopo, cscr, cbuf)  # of the predicted motion
+        if n_body < 0:
+            return 0  # the contact buffer is too small; the world grows it and repeats the step
         for _ in range(iterations):
+            # collider contacts first, so that the springs carry their support through the sweep
+            for k in range(count):
+                i = touch[k]
+                nx, ny = planes[k, 0], planes[k, 1]
+                gap = x[i, 0] * nx + x[i, 1] * ny - planes[k, 2]
+                if inv_mass[i] == 0.0:
+                    continue
+                push = -gap if gap < 0.0 else 0.0
+                # tangential motion since the substep began (t = (-ny, nx)). Stick or slide
+                # is decided once, by the first sweep (the predicted motion's push is the
+                # substep's normal impulse, as in the collider rule); a stuck vertex has its
+                # tangential motion undone in every sweep, a sliding one is held back by the
+                # dynamic coefficient times each sweep's push
+                slide = (x_prev[i, 0] - x[i, 0]) * -ny + (x_prev[i, 1] - x[i, 1]) * nx
+                if planes[k, 5] < 0.0:
+                    planes[k, 5] = 1.0 if abs(slide) <= planes[k, 3] * push else 0.0
+                if planes[k, 5] == 0.0:
+                    slide = min(abs(slide), planes[k, 4] * push) * (1.0 if slide > 0.0 else -1.0)
+                x[i, 0] += push * nx - slide * ny
+                x[i, 1] += push * ny + slide * nx
+            project_contacts(x, inv_mass, ctopo, cbuf, n_body)
             for e in range(spring_i.shape[0]):
                 i = np.uint64(spring_i[e])
                 j = np.uint64(spring_j[e])
@@ -196,9 +243,12 @@ class XPBD:
         if self._n != shape:  # scratch kept between steps
             self._x_prev = np.empty((shape[0], 2))
             self._lam = np.empty(shape[1])
+            self._planes = np.empty((shape[0], 6))
+            self._touch = np.empty(shape[0], np.int32)
             self._n = shape
         gx, gy = inputs.gravity
         return xpbd_substeps(state.x, state.v, state.x_start, state.v_start, self._x_prev, self._lam,
+                             self._planes, self._touch,
                              model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              model.spring_stiffness, model.spring_damping, float(gx), float(gy),
                              1.0 / (1.0 + float(h) * inputs.air_drag),
