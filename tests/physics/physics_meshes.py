@@ -1,10 +1,11 @@
 """Small meshes for the physics tests, built without deforma.mesh.box (not a dependency here),
-and the slide measurement they share."""
+and the setups and measurements several test files share."""
 
 import math
 
 import numpy as np
 
+import deforma
 from deforma.mesh import Mesh
 
 
@@ -57,3 +58,12 @@ def slide_acceleration(world, body, along, *, steps, after):
     times, where = np.array(times), np.array(where)
     late = times > after
     return -2 * np.polyfit(times[late], where[late], 2)[0], where[late]
+
+
+def head_on(name, *, dt, substeps):
+    """Two bodies (2 kg and 0.5 kg) about to collide head-on, without gravity or colliders."""
+    w = deforma.World(dt=dt, substeps=substeps, gravity=(0, 0), stiffness=3000.0, damping=2.0, integrator=name)
+    a = w.add_body(grid_mesh(0.6, 0.4, 7, 5), position=(-0.5, 0.0), mass=2.0)
+    b = w.add_body(grid_mesh(0.4, 0.6, 5, 7), position=(0.5, 0.1), mass=0.5)
+    a.velocities, b.velocities = (2.0, 0.0), (-3.0, 0.5)
+    return w, a, b

@@ -13,7 +13,7 @@ import pytest
 import deforma
 from deforma.physics import contacts
 from contact_checks import crossings, vertices_inside_other_bodies
-from physics_meshes import grid_mesh
+from physics_meshes import grid_mesh, head_on
 
 G = 9.81
 ALL = ["symplectic-euler", "implicit-euler", "xpbd"]
@@ -82,10 +82,7 @@ def test_a_stack_of_five_boxes_rests():
 # -- collisions: momentum and energy ------------------------------------------------------------
 @pytest.mark.parametrize("name", ALL)
 def test_head_on_collision_keeps_momentum_and_never_gains_energy(name):
-    w = deforma.World(dt=1 / 1000, substeps=2, gravity=(0, 0), stiffness=3000.0, damping=2.0, integrator=name)
-    a = w.add_body(grid_mesh(0.6, 0.4, 7, 5), position=(-0.5, 0.0), mass=2.0)
-    b = w.add_body(grid_mesh(0.4, 0.6, 5, 7), position=(0.5, 0.1), mass=0.5)
-    a.velocities, b.velocities = (2.0, 0.0), (-3.0, 0.5)
+    w, a, b = head_on(name, dt=1 / 1000, substeps=2)
     m = w._model.vertex_mass[:, None]
     p0 = (m * w._state.v).sum(axis=0)
     scale = (m * np.abs(w._state.v)).sum()

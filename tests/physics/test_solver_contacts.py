@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import deforma
-from physics_meshes import grid_mesh, slide_acceleration
+from physics_meshes import grid_mesh, head_on, slide_acceleration
 
 G = 9.81
 H = 1 / 60
@@ -116,3 +116,37 @@ def test_a_body_leaves_the_floor_when_thrown_up():
     for _ in range(10):  # up to 0.17 s: v = 3 - g t, about 0.37 m by then
         w.step()
     assert b.center_of_mass[1] > 0.3
+
+
+def test_the_jelly_stack_rests_at_a_display_step_under_implicit_euler():
+    # body contacts inside the solve as vertex-to-edge-point springs: with them only after
+    # the solve, the stack still shivered at 0.2 m/s after 6 s
+    from contact_checks import crossings
+
+    w = deforma.load_scene("jelly")
+    w.integrator = "implicit-euler"
+    w.dt, w.substeps = H, 2
+    for k in range(360):
+        w.step()
+        assert crossings(w)[1] == 0, k
+    assert np.hypot(*w._state.v.T).max() < 0.01
+    heights = sorted(b.center_of_mass[1] for b in w.bodies)
+    assert np.all(np.diff(heights) > 0.8)  # still a stack, each box on the one below
+    assert inverted_triangles(w) == 0
+
+
+
+def test_body_contacts_in_the_implicit_solve_keep_momentum_at_a_display_step():
+    # springs between each vertex and its edge point, whose forces sum to zero. (The energy
+    # is not checked here: at 5 m/s these soft bodies fold on impact at this step, before
+    # and after contacts went into the solve; see docs/integrators.md.)
+    w, a, b = head_on("implicit-euler", dt=H, substeps=1)
+    m = w._model.vertex_mass[:, None]
+    p0 = (m * w._state.v).sum(axis=0)
+    scale = (m * np.abs(w._state.v)).sum()
+    factored = w._integrator.factorizations
+    for _ in range(40):
+        w.step()
+        assert np.abs((m * w._state.v).sum(axis=0) - p0).max() < 1e-9 * scale
+    assert w._integrator.factorizations > factored + 1  # they met: contacts went into the matrix
+    assert a.center_of_mass[0] < b.center_of_mass[0]

@@ -28,7 +28,7 @@ rigid rotation (a spinning body keeps spinning).
 The mouse pull is in the matrix (it changes ``A``'s diagonal, so a new grab or release
 refactors; moving a held grab changes only the right-hand side). Gravity is in ``y``.
 
-Collider contacts are inside the solve (the projective-dynamics way). The vertices whose
+Contacts are inside the solve (the projective-dynamics way). The vertices whose
 prediction ``y`` lies inside a collider are listed with the plane of the face they would
 leave by (:func:`~deforma.physics.colliders.contact_planes`); each gets the term
 ``k_c/2 |x - P(x)|^2``, ``k_c = contact_weight * A_ii``, whose local step
@@ -39,7 +39,14 @@ contact set refactors; a resting or sliding body keeps its set, and its factor, 
 steps (docs/integrators.md says why this and not an iterative solve). After the solve the
 shared collider response (:func:`~deforma.physics.colliders.finish_position_step`) and the
 body contact stage run as in the symplectic path, so nothing ends inside a collider or
-across an outline; body-body contacts act only there, after the solve.
+across an outline.
+
+Body contacts are in the solve too: the contacts of the predicted motion
+(:func:`~deforma.physics.contacts.detect_contacts`) each add a spring between the vertex and
+the edge point, ``k_c/2 |D x - q|^2`` with ``D x = x_p - (1 - s) x_a - s x_b``, whose
+coefficients sum to zero (linear momentum kept exactly); :func:`body_contact_rhs` is its
+local step. Its entries join the matrix, so a new set of pairs refactors; a pair keeps the
+``s`` it had when the matrix was built.
 
 With a fixed number of iterations per substep (``iterations``, default 3) the solution is
 approximate where springs turn (the local step lags one iteration); along a spring it is
@@ -58,7 +65,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from .colliders import contact_planes, finish_position_step
-from .contacts import ST_STAMP, contact_stage, gather_start
+from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start
 from .integrators import register_integrator
 
 
@@ -171,6 +178,55 @@ def contact_rhs(x, x_n, planes, index, count, weight, b):
         b[i, 1] += weight[k] * py
 
 
+@njit(cache=True)
+def body_contact_rhs(x, x_n, triple, s, weight, normal, target, mu, count, b):
+    """Add the body contacts' local step to ``b``.
+
+    Contact ``c`` joins vertex ``p`` and the point ``(1 - s) a + s b`` of an edge
+    (``triple[c] = p, a, b``) through the term ``w/2 |D x - q|^2``, ``D x = x_p - (1 - s)
+    x_a - s x_b``: a spring between the vertex and the edge point, whose coefficients sum to
+    zero, so that its forces keep linear momentum exactly. The local step's ``q`` is ``D x``
+    put at least ``target`` in front of the edge along ``normal``, with Coulomb friction on
+    the relative motion since the substep began (``mu`` = dynamic, static), as for colliders.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.5, -0.1], [0.0, 0.0], [1.0, 0.0]])  # a vertex 0.1 m behind an edge
+    >>> b = np.zeros((3, 2))
+    >>> body_contact_rhs(x, x, np.array([[0, 1, 2]]), np.array([0.5]), np.array([1.0]),
+    ...                  np.array([[0.0, 1.0]]), np.array([0.01]), np.array([[0.3, 0.5]]), 1, b)
+    >>> b.round(9).tolist()  # q = (0, 0.01): 1 cm in front; D^T q
+    [[0.0, 0.01], [0.0, -0.005], [0.0, -0.005]]
+    """
+    for c in range(count):
+        p, a, e = triple[c, 0], triple[c, 1], triple[c, 2]
+        t = s[c]
+        ca = 1.0 - t
+        nx, ny = normal[c, 0], normal[c, 1]
+        qx = x[p, 0] - ca * x[a, 0] - t * x[e, 0]
+        qy = x[p, 1] - ca * x[a, 1] - t * x[e, 1]
+        gap = target[c] - (qx * nx + qy * ny)
+        if gap > 0.0:
+            qx += gap * nx
+            qy += gap * ny
+            # relative motion along the edge since the substep began (t = (-ny, nx))
+            rx = x_n[p, 0] - ca * x_n[a, 0] - t * x_n[e, 0]
+            ry = x_n[p, 1] - ca * x_n[a, 1] - t * x_n[e, 1]
+            slide = (rx - qx) * -ny + (ry - qy) * nx
+            if abs(slide) > mu[c, 1] * gap:
+                slide = mu[c, 0] * gap * (1.0 if slide > 0.0 else -1.0)
+            qx -= slide * ny
+            qy += slide * nx
+        w = weight[c]
+        b[p, 0] += w * qx
+        b[p, 1] += w * qy
+        b[a, 0] -= w * ca * qx
+        b[a, 1] -= w * ca * qy
+        b[e, 0] -= w * t * qx
+        b[e, 1] -= w * t * qy
+
+
 def system_matrix(model, grab_slot, grab_pull, h: float) -> sp.csc_matrix:
     """The constant global matrix ``M + L_w + h^2 S_grab`` (N x N, kg), sparse CSC.
 
@@ -236,13 +292,17 @@ class ImplicitEuler:
         self.factorizations = 0
         self._key = None
         self._touching = None
+        self._triples = None
         self._lu = None
         self._scratch_n = -1
 
-    def _factor_if_needed(self, model, inputs, h, touching):
+    def _factor_if_needed(self, model, inputs, h, touching, triples, s):
         # Everything the matrix depends on; compared by value every step (O(N + E), a few
         # percent of a solve) so live parameter changes are never missed. The vertices in
-        # collider contact add their weight to the diagonal: a new set refactors.
+        # collider contact add their weight to the diagonal, the body contacts their
+        # vertex-to-edge-point springs: a new set refactors. A body contact keeps the edge
+        # parameter s it had when the matrix was built (it is in the matrix), so a resting
+        # heap, whose s only jitters, keeps its factor.
         key = self._key
         same_base = not (key is None or key[0] is not model or key[1] != h
                          or not np.array_equal(key[2], model.vertex_mass)
@@ -250,7 +310,7 @@ class ImplicitEuler:
                          or not np.array_equal(key[4], model.spring_damping)
                          or not np.array_equal(key[5], inputs.grab_slot)
                          or not np.array_equal(key[6], inputs.grab_pull[:, 0]))
-        if same_base and np.array_equal(self._touching, touching):
+        if same_base and np.array_equal(self._touching, touching) and np.array_equal(self._triples, triples):
             return
         if not same_base:
             self._a = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h)
@@ -260,12 +320,23 @@ class ImplicitEuler:
             self._wk = h * h * model.spring_stiffness
             self._wd = h * model.spring_damping
         self._touching = touching.copy()
+        self._triples = triples.copy()
+        self._s = s.copy()
         self._contact_weight = self.contact_weight * self._diag[touching]
+        self._pair_weight = self.contact_weight * self._diag[triples[:, 0]]
         a = self._a
-        if len(touching):
+        if len(touching) or len(triples):
             extra = np.zeros(model.n_vertices)
             extra[touching] = self._contact_weight
-            a = (a + sp.diags(extra)).tocsc()
+            a = a + sp.diags(extra)
+            if len(triples):
+                co = np.stack([np.ones_like(s), s - 1.0, -s], axis=1)  # D's coefficients: sum 0
+                rows = np.repeat(triples, 3, axis=1).ravel()
+                cols = np.tile(triples, (1, 3)).ravel()
+                vals = (self._pair_weight[:, None, None] * co[:, :, None] * co[:, None, :]).ravel()
+                n = model.n_vertices
+                a = a + sp.csc_matrix((vals, (rows, cols)), shape=(n, n))
+            a = a.tocsc()
         # A is symmetric positive definite: no pivoting needed, and a symmetric ordering
         # (minimum degree on A + A^T) gave 40% less fill than COLAMD on a 1e5 mesh.
         self._lu = spla.splu(a, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
@@ -306,14 +377,24 @@ class ImplicitEuler:
             # of x_n). Starting at the prediction y measured worse on impacts: y can already
             # have a row of vertices pushed through the next, and the iteration keeps it.
             count = contact_planes(x_n, y, inputs.rects, margin, self._planes, self._touch)
-            self._factor_if_needed(model, inputs, h, self._touch[:count])
+            scr, topo, buf = inputs.contact_scratch, model.contact, inputs.contacts
+            gather_start(x_n, topo, scr)
+            n_body = detect_contacts(y, topo, scr, buf)  # of the predicted motion
+            if n_body < 0:
+                return 0  # the contact buffer is too small; the world grows it and repeats the step
+            cv = topo.cv_vertex
+            edge = buf.edge[:n_body]
+            triples = np.stack([cv[buf.vertex[:n_body]], cv[topo.ce_a[edge]], cv[topo.ce_b[edge]]], axis=1)
+            self._factor_if_needed(model, inputs, h, self._touch[:count], triples, buf.s[:n_body])
             for it in range(self.iterations):
                 implicit_rhs(x, x_n, y, model.vertex_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              self._wk, self._wd, inputs.grab_slot, inputs.grab_pull, h2, b)
                 # the first projection is of the prediction: where the vertex is headed
-                contact_rhs(y if it == 0 else x, x_n, self._planes, self._touch, count, self._contact_weight, b)
+                z = y if it == 0 else x
+                contact_rhs(z, x_n, self._planes, self._touch, count, self._contact_weight, b)
+                body_contact_rhs(z, x_n, self._triples, self._s, self._pair_weight, buf.normal, buf.target, buf.mu,
+                                 n_body, b)
                 x[...] = self._lu.solve(b)
-            scr = inputs.contact_scratch
             bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
             if bad:
                 return bad
