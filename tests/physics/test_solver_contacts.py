@@ -150,3 +150,34 @@ def test_body_contacts_in_the_implicit_solve_keep_momentum_at_a_display_step():
         assert np.abs((m * w._state.v).sum(axis=0) - p0).max() < 1e-9 * scale
     assert w._integrator.factorizations > factored + 1  # they met: contacts went into the matrix
     assert a.center_of_mass[0] < b.center_of_mass[0]
+
+
+# -- bad input ------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name, attribute, value", [
+    ("implicit-euler", "iterations", 0), ("implicit-euler", "iterations", -2), ("xpbd", "iterations", 1.5),
+    ("xpbd", "iterations", True), ("implicit-euler", "contact_weight", 0.0),
+    ("implicit-euler", "contact_weight", float("nan")), ("implicit-euler", "contact_weight", float("inf"))])
+def test_a_stable_integrator_refuses_bad_settings_and_leaves_the_state(name, attribute, value):
+    w = deforma.World(dt=H, integrator=name)
+    b = w.add_body(grid_mesh(0.4, 0.2, 5, 3))
+    before = b.positions.copy()
+    setattr(w._integrator, attribute, value)
+    with pytest.raises(ValueError, match=f"{attribute} must be"):
+        w.step()
+    assert np.array_equal(b.positions, before) and w.step_count == 0
+
+
+@pytest.mark.parametrize("name", ["symplectic-euler", "implicit-euler", "xpbd"])
+def test_a_body_squeezed_between_colliders_is_reported_and_put_back(name):
+    w = deforma.World(dt=H if name != "symplectic-euler" else 1 / 2000, integrator=name, stiffness=2000.0)
+    w.add_collider(deforma.Rect((0, -0.5), (4, 1.0), 0.0))
+    b = w.add_body(grid_mesh(0.4, 0.2, 9, 5), position=(0, 0.1001))
+    w.add_collider(deforma.Rect((0, 0.26), (4, 0.1), 0.0))
+    w.step()
+    # the lid lowered onto the floor in one go: no room is left for the body
+    w.colliders[1] = deforma.Rect((0, 0.02), (4, 0.1), 0.0)
+    before = b.positions.copy()
+    with pytest.raises(deforma.SimulationUnstable, match="trapped inside collider 1") as e:
+        w.step()
+    assert "move the colliders apart" in e.value.hint
+    assert np.array_equal(b.positions, before) and np.isfinite(b.positions).all()

@@ -347,6 +347,9 @@ class ImplicitEuler:
         if isinstance(self.iterations, bool) or not isinstance(self.iterations, (int, np.integer)) \
                 or self.iterations < 1:
             raise ValueError(f"iterations must be an integer >= 1, got {self.iterations!r}")
+        if isinstance(self.contact_weight, bool) or not isinstance(self.contact_weight, (int, float, np.number)) \
+                or not 0.0 < self.contact_weight < 1e12:
+            raise ValueError(f"contact_weight must be a number in (0, 1e12), got {self.contact_weight!r}")
         n = model.n_vertices
         if self._scratch_n != n:
             self._x_n = np.empty((n, 2))

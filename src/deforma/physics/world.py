@@ -852,7 +852,8 @@ class World:
             If a vertex ends non-finite or faster than ``max_speed``; the state is then put
             back to what it was before this step.
         """
-        if self._packed_colliders is None or self._packed_colliders != self._colliders:
+        moved = self._packed_colliders is None or self._packed_colliders != self._colliders
+        if moved:
             self._pack_colliders()
         if self._grabs_dirty:
             self._rebuild_grabs()
@@ -872,8 +873,29 @@ class World:
                                                               max(2 * need_p, len(buf.pair_vertex)))
             if bad:
                 self._fail()
+            if moved:
+                self._check_not_trapped()
         self.time += self._dt
         self.step_count += 1
+
+    def _check_not_trapped(self) -> None:
+        """After colliders changed: refuse a step that left a vertex inside one.
+
+        The response pushes a vertex out of a collider that moved onto it; only one with no
+        room left, squeezed between colliders closer than the body can fit, stays inside.
+        """
+        x = self._state.x
+        for c, rect in enumerate(self._colliders):
+            inside = np.flatnonzero(rect.contains(x))
+            if len(inside):
+                b = int(np.searchsorted(self._model.body_vertex_offsets, inside[0], side="right") - 1)
+                self._state.restore()
+                hint = ("move the colliders apart (or the body out from between them): the gap left "
+                        "is narrower than the body can be squeezed")
+                raise SimulationUnstable(
+                    f"body {b} is trapped inside collider {c} at step {self.step_count} "
+                    f"({len(inside)} vertices, squeezed between colliders); {hint}",
+                    body=self._bodies[b], step=self.step_count, hint=hint)
 
     def _fail(self):
         x, v = self._state.x, self._state.v
