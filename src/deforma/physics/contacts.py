@@ -539,8 +539,9 @@ def detect_contacts(x, topo, scr, out):
 
     For solvers that hold contacts inside their solve (:mod:`~deforma.physics.xpbd`): they
     call it with the predicted end of the substep, use the contacts as constraints, and the
-    full stage still runs after them. Returns the number of contacts, or -1 if ``out`` was
-    too small (as :func:`contact_stage`).
+    full stage still runs after them, from the same :func:`gather_start` (this reads
+    ``scr.xp`` and only grows the body boxes). Returns the number of contacts, or -1 if
+    ``out`` was too small (as :func:`contact_stage`).
     """
     status = scr.status
     # _activate dedupes folded vertices by the substep's stamp; a stamp of its own (negative,

@@ -401,7 +401,7 @@ class ImplicitEuler:
             bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
             if bad:
                 return bad
-            gather_start(x_n, model.contact, scr)
+            # scr.xp still holds x_n (detect_contacts only read it): no second gather_start
             if contact_stage(x, v, model.vertex_inv_mass, model.contact, scr, inputs.contacts, inputs.rects,
                              inputs.hits, float(h)) < 0:
                 return 0  # the contact buffer is too small; the world grows it and repeats the step

@@ -202,7 +202,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         bad = finish_position_step(x, v, x_prev, rects, hits, cscr.status[ST_STAMP] + 1, h, vmax2)
         if bad:
             return bad
-        gather_start(x_prev, ctopo, cscr)
+        # cscr.xp still holds x_prev (detect_contacts only read it): no second gather_start
         if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
             return 0  # the contact buffer is too small; the world grows it and repeats the step
     return 0
