@@ -181,3 +181,17 @@ def test_a_body_squeezed_between_colliders_is_reported_and_put_back(name):
         w.step()
     assert "move the colliders apart" in e.value.hint
     assert np.array_equal(b.positions, before) and np.isfinite(b.positions).all()
+
+
+def test_a_new_contact_weight_is_taken_at_the_next_step():
+    w = deforma.World(dt=H, stiffness=2e4, integrator="implicit-euler")
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
+    w.add_body(grid_mesh(0.4, 0.2, 9, 5, center=(0.0, 0.1001)))
+    for _ in range(30):
+        w.step()
+    resting = w._integrator.factorizations
+    w.step()
+    assert w._integrator.factorizations == resting  # same contacts, same factor
+    w._integrator.contact_weight = 50.0
+    w.step()
+    assert w._integrator.factorizations == resting + 1

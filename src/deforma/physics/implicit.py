@@ -296,29 +296,34 @@ class ImplicitEuler:
         self._lu = None
         self._scratch_n = -1
 
-    def _factor_if_needed(self, model, inputs, h, touching, triples, s):
-        # Everything the matrix depends on; compared by value every step (O(N + E), a few
-        # percent of a solve) so live parameter changes are never missed. The vertices in
-        # collider contact add their weight to the diagonal, the body contacts their
-        # vertex-to-edge-point springs: a new set refactors. A body contact keeps the edge
-        # parameter s it had when the matrix was built (it is in the matrix), so a resting
-        # heap, whose s only jitters, keeps its factor.
+    def _base_if_needed(self, model, inputs, h):
+        # Everything the contact-free matrix depends on; compared by value once per step
+        # (O(N + E), a few percent of a solve) so live parameter changes are never missed.
         key = self._key
-        same_base = not (key is None or key[0] is not model or key[1] != h
-                         or not np.array_equal(key[2], model.vertex_mass)
-                         or not np.array_equal(key[3], model.spring_stiffness)
-                         or not np.array_equal(key[4], model.spring_damping)
-                         or not np.array_equal(key[5], inputs.grab_slot)
-                         or not np.array_equal(key[6], inputs.grab_pull[:, 0]))
-        if same_base and np.array_equal(self._touching, touching) and np.array_equal(self._triples, triples):
+        if not (key is None or key[0] is not model or key[1] != h
+                or not np.array_equal(key[2], model.vertex_mass)
+                or not np.array_equal(key[3], model.spring_stiffness)
+                or not np.array_equal(key[4], model.spring_damping)
+                or not np.array_equal(key[5], inputs.grab_slot)
+                or not np.array_equal(key[6], inputs.grab_pull[:, 0])):
             return
-        if not same_base:
-            self._a = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h)
-            self._diag = self._a.diagonal()
-            self._key = (model, h, model.vertex_mass.copy(), model.spring_stiffness.copy(),
-                         model.spring_damping.copy(), inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy())
-            self._wk = h * h * model.spring_stiffness
-            self._wd = h * model.spring_damping
+        self._a = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h)
+        self._diag = self._a.diagonal()
+        self._key = (model, h, model.vertex_mass.copy(), model.spring_stiffness.copy(),
+                     model.spring_damping.copy(), inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy())
+        self._wk = h * h * model.spring_stiffness
+        self._wd = h * model.spring_damping
+        self._touching = None  # the contact terms must be added again
+
+    def _factor_if_needed(self, model, touching, triples, s):
+        # The vertices in collider contact add their weight to the diagonal, the body
+        # contacts their vertex-to-edge-point springs: a new set refactors. A body contact
+        # keeps the edge parameter s it had when the matrix was built (it is in the
+        # matrix), so a resting heap, whose s only jitters, keeps its factor.
+        if self._touching is not None and self._weight_used == self.contact_weight \
+                and np.array_equal(self._touching, touching) and np.array_equal(self._triples, triples):
+            return
+        self._weight_used = self.contact_weight
         self._touching = touching.copy()
         self._triples = triples.copy()
         self._s = s.copy()
@@ -358,6 +363,7 @@ class ImplicitEuler:
             self._planes = np.empty((n, 5))
             self._touch = np.empty(n, np.int32)
             self._scratch_n = n
+        self._base_if_needed(model, inputs, h)
         x, v = state.x, state.v
         x_n, y, b = self._x_n, self._y, self._b
         gx, gy = inputs.gravity
@@ -388,7 +394,7 @@ class ImplicitEuler:
             cv = topo.cv_vertex
             edge = buf.edge[:n_body]
             triples = np.stack([cv[buf.vertex[:n_body]], cv[topo.ce_a[edge]], cv[topo.ce_b[edge]]], axis=1)
-            self._factor_if_needed(model, inputs, h, self._touch[:count], triples, buf.s[:n_body])
+            self._factor_if_needed(model, self._touch[:count], triples, buf.s[:n_body])
             for it in range(self.iterations):
                 implicit_rhs(x, x_n, y, model.vertex_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              self._wk, self._wd, inputs.grab_slot, inputs.grab_pull, h2, b)
