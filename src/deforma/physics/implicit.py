@@ -270,11 +270,12 @@ class ImplicitEuler:
         here (0.071 s; four took 0.089 s) and measured within 0.3% of four in the resting
         height of a 1e4-vertex body (``benchmarks/bench_integrators.py --sag``).
     contact_weight : float
-        Weight of a collider contact in the solve, in multiples of the vertex's own
-        diagonal entry (default 10; larger holds contacts tighter in few iterations).
+        Weight of a contact (collider or body) in the solve, in multiples of the diagonal
+        entry of its vertex (default 10; in (0, 1e12); larger holds contacts tighter in
+        few iterations).
     factorizations : int
         How many times the matrix was factored (refactoring follows parameter, ``h``,
-        grab and collider-contact-set changes).
+        grab, contact-set and ``contact_weight`` changes).
 
     Examples
     --------
