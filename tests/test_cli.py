@@ -262,3 +262,15 @@ def test_mesh_picture_of_a_builtin_texture(tmp_path, capsys):
     # the picture is drawn under the mesh: the bunny's brown is there, not only the paper colour
     brownish = (img[..., 0] > img[..., 2] + 40) & (img[..., 0] < 230)
     assert brownish.mean() > 0.1
+
+
+def test_version_prints_the_installed_version_and_exits_0(capsys):
+    from importlib.metadata import version
+
+    import deforma
+
+    with pytest.raises(SystemExit) as e:
+        main(["--version"])
+    out, _ = capsys.readouterr()
+    assert e.value.code == 0
+    assert out.strip() == f"deforma {deforma.__version__}" and deforma.__version__ == version("deforma")

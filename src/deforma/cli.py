@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import __version__
+
 __all__ = ["main"]
 
 #: Exit codes: 1 a user error (scene, output, options), 3 the simulation became unstable,
@@ -62,6 +64,7 @@ def _positive(kind, *, hi=None):
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="deforma", description="Deformable 2D objects: run scenes, draw meshes.")
     p.add_argument("--debug", action="store_true", help="show the full traceback on errors")
+    p.add_argument("--version", action="version", version=f"deforma {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
     r = sub.add_parser("run", help="simulate a scene headless; write a video, PNG frames and/or states",
