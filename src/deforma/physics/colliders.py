@@ -386,14 +386,16 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
 
 
 @njit(cache=True)
-def contact_planes(x0, y, rects, margin, planes, index):
+def contact_planes(x0, y, rects, planes, index):
     """The collider contacts a stable solver puts inside its solve: which vertices, and where.
 
-    A vertex whose predicted end of substep ``y`` lies inside a rectangle grown by
-    ``margin`` gets the plane of the face it would leave by (chosen as
-    :func:`collide_point` chooses it, from where it started, ``x0``); of several
-    rectangles, the one it is deepest in. A point ``p`` is outside that face when
-    ``n . p >= c``.
+    A vertex whose predicted end of substep ``y`` lies inside a rectangle gets the plane of
+    the face it would leave by (chosen as :func:`collide_point` chooses it, from where it
+    started, ``x0``); of several rectangles, the one it is deepest in. A point ``p`` is
+    outside that face when ``n . p >= c``. Only vertices headed inside are listed: the
+    solvers hold a listed vertex near its iterate, and listing vertices a hair outside too
+    made the next row up of a body on the floor follow its free fall
+    (``docs/integrators.md``).
 
     Parameters
     ----------
@@ -401,8 +403,6 @@ def contact_planes(x0, y, rects, margin, planes, index):
         Positions at the start of the substep and predicted at its end (m).
     rects : (R, RECT_COLUMNS) float64
         From :func:`pack_rects`.
-    margin : float
-        How far outside a rectangle a predicted position still counts (m).
     planes : (N, 5) float64
         Output: ``nx, ny, c, static_friction, friction`` per listed vertex (the first
         ``count`` rows).
@@ -420,7 +420,7 @@ def contact_planes(x0, y, rects, margin, planes, index):
     >>> floor = pack_rects([Rect((0, -0.5), (10, 1.0), 0.0)], friction=0.3, static_friction=0.5)
     >>> planes, index = np.zeros((2, 5)), np.zeros(2, np.int32)
     >>> x0 = np.array([[0.0, 0.01], [1.0, 2.0]])
-    >>> contact_planes(x0, x0 - [0.0, 0.02], floor, 0.001, planes, index)  # the low one only
+    >>> contact_planes(x0, x0 - [0.0, 0.02], floor, planes, index)  # the low one only
     1
     >>> int(index[0]), (planes[0] + 0.0).round(6).tolist()  # + 0.0 turns -0.0 into 0.0
     (0, [0.0, 1.0, 0.0, 0.5, 0.3])
@@ -430,17 +430,14 @@ def contact_planes(x0, y, rects, margin, planes, index):
         px, py = y[i, 0], y[i, 1]
         best_depth = -np.inf
         for r in range(rects.shape[0]):
-            cx, cy, ux, uy = rects[r, RECT_CX], rects[r, RECT_CY], rects[r, RECT_UX], rects[r, RECT_UY]
-            a = (px - cx) * ux + (py - cy) * uy
-            b = (py - cy) * ux - (px - cx) * uy
-            if abs(a) >= rects[r, RECT_HX] + margin or abs(b) >= rects[r, RECT_HY] + margin:
+            if not _inside(rects, r, px, py):
                 continue
             nx, ny, tx, ty, t, d, depth = _exit_face(rects, r, x0[i, 0], x0[i, 1], px, py)
             if depth > best_depth:
                 best_depth = depth
                 planes[count, 0] = nx
                 planes[count, 1] = ny
-                planes[count, 2] = cx * nx + cy * ny + d + rects[r, RECT_SKIN]
+                planes[count, 2] = rects[r, RECT_CX] * nx + rects[r, RECT_CY] * ny + d + rects[r, RECT_SKIN]
                 planes[count, 3] = rects[r, RECT_STATIC_FRICTION]
                 planes[count, 4] = rects[r, RECT_FRICTION]
         if best_depth > -np.inf:

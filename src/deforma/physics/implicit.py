@@ -373,7 +373,6 @@ class ImplicitEuler:
         np.copyto(state.x_start, x)
         np.copyto(state.v_start, v)
         keep = 1.0 / (1.0 + h * inputs.air_drag)
-        margin = 0.0  # only vertices headed inside: a listed one is held near its iterate
         for _ in range(substeps):
             np.copyto(x_n, x)
             if keep != 1.0:  # air drag, split off before the solve (stable at any h)
@@ -386,7 +385,7 @@ class ImplicitEuler:
             # start of the substep (Baraff & Witkin's one Newton step, with the directions
             # of x_n). Starting at the prediction y measured worse on impacts: y can already
             # have a row of vertices pushed through the next, and the iteration keeps it.
-            count = contact_planes(x_n, y, inputs.rects, margin, self._planes, self._touch)
+            count = contact_planes(x_n, y, inputs.rects, self._planes, self._touch)
             scr, topo, buf = inputs.contact_scratch, model.contact, inputs.contacts
             gather_start(x_n, topo, scr)
             n_body = detect_contacts(y, topo, scr, buf)  # of the predicted motion

@@ -125,7 +125,6 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     """
     n = x.shape[0]
     h2 = h * h
-    margin = 0.0  # only vertices headed inside a collider are listed
     for i in range(n):
         x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
     for sub in range(substeps):
@@ -148,7 +147,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
             x[i, 1] = py
         for e in range(spring_i.shape[0]):
             lam[e] = 0.0
-        count = contact_planes(x_prev, x, rects, margin, planes, touch)
+        count = contact_planes(x_prev, x, rects, planes, touch)
         for k in range(count):
             planes[k, 5] = -1.0  # stick or slide: not decided yet
         gather_start(x_prev, ctopo, cscr)
