@@ -14,8 +14,8 @@ Examples
 
 from . import mesh
 from .mesh.delaunay import delaunay
-from .physics import Rect, SimulationUnstable, World
+from .physics import Material, Rect, SimulationUnstable, World
 from .scene import load_scene, save_scene
 
-__all__ = ["Rect", "SimulationUnstable", "World", "delaunay", "load_scene", "mesh", "save_scene"]
+__all__ = ["Material", "Rect", "SimulationUnstable", "World", "delaunay", "load_scene", "mesh", "save_scene"]
 __version__ = "0.1.0"

@@ -1,6 +1,7 @@
 """The kernels against plain NumPy references, and the parallel paths against the serial ones."""
 
 import numpy as np
+import pytest
 
 import deforma
 from deforma.physics import integrators
@@ -61,22 +62,31 @@ def test_one_step_matches_a_numpy_symplectic_euler_step():
     assert np.allclose(b.positions, x1, rtol=1e-12, atol=1e-14)
 
 
-def test_parallel_and_serial_steps_agree_exactly():
+@pytest.mark.parametrize("material", [None, "corotated", "neo-hookean"])
+def test_parallel_and_serial_steps_agree_exactly(material):
     runs = []
     for kernel in (integrators.symplectic_euler_serial, integrators.symplectic_euler_parallel):
         w, b = perturbed_world(40)
+        if material is not None:  # the same mesh as finite elements, with damping
+            b.material = deforma.Material(material, youngs_modulus=100.0, poisson_ratio=0.3, density=4.0,
+                                          damping=0.002)
         w.add_collider(Rect((0, -0.3), (3, 0.2), 10.0))
         w.add_collider(Rect((0.3, 0.0), (0.2, 0.2), 45.0))
         w.grab((0.0, 0.0), radius=0.1)
-        w.step()  # packs the colliders and grabs
+        h = min(1e-3, 0.5 * w.stable_dt())  # within the elements' stable step
+        w._pack_colliders()
+        w._rebuild_grabs()
         m, s, inp = w._model, w._state, w._inputs
-        fbuf = np.zeros((3, m.n_vertices, 2))  # the same 3 spring chunks for both
-        chunks, verts = integrators.spring_chunks(m.spring_i, m.spring_j, 3)
+        fbuf = np.zeros((3, m.n_vertices, 2))  # the same 3 chunks of springs and elements for both
+        chunks, elem_chunks, verts = integrators.merged_chunks(m.spring_i, m.spring_j, m.elem, 3)
         for _ in range(50):
             kernel(s.x, s.v, s.x_start, s.v_start, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
-                   m.spring_stiffness, m.spring_damping, m.vertex_inv_mass, 0.0, -9.81, 1.0, inp.grab_slot,
-                   inp.grab_pull, inp.rects, inp.hits, m.contact, inp.contact_scratch, inp.contacts, 1e-3, 2, 1e6)
+                   m.spring_stiffness, m.spring_damping, elem_chunks, m.elem, m.elem_b, m.elem_area, m.elem_mu,
+                   m.elem_lambda, m.elem_damping, m.elem_kind, m.vertex_inv_mass, 0.0, -9.81, 1.0,
+                   inp.grab_slot, inp.grab_pull, inp.rects, inp.hits, m.contact, inp.contact_scratch, inp.contacts,
+                   h, 2, 1e6)
         assert not fbuf.any()  # scratch left zeroed
+        assert np.isfinite(s.x).all()
         runs.append((s.x.copy(), s.v.copy()))
     assert np.array_equal(runs[0][0], runs[1][0]) and np.array_equal(runs[0][1], runs[1][1])
 

@@ -1,4 +1,4 @@
-"""Physics: mass-spring soft bodies, rotated-rectangle colliders with Coulomb friction.
+"""Physics: soft bodies of springs or finite elements, rotated-rectangle colliders with Coulomb friction.
 
 ``World`` ties together the constant ``Model`` (springs, rest lengths, masses), the
 ``State`` (positions, velocities), the force kernels, an integrator chosen by name and the
@@ -7,7 +7,8 @@ collider leaf. See ``docs/physics.md`` for the model and the friction scheme.
 
 from .colliders import Rect
 from .integrators import available_integrators, register_integrator
+from .material import Material
 from .world import Body, Energy, Grab, SimulationUnstable, World
 
-__all__ = ["Body", "Energy", "Grab", "Rect", "SimulationUnstable", "World", "available_integrators",
+__all__ = ["Body", "Energy", "Grab", "Material", "Rect", "SimulationUnstable", "World", "available_integrators",
            "register_integrator"]

@@ -66,6 +66,7 @@ from numba import njit
 
 from .colliders import contact_planes, finish_position_step
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start
+from .elements import element_matrix, implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
 
 
@@ -227,11 +228,18 @@ def body_contact_rhs(x, x_n, triple, s, weight, normal, target, mu, count, b):
         b[e, 1] -= w * t * qy
 
 
-def system_matrix(model, grab_slot, grab_pull, h: float) -> sp.csc_matrix:
-    """The constant global matrix ``M + L_w + h^2 S_grab`` (N x N, kg), sparse CSC.
+def element_weights(model, h: float) -> np.ndarray:
+    """Weight (kg) of each element in the solve: ``A (h^2 + h beta) k``, ``k`` its stiffness bound."""
+    return model.elem_area * (h * h + h * model.elem_damping) * max_stiffness(model.elem_mu, model.elem_lambda)
 
-    ``L_w`` is the graph Laplacian of the springs weighted by ``h^2 ks + h kd``; the x and y
-    coordinates share it, so one N x N factor serves both.
+
+def system_matrix(model, grab_slot, grab_pull, h: float, mass=None) -> sp.csc_matrix:
+    """The constant global matrix ``M + L_w + K_w + h^2 S_grab`` (N x N, kg), sparse CSC.
+
+    ``L_w`` is the graph Laplacian of the springs weighted by ``h^2 ks + h kd``, ``K_w`` the
+    elements' ``sum_e w_e D D^T`` (:func:`element_weights`); the x and y coordinates share
+    it, so one N x N factor serves both. ``mass`` replaces ``M``'s diagonal (the solve uses
+    ``M (1 + h air_drag)``). Pinned vertices are handled by the caller (:func:`pin_rows`).
 
     Examples
     --------
@@ -244,7 +252,7 @@ def system_matrix(model, grab_slot, grab_pull, h: float) -> sp.csc_matrix:
     n = model.n_vertices
     w = h * h * model.spring_stiffness + h * model.spring_damping
     i, j = model.spring_i, model.spring_j
-    diag = model.vertex_mass.copy()
+    diag = (model.vertex_mass if mass is None else mass).copy()
     np.add.at(diag, i, w)
     np.add.at(diag, j, w)
     held = np.flatnonzero(grab_slot >= 0)
@@ -252,7 +260,20 @@ def system_matrix(model, grab_slot, grab_pull, h: float) -> sp.csc_matrix:
     rows = np.concatenate([np.arange(n), i, j])
     cols = np.concatenate([np.arange(n), j, i])
     vals = np.concatenate([diag, -w, -w])
-    return sp.csc_matrix((vals, (rows, cols)), shape=(n, n))
+    a = sp.csc_matrix((vals, (rows, cols)), shape=(n, n))
+    if model.n_elements:
+        a = a + element_matrix(model.elem, model.elem_b, element_weights(model, h), n)
+    return a.tocsc()
+
+
+def pin_rows(a, pinned) -> sp.csc_matrix:
+    """``a`` with each pinned vertex's row replaced by the identity's: its equation becomes
+    ``x_p = b_p`` (the caller puts the pinned position in ``b_p``), while the free rows keep
+    their coupling to it, so that it acts on them as a known position."""
+    if not pinned.any():
+        return a
+    free = sp.diags((~pinned).astype(np.float64))
+    return (free @ a + sp.diags(pinned.astype(np.float64))).tocsc()
 
 
 @register_integrator("implicit-euler")
@@ -306,14 +327,27 @@ class ImplicitEuler:
                 or not np.array_equal(key[3], model.spring_stiffness)
                 or not np.array_equal(key[4], model.spring_damping)
                 or not np.array_equal(key[5], inputs.grab_slot)
-                or not np.array_equal(key[6], inputs.grab_pull[:, 0])):
+                or not np.array_equal(key[6], inputs.grab_pull[:, 0])
+                or not np.array_equal(key[7], model.vertex_inv_mass)
+                or not np.array_equal(key[8], model.elem_mu)
+                or not np.array_equal(key[9], model.elem_lambda)
+                or not np.array_equal(key[10], model.elem_damping)
+                or key[11] != inputs.air_drag):
             return
-        self._a = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h)
+        # Air drag -c v joins backward Euler as (1 + h c) M (x - y) / h^2 = f(x) + M g with
+        # y = x_n + (h v_n + h^2 g) / (1 + h c): the heavier mass is in the matrix, so that
+        # forces (not only gravity) balance at rest as they do without drag.
+        self._mass = model.vertex_mass * (1.0 + h * inputs.air_drag)
+        self._a = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, self._mass)
         self._diag = self._a.diagonal()
         self._key = (model, h, model.vertex_mass.copy(), model.spring_stiffness.copy(),
-                     model.spring_damping.copy(), inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy())
+                     model.spring_damping.copy(), inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy(),
+                     model.vertex_inv_mass.copy(), model.elem_mu.copy(), model.elem_lambda.copy(),
+                     model.elem_damping.copy(), inputs.air_drag)
         self._wk = h * h * model.spring_stiffness
         self._wd = h * model.spring_damping
+        self._we = element_weights(model, h)
+        self._pinned = np.flatnonzero(model.pinned)
         self._touching = None  # the contact terms must be added again
 
     def _factor_if_needed(self, model, touching, triples, s):
@@ -343,8 +377,10 @@ class ImplicitEuler:
                 n = model.n_vertices
                 a = a + sp.csc_matrix((vals, (rows, cols)), shape=(n, n))
             a = a.tocsc()
-        # A is symmetric positive definite: no pivoting needed, and a symmetric ordering
-        # (minimum degree on A + A^T) gave 40% less fill than COLAMD on a 1e5 mesh.
+        a = pin_rows(a, model.pinned)
+        # A is symmetric positive definite (but for pinned rows, which are the identity's): no
+        # pivoting needed, and a symmetric ordering (minimum degree on A + A^T) gave 40% less
+        # fill than COLAMD on a 1e5 mesh.
         self._lu = spla.splu(a, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                              options=dict(SymmetricMode=True))
         self.factorizations += 1
@@ -375,7 +411,7 @@ class ImplicitEuler:
         keep = 1.0 / (1.0 + h * inputs.air_drag)
         for _ in range(substeps):
             np.copyto(x_n, x)
-            if keep != 1.0:  # air drag, split off before the solve (stable at any h)
+            if keep != 1.0:  # air drag: the prediction's share here, the mass's in the matrix (see _base_if_needed)
                 v *= keep
             np.multiply(v, h, out=y)
             y += x
@@ -396,13 +432,17 @@ class ImplicitEuler:
             triples = np.stack([cv[buf.vertex[:n_body]], cv[topo.ce_a[edge]], cv[topo.ce_b[edge]]], axis=1)
             self._factor_if_needed(model, self._touch[:count], triples, buf.s[:n_body])
             for it in range(self.iterations):
-                implicit_rhs(x, x_n, y, model.vertex_mass, model.spring_i, model.spring_j, model.spring_rest_length,
+                implicit_rhs(x, x_n, y, self._mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              self._wk, self._wd, inputs.grab_slot, inputs.grab_pull, h2, b)
+                if len(model.elem):
+                    implicit_element_rhs(x, x_n, model.elem, model.elem_b, model.elem_area, model.elem_mu,
+                                         model.elem_lambda, model.elem_damping, model.elem_kind, self._we, h, b)
                 # the first projection is of the prediction: where the vertex is headed
                 z = y if it == 0 else x
                 contact_rhs(z, x_n, self._planes, self._touch, count, self._contact_weight, b)
                 body_contact_rhs(z, x_n, self._triples, self._s, self._pair_weight, buf.normal, buf.target, buf.mu,
                                  n_body, b)
+                b[self._pinned] = x_n[self._pinned]  # pinned: x_p = where it is
                 x[...] = self._lu.solve(b)
             bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
             if bad:

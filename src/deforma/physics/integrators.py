@@ -45,6 +45,7 @@ from numba import njit, prange
 
 from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, jump_reach, record_hit
 from .contacts import ST_STAMP, contact_stage, gather_start
+from .elements import element_forces
 from .forces import spring_force
 from .jit import serial_and_parallel
 
@@ -166,13 +167,16 @@ def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
 # Scalar-only helpers are free.
 
 def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
+                      elem_ptr, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind,
                       inv_mass, gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps,
                       vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions.
 
-    ``fbuf`` (T, N, 2) are zeroed force buffers, one per spring chunk ``chunk_ptr[t]:
-    chunk_ptr[t + 1]``, and are left zeroed; chunk ``t`` touches only the vertices
-    ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see :func:`spring_chunks`). Saves the start state into ``x_start`` /
+    ``fbuf`` (T, N, 2) are zeroed force buffers, one per chunk ``t`` of springs
+    (``chunk_ptr[t]:chunk_ptr[t + 1]``) and of triangle elements (``elem_ptr[t]:elem_ptr[t +
+    1]``; see :mod:`deforma.physics.elements` for ``elem*``), and are left zeroed; chunk
+    ``t`` touches only the vertices ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see
+    :func:`spring_chunks`). A vertex with ``inv_mass`` 0 is pinned: it stays where it is. Saves the start state into ``x_start`` /
     ``v_start``; stops early and returns the number of vertices that ended non-finite or
     faster than ``sqrt(vmax2)`` m/s (or 0 at once when the contact buffer ``cbuf`` is too
     small: ``cscr.status`` says so). ``hits`` records collider contacts (written only on a
@@ -190,6 +194,10 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
         for t in prange(n_chunks):
             lo, hi = chunk_ptr[t], chunk_ptr[t + 1]
             scatter_spring_forces(x, v, spring_i[lo:hi], spring_j[lo:hi], rest[lo:hi], ks[lo:hi], kd[lo:hi], fbuf[t])
+            lo, hi = elem_ptr[t], elem_ptr[t + 1]
+            if hi > lo:
+                element_forces(x, v, elem[lo:hi], elem_b[lo:hi], elem_area[lo:hi], elem_mu[lo:hi], elem_lam[lo:hi],
+                               elem_beta[lo:hi], elem_kind[lo:hi], fbuf[t])
         save = sub == 0
         bad = 0
         for i in prange(x.shape[0]):
@@ -214,6 +222,10 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
             if g >= 0:  # forces.grab_force
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
                 fy += grab_pull[g, 2] - grab_pull[g, 0] * y0
+            if inv_mass[i] == 0.0:  # pinned: it stays (its buffers are re-zeroed above)
+                v[i, 0] = 0.0
+                v[i, 1] = 0.0
+                continue
             px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass[i], gx, gy, keep, h)
             near = False
             for r in range(rects.shape[0]):  # broad phase: bounding boxes (a helper for these
@@ -234,6 +246,42 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
 
 
 symplectic_euler_serial, symplectic_euler_parallel = serial_and_parallel(_symplectic_euler, "symplectic_euler")
+
+
+def element_chunks(elem, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
+    """Split the elements into ``n_chunks`` equal runs, as :func:`spring_chunks` does springs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ptr, verts = element_chunks(np.array([[0, 1, 2], [1, 3, 2]], np.int32), 2)
+    >>> ptr.tolist(), verts.tolist()
+    ([0, 1, 2], [[0, 3], [1, 4]])
+    """
+    n = len(elem)
+    ptr = (np.arange(n_chunks + 1, dtype=np.int64) * n) // n_chunks
+    verts = np.zeros((n_chunks, 2), np.int64)
+    for t in range(n_chunks):
+        lo, hi = ptr[t], ptr[t + 1]
+        if hi > lo:
+            verts[t] = elem[lo:hi].min(), elem[lo:hi].max() + 1
+    return ptr, verts
+
+
+def merged_chunks(spring_i, spring_j, elem, n_chunks: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Spring and element runs per chunk and the vertices each chunk touches (both runs).
+
+    Returns ``(spring_ptr, elem_ptr, chunk_vertices)``.
+    """
+    sp_ptr, sp_v = spring_chunks(spring_i, spring_j, n_chunks)
+    el_ptr, el_v = element_chunks(elem, n_chunks)
+    verts = np.zeros((n_chunks, 2), np.int64)
+    for t in range(n_chunks):
+        ranges = [r for r, used in ((sp_v[t], sp_ptr[t + 1] > sp_ptr[t]), (el_v[t], el_ptr[t + 1] > el_ptr[t]))
+                  if used]
+        if ranges:
+            verts[t] = min(r[0] for r in ranges), max(r[1] for r in ranges)
+    return sp_ptr, el_ptr, verts
 
 
 def spring_chunks(spring_i, spring_j, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
@@ -291,6 +339,7 @@ class SymplecticEuler:
         self._fbuf = np.zeros((0, 0, 2))
         self._model = None
         self._chunks = np.zeros(1, np.int64)
+        self._elem_chunks = np.zeros(1, np.int64)
         self._chunk_vertices = np.zeros((0, 2), np.int64)
         self._threads = None  # numba.get_num_threads(), re-read every 1024 steps
         self._ticks = 0
@@ -345,7 +394,8 @@ class SymplecticEuler:
             # scratch kept between steps: the kernels allocate nothing and leave it zeroed
             self._model = model  # a new Model means new topology: new chunks
             self._fbuf = np.zeros((n_chunks, n, 2))
-            self._chunks, self._chunk_vertices = spring_chunks(model.spring_i, model.spring_j, n_chunks)
+            self._chunks, self._elem_chunks, self._chunk_vertices = merged_chunks(
+                model.spring_i, model.spring_j, model.elem, n_chunks)
             self._reset_timing()
         if self.mode not in ("auto", "serial", "parallel"):
             raise ValueError(f"mode must be 'auto', 'serial' or 'parallel', got {self.mode!r}")
@@ -360,7 +410,9 @@ class SymplecticEuler:
         start = time.perf_counter()
         bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks, self._chunk_vertices,
                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
-                     model.spring_damping, model.vertex_inv_mass, float(gx), float(gy),
+                     model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
+                     model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
+                     model.vertex_inv_mass, float(gx), float(gy),
                      1.0 / (1.0 + float(h) * inputs.air_drag), inputs.grab_slot,
                      inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch,
                      inputs.contacts,

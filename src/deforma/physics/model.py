@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .elements import rest_geometry
 from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology, rest_clearance
 
 
@@ -156,8 +157,26 @@ class Model:
     adj_sign : (2E,) float64
         +1 where the vertex is the spring's ``i`` end, -1 where it is the ``j`` end; lets a
         per-vertex gather sum spring forces computed once per spring, without write races.
-    body_vertex_offsets, body_spring_offsets : (B + 1,) int64
-        Where each body's vertices and springs start.
+    body_vertex_offsets, body_spring_offsets, body_elem_offsets : (B + 1,) int64
+        Where each body's vertices, springs and elements start. A body of a finite-element
+        material has elements and no springs; a springs body has springs and no elements.
+    elem : (T, 3) int32
+        Triangle elements (global vertex indices, counter-clockwise at rest), each body's
+        sorted by their lowest vertex (so a run of elements touches a narrow band of
+        vertices).
+    elem_b : (T, 4) float64
+        Rest-shape inverses ``B`` (row-major, 1/m); see :mod:`deforma.physics.elements`.
+    elem_area : (T,) float64
+        Rest areas (m^2).
+    elem_mu, elem_lambda, elem_damping : (T,) float64
+        Plane-stress Lamé parameters (Pa) and damping (s) of each element's material.
+    elem_kind : (T,) int32
+        ``material.KIND_COROTATED`` or ``KIND_NEO_HOOKEAN``.
+    vertex_area : (N,) float64
+        Lumped rest area per vertex of finite-element bodies (a third of each triangle
+        around it, m^2; 0 for springs bodies): its mass is ``density * vertex_area``.
+    pinned : (N,) bool
+        Pinned vertices: they keep their position (``vertex_inv_mass`` 0, infinite mass).
     contact : ContactTopology
         Every body as the contact stage reads it (outline and other vertices, outline edges,
         triangles, per-vertex contact thickness, per-body flags, thickness and friction);
@@ -171,31 +190,68 @@ class Model:
     ([1.0, 1.0, 1.0], [0, 2, 4, 6])
     """
 
-    def __init__(self, topologies, *, masses, stiffness, damping, contact=None):
+    def __init__(self, topologies, *, masses, stiffness, damping, materials=None, pinned=None, contact=None):
         self.topologies = list(topologies)
+        nb = len(self.topologies)
+        materials = [None] * nb if materials is None else list(materials)
+        fem = [m is not None and m.is_fem for m in materials]
         nv = [t.n_vertices for t in self.topologies]
-        ne = [t.n_springs for t in self.topologies]
-        self.body_vertex_offsets = np.zeros(len(nv) + 1, np.int64)
-        self.body_spring_offsets = np.zeros(len(ne) + 1, np.int64)
+        ne = [0 if f else t.n_springs for t, f in zip(self.topologies, fem)]
+        nt = [len(t.triangles) if f else 0 for t, f in zip(self.topologies, fem)]
+        self.body_vertex_offsets = np.zeros(nb + 1, np.int64)
+        self.body_spring_offsets = np.zeros(nb + 1, np.int64)
+        self.body_elem_offsets = np.zeros(nb + 1, np.int64)
         np.cumsum(nv, out=self.body_vertex_offsets[1:])
         np.cumsum(ne, out=self.body_spring_offsets[1:])
-        n, e = int(self.body_vertex_offsets[-1]), int(self.body_spring_offsets[-1])
+        np.cumsum(nt, out=self.body_elem_offsets[1:])
+        n, e, ntot = int(self.body_vertex_offsets[-1]), int(self.body_spring_offsets[-1]), int(self.body_elem_offsets[-1])
 
         self.spring_i = np.empty(e, np.int32)
         self.spring_j = np.empty(e, np.int32)
         self.spring_rest_length = np.empty(e, np.float64)
+        self.elem = np.empty((ntot, 3), np.int32)
+        self.elem_b = np.empty((ntot, 4), np.float64)
+        self.elem_area = np.empty(ntot, np.float64)
+        self.vertex_area = np.zeros(n, np.float64)
         for b, t in enumerate(self.topologies):
             s0, s1 = self.body_spring_offsets[b], self.body_spring_offsets[b + 1]
             v0 = self.body_vertex_offsets[b]
-            self.spring_i[s0:s1] = t.springs[:, 0] + v0
-            self.spring_j[s0:s1] = t.springs[:, 1] + v0
-            self.spring_rest_length[s0:s1] = t.spring_rest_length
+            if not fem[b]:
+                self.spring_i[s0:s1] = t.springs[:, 0] + v0
+                self.spring_j[s0:s1] = t.springs[:, 1] + v0
+                self.spring_rest_length[s0:s1] = t.spring_rest_length
+                continue
+            t0, t1 = self.body_elem_offsets[b], self.body_elem_offsets[b + 1]
+            tri = t.triangles[np.argsort(t.triangles.min(axis=1), kind="stable")]
+            bmat, area = rest_geometry(t.rest_positions, tri)
+            self.elem[t0:t1] = tri + v0
+            self.elem_b[t0:t1] = bmat
+            self.elem_area[t0:t1] = area
+            lumped = np.bincount(tri.ravel(), np.repeat(area / 3.0, 3), minlength=t.n_vertices)
+            if not np.all(lumped > 0):
+                k = int(np.flatnonzero(lumped <= 0)[0])
+                raise ValueError(f"vertex {k} belongs to no triangle: a finite-element body gets its mass from "
+                                 f"its triangles' area, so every vertex must be a corner of one (or use the "
+                                 f"'springs' material)")
+            self.vertex_area[v0:v0 + t.n_vertices] = lumped
+        self.elem_mu = np.zeros(ntot, np.float64)
+        self.elem_lambda = np.zeros(ntot, np.float64)
+        self.elem_damping = np.zeros(ntot, np.float64)
+        self.elem_kind = np.zeros(ntot, np.int32)
         self.vertex_mass = np.empty(n, np.float64)
         self.vertex_inv_mass = np.empty(n, np.float64)
+        self.pinned = np.zeros(n, bool)
+        if pinned is not None:
+            for b, mask in enumerate(pinned):
+                self.pinned[self.body_vertex_offsets[b]:self.body_vertex_offsets[b + 1]] = mask
         self.spring_stiffness = np.empty(e, np.float64)
         self.spring_damping = np.empty(e, np.float64)
-        for b in range(len(self.topologies)):
-            self.set_body_parameters(b, mass=masses[b], stiffness=stiffness[b], damping=damping[b])
+        self.materials = materials
+        for b in range(nb):
+            if fem[b]:
+                self.set_body_material(b, materials[b])
+            else:
+                self.set_body_parameters(b, mass=masses[b], stiffness=stiffness[b], damping=damping[b])
 
         # CSR adjacency: each spring appears once under each of its two ends.
         ends = np.concatenate([self.spring_i, self.spring_j])
@@ -259,18 +315,54 @@ class Model:
         """Total number of springs over all bodies."""
         return len(self.spring_i)
 
+    @property
+    def n_elements(self) -> int:
+        """Total number of triangle elements over all bodies."""
+        return len(self.elem)
+
     def set_body_parameters(self, body: int, *, mass: float, stiffness: float, damping: float) -> None:
-        """Write body ``body``'s total mass (kg), stiffness (N/m) and damping (N*s/m) into the arrays.
+        """Write springs body ``body``'s total mass (kg), stiffness (N/m) and damping (N*s/m) into the arrays.
 
         The caller validates the values; this only spreads them over vertices and springs.
+        A finite-element body ignores them (its material sets its masses).
         """
+        if self.materials[body] is not None and self.materials[body].is_fem:
+            return
         v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
         s0, s1 = self.body_spring_offsets[body], self.body_spring_offsets[body + 1]
-        m = mass / (v1 - v0)
-        self.vertex_mass[v0:v1] = m
-        self.vertex_inv_mass[v0:v1] = 1.0 / m
+        self.vertex_mass[v0:v1] = mass / (v1 - v0)
+        self._inverse_masses(v0, v1)
         self.spring_stiffness[s0:s1] = stiffness
         self.spring_damping[s0:s1] = damping
+
+    def set_body_material(self, body: int, material) -> None:
+        """Write finite-element body ``body``'s material: element parameters and vertex masses
+        (``density`` times each vertex's lumped area). The body must have been built with a
+        finite-element material (switching between springs and elements rebuilds the Model)."""
+        if material is None or not material.is_fem or self.materials[body] is None \
+                or not self.materials[body].is_fem:
+            raise ValueError("set_body_material needs a finite-element body and material; rebuild the Model to "
+                             "switch between springs and elements")
+        self.materials[body] = material
+        t0, t1 = self.body_elem_offsets[body], self.body_elem_offsets[body + 1]
+        mu, lam = material.lame()
+        self.elem_mu[t0:t1] = mu
+        self.elem_lambda[t0:t1] = lam
+        self.elem_damping[t0:t1] = material.damping
+        self.elem_kind[t0:t1] = material.kind
+        v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
+        self.vertex_mass[v0:v1] = material.density * self.vertex_area[v0:v1]
+        self._inverse_masses(v0, v1)
+
+    def set_pinned(self, body: int, mask) -> None:
+        """Pin (``True``) or free the vertices of body ``body`` (mask over its vertices)."""
+        v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
+        self.pinned[v0:v1] = mask
+        self._inverse_masses(v0, v1)
+
+    def _inverse_masses(self, v0, v1):
+        # a pinned vertex has infinite mass: no force, impulse or projection moves it
+        self.vertex_inv_mass[v0:v1] = np.where(self.pinned[v0:v1], 0.0, 1.0 / self.vertex_mass[v0:v1])
 
     def set_contact_parameters(self, body: int, *, collide: bool, self_collision: bool, friction: float,
                                static_friction: float, thickness: float) -> None:

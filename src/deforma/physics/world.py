@@ -17,12 +17,16 @@ import numpy as np
 
 from . import contacts as _contacts
 from .colliders import Rect, make_hits, pack_rects
+from .elements import element_energy, gradient_row_sums, max_stiffness
 from .integrators import make_integrator
+from .material import Material
 from .model import BodyTopology, Model
 from .state import State
 
 # Automatic contact thickness: this fraction of a body's median boundary edge (see World).
 AUTO_THICKNESS = 0.05
+# Any finite-element material: builds a probe Model to check that a mesh can be one.
+_PROBE = Material("corotated", youngs_modulus=1.0, poisson_ratio=0.0, density=1.0)
 
 
 class SimulationUnstable(RuntimeError):
@@ -47,17 +51,19 @@ class SimulationUnstable(RuntimeError):
 
 @dataclass(frozen=True)
 class Energy:
-    """Energies in joules: kinetic ``sum m v^2 / 2``, spring ``sum ks (L - l)^2 / 2`` and
-    gravitational ``-sum m g . x`` (zero at the origin)."""
+    """Energies in joules: kinetic ``sum m v^2 / 2``, spring ``sum ks (L - l)^2 / 2``,
+    gravitational ``-sum m g . x`` (zero at the origin) and the elastic energy of the
+    finite elements ``sum A psi(F)``."""
 
     kinetic: float
     spring: float
     gravitational: float
+    elastic: float = 0.0
 
     @property
     def total(self) -> float:
-        """Sum of the three, in joules."""
-        return self.kinetic + self.spring + self.gravitational
+        """Sum of the four, in joules."""
+        return self.kinetic + self.spring + self.gravitational + self.elastic
 
 
 def _finite(value, name: str) -> float:
@@ -90,6 +96,22 @@ def _switch(value, name: str) -> bool:
     return bool(value)
 
 
+def _material(value):
+    if value is None or isinstance(value, Material):
+        return value
+    raise ValueError(f"material must be a deforma.Material (or None for the world's / the seed's springs), "
+                     f"got {type(value).__name__}: e.g. deforma.Material('neo-hookean', youngs_modulus=1e5, "
+                     f"poisson_ratio=0.3, density=100.0)")
+
+
+def _fem_mesh_check(topology) -> None:
+    """Refuse a mesh that cannot be made of finite elements (before anything changes)."""
+    if not len(topology.triangles):
+        raise ValueError("a finite-element material needs a mesh with triangles; this body has only springs "
+                         "(use the 'springs' material)")
+    Model([topology], masses=[1.0], stiffness=[0.0], damping=[0.0], materials=[_PROBE])  # raises with the reason
+
+
 def _pair(value, name: str) -> tuple[float, float]:
     try:
         a = np.asarray(value, dtype=np.float64)
@@ -103,11 +125,13 @@ def _pair(value, name: str) -> tuple[float, float]:
 class Body:
     """A soft body in a world: a handle onto its slice of the world's arrays.
 
-    Made by :meth:`World.add_body`, not directly. ``mass`` (kg, total), ``stiffness``
-    (N/m per spring), ``damping`` (N*s/m per spring) and the body-contact ``friction`` /
-    ``static_friction`` can be set live; setting ``None`` makes the body follow the world's
-    value again. ``collide`` and ``self_collision`` switch its contacts with other bodies
-    and with itself.
+    Made by :meth:`World.add_body`, not directly. ``material``, the springs' ``mass`` (kg,
+    total), ``stiffness`` (N/m per spring) and ``damping`` (N*s/m per spring), and the
+    body-contact ``friction`` / ``static_friction`` can be set live; setting ``None`` makes
+    the body follow the world's value again. A body of a finite-element material takes its
+    mass from the material's density and has no springs to set. ``collide`` and
+    ``self_collision`` switch its contacts with other bodies and with itself; :meth:`pin`
+    holds vertices in place.
 
     Examples
     --------
@@ -124,6 +148,7 @@ class Body:
         self.mesh = mesh
         self.topology = topology
         self._overrides = overrides
+        self._pinned = np.zeros(topology.n_vertices, bool)
 
     def _check(self) -> "World":
         if self._world is None:
@@ -197,29 +222,123 @@ class Body:
         return self.topology.springs
 
     @property
+    def vertex_masses(self) -> np.ndarray:
+        """(N,) mass of each vertex in kg (a copy): equal for springs, ``density`` times the
+        lumped area for finite elements."""
+        return self._check()._model.vertex_mass[self.vertex_slice].copy()
+
+    @property
     def center_of_mass(self) -> np.ndarray:
-        """(2,) centre of mass in metres (all vertices weigh the same)."""
-        return self.positions.mean(axis=0)
+        """(2,) centre of mass in metres (vertices weighted by their masses)."""
+        m = self._check()._model.vertex_mass[self.vertex_slice]
+        return (m @ self.positions) / m.sum()
+
+    @property
+    def material(self) -> Material:
+        """The body's material (its own, or the world's; ``Material("springs")`` if neither is set).
+
+        Setting it (or ``None``: follow the world) switches the model live; the body keeps its
+        positions and velocities.
+        """
+        m = self._overrides["material"]
+        if m is None:
+            m = self._check().material
+        return Material("springs") if m is None else m
+
+    @material.setter
+    def material(self, value):
+        world = self._check()
+        value = _material(value)
+        if value is not None and value.is_fem:
+            _fem_mesh_check(self.topology)
+        self._overrides["material"] = value
+        world._material_changed()
+
+    @property
+    def is_fem(self) -> bool:
+        """True if the body is made of finite elements (its material is not ``"springs"``)."""
+        return self.material.is_fem
 
     def _param(self, name):
         v = self._overrides[name]
         return getattr(self._check(), name) if v is None else v
 
     def _set_param(self, name, value, check):
+        if value is not None and name in ("mass", "stiffness", "damping") and self.is_fem:
+            raise ValueError(f"body {self._index} is made of {self.material.model!r} elements, which have no "
+                             f"spring {name}: change its material (youngs_modulus, density, damping) instead")
         self._overrides[name] = None if value is None else check(value)
         self._check()._apply_body_parameters(self._index)
 
-    mass = property(lambda self: self._param("mass"),
+    def _mass(self):
+        if self.is_fem:
+            return float(self._check()._model.vertex_mass[self.vertex_slice].sum())
+        return self._param("mass")
+
+    mass = property(_mass,
                     lambda self, v: self._set_param("mass", v, lambda x: _positive(x, "mass", "kg")),
-                    doc="Total mass in kg, spread evenly over the vertices (the original's mass / N).")
+                    doc="Total mass in kg: for springs spread evenly over the vertices (the original's "
+                        "mass / N); for finite elements ``density * area`` (read-only).")
     stiffness = property(lambda self: self._param("stiffness"),
                          lambda self, v: self._set_param("stiffness", v,
                                                          lambda x: _non_negative(x, "stiffness", "N/m")),
-                         doc="Spring constant ks of every spring, N/m.")
+                         doc="Spring constant ks of every spring, N/m (springs bodies).")
     damping = property(lambda self: self._param("damping"),
                        lambda self, v: self._set_param("damping", v,
                                                        lambda x: _non_negative(x, "damping", "N*s/m")),
-                       doc="Spring damping kd of every spring, N*s/m.")
+                       doc="Spring damping kd of every spring, N*s/m (springs bodies).")
+
+    @property
+    def pinned(self) -> np.ndarray:
+        """(N,) bool: which vertices are pinned (a copy; use :meth:`pin` / :meth:`unpin`)."""
+        self._check()
+        return self._pinned.copy()
+
+    def _indices(self, indices, name):
+        try:
+            a = np.asarray(indices)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be vertex indices (integers), got {indices!r}") from None
+        if a.dtype == bool and a.shape == (self.n_vertices,):
+            return np.flatnonzero(a)
+        a = a.reshape(-1)
+        if a.size and not np.issubdtype(a.dtype, np.integer):
+            raise ValueError(f"{name} must be integers (or a bool mask of {self.n_vertices}), got dtype {a.dtype}")
+        if a.size and (a.min() < 0 or a.max() >= self.n_vertices):
+            bad = int(a[(a < 0) | (a >= self.n_vertices)][0])
+            raise ValueError(f"{name}: vertex index {bad} is out of range; body {self._index} has vertices "
+                             f"0..{self.n_vertices - 1}")
+        return a.astype(np.int64)
+
+    def pin(self, indices) -> None:
+        """Hold vertices ``indices`` (body-local, or a bool mask) where they are: infinite mass,
+        zero velocity, under every integrator, until :meth:`unpin`.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]), position=(0, 2))
+        >>> b.pin([0, 1])
+        >>> for _ in range(60):
+        ...     w.step()
+        >>> b.pinned.tolist(), b.positions[0].tolist()
+        ([True, True, False], [-0.5, 1.5])
+        """
+        world = self._check()
+        idx = self._indices(indices, "pin indices")
+        self._pinned[idx] = True
+        self.velocities[idx] = 0.0
+        world._model.set_pinned(self._index, self._pinned)
+
+    def unpin(self, indices=None) -> None:
+        """Free vertices ``indices`` (default: all of them)."""
+        world = self._check()
+        if indices is None:
+            self._pinned[:] = False
+        else:
+            self._pinned[self._indices(indices, "unpin indices")] = False
+        world._model.set_pinned(self._index, self._pinned)
     friction = property(lambda self: self._param("friction"),
                         lambda self, v: self._set_param("friction", v,
                                                         lambda x: _non_negative(x, "friction", "(dimensionless)")),
@@ -266,6 +385,9 @@ class Body:
     def __repr__(self) -> str:
         if self._world is None:
             return "Body(removed)"
+        if self.is_fem:
+            return (f"Body({self.n_vertices} vertices, {len(self.triangles)} {self.material.model} elements, "
+                    f"mass {self.mass:.4g} kg)")
         return f"Body({self.n_vertices} vertices, {self.n_springs} springs, mass {self.mass} kg)"
 
 
@@ -352,7 +474,7 @@ class World:
 
     def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps=1, mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
-                 integrator="symplectic-euler", contact_thickness=None, air_drag=0.0):
+                 integrator="symplectic-euler", contact_thickness=None, air_drag=0.0, material=None):
         self._inputs = _StepInputs()
         self._bodies: list[Body] = []
         self._colliders: list[Rect] = []
@@ -362,6 +484,7 @@ class World:
         self._model = Model([], masses=[], stiffness=[], damping=[])
         self._state = State.empty()
         self._contact_thickness = None
+        self._material = None
         self._make_contact_scratch()
         self.time = 0.0
         self.step_count = 0
@@ -378,6 +501,7 @@ class World:
         self.integrator = integrator
         self.contact_thickness = contact_thickness
         self.air_drag = air_drag
+        self.material = material
 
     # -- parameters -------------------------------------------------------------------------
     @property
@@ -499,6 +623,26 @@ class World:
         return float(min(AUTO_THICKNESS * np.median(lengths), 0.5 * lengths.min()))
 
     @property
+    def material(self) -> Material | None:
+        """Default material of bodies that have none of their own; ``None``: the seed's springs."""
+        return self._material
+
+    @material.setter
+    def material(self, value):
+        value = _material(value)
+        if value is not None and value.is_fem:
+            for body in self._bodies:
+                if body._overrides["material"] is None:
+                    _fem_mesh_check(body.topology)
+        self._material = value
+        self._material_changed()
+
+    def _material_changed(self) -> None:
+        # springs and elements are different arrays: rebuild the Model, keep the state
+        if self._bodies:
+            self._rebuild(self._state.x.copy(), self._state.v.copy())
+
+    @property
     def integrator(self) -> str:
         """Name of the time integrator."""
         return self._integrator.name
@@ -513,9 +657,9 @@ class World:
         """The bodies, in the order added (a new list; use add_body / remove_body to change)."""
         return list(self._bodies)
 
-    def add_body(self, mesh, *, position=None, mass=None, stiffness=None, damping=None, collide=True,
+    def add_body(self, mesh, *, position=None, material=None, mass=None, stiffness=None, damping=None, collide=True,
                  self_collision=True, friction=None, static_friction=None) -> Body:
-        """Make a soft body from a mesh: a mass per vertex, a spring per unique edge.
+        """Make a soft body from a mesh: springs on its edges, or finite elements on its triangles.
 
         Parameters
         ----------
@@ -524,8 +668,14 @@ class World:
             ``triangles``), e.g. a chain of springs. Rest lengths come from the vertices.
         position : (float, float), optional
             Where the mesh's bounding-box centre goes, metres; ``None`` keeps its coordinates.
+        material : deforma.Material, optional
+            What the body is made of; ``None`` follows the world's ``material`` (whose default
+            ``None`` is the seed's springs). A finite-element material (``"corotated"``,
+            ``"neo-hookean"``) makes every triangle an element and takes the mass from its
+            density, so it cannot be combined with ``mass``, ``stiffness`` or ``damping``.
         mass, stiffness, damping : float, optional
-            Total mass (kg), spring constant (N/m) and damping (N*s/m); ``None`` follows the world.
+            Springs only: total mass (kg), spring constant (N/m) and damping (N*s/m); ``None``
+            follows the world.
         collide : bool, optional
             Touch other bodies (default). Off, the body passes through every other body; in
             a heap that saves most of the step (the contact stage is 80-90% of it there).
@@ -565,7 +715,16 @@ class World:
         if x.ndim == 2 and x.shape[1] == 2 and len(x) and position is not None:
             x += np.asarray(_pair(position, "position")) - (x.min(axis=0) + x.max(axis=0)) / 2
         topo = BodyTopology.from_arrays(x, edges, getattr(mesh, "triangles", None))
+        material = _material(material)
+        effective = material if material is not None else self._material
+        if effective is not None and effective.is_fem:
+            given = [k for k, v in (("mass", mass), ("stiffness", stiffness), ("damping", damping)) if v is not None]
+            if given:
+                raise ValueError(f"the {effective.model!r} material sets the body's mass (density * area) and "
+                                 f"elasticity (youngs_modulus, poisson_ratio); do not pass {', '.join(given)} too")
+            _fem_mesh_check(topo)
         overrides = {
+            "material": material,
             "mass": None if mass is None else _positive(mass, "mass", "kg"),
             "stiffness": None if stiffness is None else _non_negative(stiffness, "stiffness", "N/m"),
             "damping": None if damping is None else _non_negative(damping, "damping", "N*s/m"),
@@ -615,9 +774,11 @@ class World:
 
     def _rebuild(self, x, v):
         tops = [b.topology for b in self._bodies]
-        self._model = Model(tops, masses=[b.mass for b in self._bodies],
+        self._model = Model(tops, masses=[b._param("mass") for b in self._bodies],
                             stiffness=[b.stiffness for b in self._bodies],
                             damping=[b.damping for b in self._bodies],
+                            materials=[b.material for b in self._bodies],
+                            pinned=[b._pinned for b in self._bodies],
                             contact=[self._contact_parameters(b) for b in self._bodies])
         self._state = State(x, v, self._model.body_vertex_offsets)
         self._grabs_dirty = True
@@ -637,7 +798,7 @@ class World:
 
     def _apply_body_parameters(self, b: int) -> None:
         body = self._bodies[b]
-        self._model.set_body_parameters(b, mass=body.mass, stiffness=body.stiffness, damping=body.damping)
+        self._model.set_body_parameters(b, mass=body._param("mass"), stiffness=body.stiffness, damping=body.damping)
         self._model.set_contact_parameters(b, **self._contact_parameters(body))
 
     def _check_no_overlap(self, body, x=None) -> None:
@@ -934,7 +1095,10 @@ class World:
 
         Bounds the fastest spring mode by Gershgorin's theorem, ``omega^2 <= max_i
         2 sum(ks)_i / m_i`` and ``gamma <= max_i 2 sum(kd)_i / m_i`` over the springs (and
-        grabs) at each vertex, and returns the step at which semi-implicit Euler on
+        grabs) at each vertex; a finite element adds its stiffness matrix's row sum,
+        ``A k sum_w |D_i . D_w|`` with ``k = 2 (mu + max(lambda, 0))`` its stiffness at rest
+        (:func:`~deforma.physics.elements.max_stiffness`), and ``damping`` times that to
+        ``gamma``. Then it returns the step at which semi-implicit Euler on
         ``x'' = -omega^2 x - gamma x'`` turns unstable, ``(sqrt(gamma^2 + 4 omega^2) - gamma)
         / omega^2`` (``2 / omega`` without damping). Compare it with ``dt / substeps``.
 
@@ -949,14 +1113,19 @@ class World:
         m = self._model
         if m.n_vertices == 0 or (not explicit and getattr(self._integrator, "unconditionally_stable", False)):
             return math.inf
+        # (float: bincount of no springs gives integers)
         ks = np.bincount(m.spring_i, m.spring_stiffness, m.n_vertices) + \
-            np.bincount(m.spring_j, m.spring_stiffness, m.n_vertices)
+            np.bincount(m.spring_j, m.spring_stiffness, m.n_vertices).astype(np.float64)
         kd = np.bincount(m.spring_i, m.spring_damping, m.n_vertices) + \
-            np.bincount(m.spring_j, m.spring_damping, m.n_vertices)
+            np.bincount(m.spring_j, m.spring_damping, m.n_vertices).astype(np.float64)
         if self._grabs_dirty:
             self._rebuild_grabs()
         held = self._inputs.grab_slot >= 0
         ks[held] += self._inputs.grab_pull[self._inputs.grab_slot[held], 0]
+        if m.n_elements:
+            k = max_stiffness(m.elem_mu, m.elem_lambda)
+            ks += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k, m.n_vertices)
+            kd += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k * m.elem_damping, m.n_vertices)
         w2 = float(np.max(2 * ks * m.vertex_inv_mass))
         gamma = float(np.max(2 * kd * m.vertex_inv_mass))
         if w2 == 0:
@@ -964,7 +1133,7 @@ class World:
         return (math.sqrt(gamma * gamma + 4 * w2) - gamma) / w2
 
     def energy(self, body: Body | None = None) -> Energy:
-        """Kinetic, spring and gravitational energy in joules, of one body or all.
+        """Kinetic, spring, gravitational and elastic (finite-element) energy in joules, of one body or all.
 
         Examples
         --------
@@ -977,18 +1146,21 @@ class World:
         """
         m, s = self._model, self._state
         if body is None:
-            vs, es = slice(None), slice(None)
+            vs, es, ts = slice(None), slice(None), slice(None)
         else:
             b = self._own_body(body)
             vs = body.vertex_slice
             es = slice(int(m.body_spring_offsets[b]), int(m.body_spring_offsets[b + 1]))
+            ts = slice(int(m.body_elem_offsets[b]), int(m.body_elem_offsets[b + 1]))
         x, v, mass = s.x[vs], s.v[vs], m.vertex_mass[vs]
         kinetic = 0.5 * float(np.sum(mass * np.einsum("ij,ij->i", v, v)))
         si, sj = m.spring_i[es], m.spring_j[es]
         stretch = np.linalg.norm(s.x[sj] - s.x[si], axis=1) - m.spring_rest_length[es]
         spring = 0.5 * float(np.sum(m.spring_stiffness[es] * stretch * stretch))
         gravitational = -float(np.sum(mass * (x @ np.asarray(self.gravity))))
-        return Energy(kinetic, spring, gravitational)
+        elastic = float(np.sum(element_energy(s.x, m.elem[ts], m.elem_b[ts], m.elem_area[ts], m.elem_mu[ts],
+                                              m.elem_lambda[ts], m.elem_kind[ts])))
+        return Energy(kinetic, spring, gravitational, elastic)
 
     def __repr__(self) -> str:
         return (f"World({len(self._bodies)} bodies, {self._model.n_vertices} vertices, "

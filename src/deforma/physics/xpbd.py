@@ -54,12 +54,13 @@ from numba import njit
 
 from .colliders import contact_planes, finish_position_step
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, project_contacts
+from .elements import project_elements
 from .integrators import register_integrator
 
 
 @njit(cache=True)
 def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j, rest, ks, kd,
-                  gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
+                  elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind, elem_lam_acc, gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
     """``substeps`` XPBD substeps of ``h`` s with ``iterations`` Gauss-Seidel sweeps each.
 
     Parameters
@@ -81,6 +82,10 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         Spring ends.
     rest, ks, kd : (E,) float64
         Rest lengths (m), stiffness (N/m), damping (N*s/m).
+    elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind : arrays
+        Triangle elements (see :mod:`deforma.physics.elements`).
+    elem_lam_acc : (T, 2) float64
+        Scratch: the elements' accumulated multipliers.
     gx, gy : float
         Gravity (m/s^2).
     keep : float
@@ -114,10 +119,12 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     >>> from deforma.physics.contacts import empty_topology, make_buffer, make_scratch
     >>> from deforma.physics.colliders import make_hits
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
+    >>> no_elements = (np.zeros((0, 3), np.int32), np.zeros((0, 4)), *[np.zeros(0)] * 4,
+    ...                np.zeros(0, np.int32), np.zeros((0, 2)))
     >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.zeros((2, 6)),
     ...                     np.zeros(2, np.int32), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
-    ...                     np.zeros(1), 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
+    ...                     np.zeros(1), *no_elements, 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
     ...                     np.zeros((0, 14)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
     ...                     0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
@@ -131,6 +138,10 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         for i in range(n):
             x_prev[i, 0] = x[i, 0]
             x_prev[i, 1] = x[i, 1]
+            if inv_mass[i] == 0.0:  # pinned: it stays
+                v[i, 0] = 0.0
+                v[i, 1] = 0.0
+                continue
             v[i, 0] = (v[i, 0] + h * gx) * keep
             v[i, 1] = (v[i, 1] + h * gy) * keep
             px = x[i, 0] + h * v[i, 0]
@@ -147,6 +158,9 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
             x[i, 1] = py
         for e in range(spring_i.shape[0]):
             lam[e] = 0.0
+        for e in range(elem.shape[0]):
+            elem_lam_acc[e, 0] = 0.0
+            elem_lam_acc[e, 1] = 0.0
         count = contact_planes(x_prev, x, rects, planes, touch)
         for k in range(count):
             planes[k, 5] = -1.0  # stick or slide: not decided yet
@@ -198,6 +212,8 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
                 x[i, 1] -= wi * ny * dlam
                 x[j, 0] += wj * nx * dlam
                 x[j, 1] += wj * ny * dlam
+            project_elements(x, x_prev, inv_mass, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind,
+                             elem_lam_acc, h)
         bad = finish_position_step(x, v, x_prev, rects, hits, cscr.status[ST_STAMP] + 1, h, vmax2)
         if bad:
             return bad
@@ -232,16 +248,17 @@ class XPBD:
 
     def __init__(self):
         self.iterations = 1
-        self._n = (-1, -1)
+        self._n = (-1, -1, -1)
 
     def advance(self, model, state, inputs, h, substeps):
         if isinstance(self.iterations, bool) or not isinstance(self.iterations, (int, np.integer)) \
                 or self.iterations < 1:
             raise ValueError(f"iterations must be an integer >= 1, got {self.iterations!r}")
-        shape = (model.n_vertices, model.n_springs)
+        shape = (model.n_vertices, model.n_springs, model.n_elements)
         if self._n != shape:  # scratch kept between steps
             self._x_prev = np.empty((shape[0], 2))
             self._lam = np.empty(shape[1])
+            self._elem_lam = np.empty((shape[2], 2))
             self._planes = np.empty((shape[0], 6))
             self._touch = np.empty(shape[0], np.int32)
             self._n = shape
@@ -249,7 +266,9 @@ class XPBD:
         return xpbd_substeps(state.x, state.v, state.x_start, state.v_start, self._x_prev, self._lam,
                              self._planes, self._touch,
                              model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
-                             model.spring_stiffness, model.spring_damping, float(gx), float(gy),
+                             model.spring_stiffness, model.spring_damping, model.elem, model.elem_b,
+                             model.elem_area, model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
+                             self._elem_lam, float(gx), float(gy),
                              1.0 / (1.0 + float(h) * inputs.air_drag),
                              inputs.grab_slot, inputs.grab_pull, inputs.rects, inputs.hits, model.contact,
                              inputs.contact_scratch, inputs.contacts, float(h), int(substeps),

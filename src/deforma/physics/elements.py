@@ -1,0 +1,384 @@
+"""Triangle finite elements: geometry and the passes every integrator runs over them.
+
+A triangle ``(i, j, k)`` (counter-clockwise) maps its rest shape to its current shape by
+the constant deformation gradient
+
+    F = [x_j - x_i | x_k - x_i] B,     B = [X_j - X_i | X_k - X_i]^-1   (rest positions X),
+
+so ``F[r, :] = sum_v x_v[r] D_v`` with shape-function gradients ``D_j = B[0, :]``, ``D_k =
+B[1, :]``, ``D_i = -D_j - D_k``. An element of rest area ``A`` and energy density ``psi(F)``
+puts the force ``f_v = -A P D_v`` on its vertices (``P = dpsi/dF``, from the element kind's
+module: :mod:`~deforma.physics.corotated`, :mod:`~deforma.physics.neo_hookean`); the three
+forces sum to zero, so elements keep momentum.
+
+Damping (``beta`` seconds, per element) is a viscous stress ``beta R (2 mu E' + lambda tr(E')
+I)`` with ``E' = sym(R^T dF/dt)``, the corotated linear stress of the strain rate: rigid
+motion is never damped, and a mode of angular frequency ``omega`` gets the damping ratio
+``beta omega / 2``.
+
+Here: the per-element force (:func:`element_forces`, used by the symplectic step), the
+implicit solve's right-hand side (:func:`implicit_element_rhs`) and matrix
+(:func:`element_matrix`), the XPBD projection (:func:`project_elements`), and NumPy helpers
+(deformation gradients, energies, the stable-step bound).
+
+Units: m, s, kg, Pa (N/m per metre of thickness), J.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from numba import njit
+
+from . import corotated, neo_hookean
+from .material import KIND_COROTATED
+
+
+def rest_geometry(x, tris):
+    """Rest-shape inverses ``B`` (T, 4; row-major) and rest areas (T,) of triangles ``tris``.
+
+    Raises
+    ------
+    ValueError
+        If a triangle has (numerically) zero area: it has no shape to return to.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> b, area = rest_geometry(np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]]), np.array([[0, 1, 2]]))
+    >>> (b + 0.0).tolist(), area.tolist()  # + 0.0: no negative zeros
+    ([[0.5, 0.0, 0.0, 1.0]], [1.0])
+    """
+    x = np.asarray(x, dtype=np.float64)
+    t = np.asarray(tris, dtype=np.int64)
+    e1 = x[t[:, 1]] - x[t[:, 0]]
+    e2 = x[t[:, 2]] - x[t[:, 0]]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    scale = np.maximum(np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e2, e2))
+    bad = np.flatnonzero(~(np.abs(det) > 1e-12 * scale))
+    if len(bad):
+        k = int(bad[0])
+        raise ValueError(f"triangle {k} (vertices {t[k].tolist()}) has zero area: a finite-element body needs "
+                         f"every triangle to enclose area (remove degenerate triangles or use the 'springs' "
+                         f"material)")
+    inv = 1.0 / det
+    # Dm = [[e1x, e2x], [e1y, e2y]]; B = Dm^-1
+    b = np.stack([e2[:, 1] * inv, -e2[:, 0] * inv, -e1[:, 1] * inv, e1[:, 0] * inv], axis=1)
+    return np.ascontiguousarray(b), 0.5 * np.abs(det)
+
+
+def deformation_gradients(x, tris, b):
+    """Deformation gradients (T, 2, 2) of triangles ``tris`` at positions ``x`` (NumPy).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    >>> deformation_gradients(2 * x, [[0, 1, 2]], np.array([[1.0, 0.0, 0.0, 1.0]]))[0].tolist()
+    [[2.0, 0.0], [0.0, 2.0]]
+    """
+    x = np.asarray(x, dtype=np.float64)
+    t = np.asarray(tris, dtype=np.int64)
+    ds = np.stack([x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]]], axis=2)  # columns: edges
+    return ds @ np.asarray(b).reshape(-1, 2, 2)
+
+
+def element_energy(x, tris, b, area, mu, lam, kind):
+    """Elastic energy (J) of each element (T,) at positions ``x``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    >>> b, a = rest_geometry(x, [[0, 1, 2]])
+    >>> float(element_energy(x, [[0, 1, 2]], b, a, np.ones(1), np.ones(1), np.zeros(1, np.int32))[0])
+    0.0
+    """
+    f = deformation_gradients(x, tris, b)
+    kind = np.asarray(kind)
+    psi = np.where(kind == KIND_COROTATED, corotated.energy_density(f, mu, lam),
+                   neo_hookean.energy_density(f, mu, lam))
+    return area * psi
+
+
+def signed_areas(x, tris):
+    """Signed areas (T,) in m^2 of triangles at positions ``x``: negative means inverted."""
+    x = np.asarray(x, dtype=np.float64)
+    t = np.asarray(tris, dtype=np.int64)
+    e1 = x[t[:, 1]] - x[t[:, 0]]
+    e2 = x[t[:, 2]] - x[t[:, 0]]
+    return 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+
+
+def max_stiffness(mu, lam):
+    """Largest curvature ``2 (mu + max(lambda, 0))`` (Pa) of either energy at rest in ``F``.
+
+    Bounds how stiff an element is: it sets the stable explicit step and the implicit
+    solve's matrix weight.
+    """
+    return 2.0 * (mu + np.maximum(lam, 0.0))
+
+
+def gradient_row_sums(tris, b, area, weight, n):
+    """Per vertex, ``sum_e weight_e A_e sum_w |D_v . D_w|``: the Gershgorin row sum (N/m per
+    unit ``weight``) of the elements' stiffness matrices at vertex ``v`` (n,)."""
+    t = np.asarray(tris, dtype=np.int64)
+    bb = np.asarray(b).reshape(-1, 2, 2)
+    d = np.stack([-bb[:, 0] - bb[:, 1], bb[:, 0], bb[:, 1]], axis=1)  # (T, 3, 2): D_i, D_j, D_k
+    dots = np.abs(np.einsum("tvc,twc->tvw", d, d)).sum(axis=2)  # (T, 3)
+    out = np.zeros(n)
+    np.add.at(out, t.ravel(), ((weight * area)[:, None] * dots).ravel())
+    return out
+
+
+def element_matrix(tris, b, weight, n) -> sp.csc_matrix:
+    """Sum over elements of ``weight_e D D^T`` (N x N): the matrix of ``sum_e weight_e / 2
+    |F_e(x) - T_e|^2`` for one coordinate (symmetric, rows sum to zero).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    >>> b, a = rest_geometry(x, [[0, 1, 2]])
+    >>> element_matrix([[0, 1, 2]], b, np.ones(1), 3).toarray().tolist()
+    [[2.0, -1.0, -1.0], [-1.0, 1.0, 0.0], [-1.0, 0.0, 1.0]]
+    """
+    t = np.asarray(tris, dtype=np.int64)
+    bb = np.asarray(b).reshape(-1, 2, 2)
+    d = np.stack([-bb[:, 0] - bb[:, 1], bb[:, 0], bb[:, 1]], axis=1)
+    vals = np.asarray(weight)[:, None, None] * np.einsum("tvc,twc->tvw", d, d)
+    rows = np.repeat(t, 3, axis=1).ravel()
+    cols = np.tile(t, (1, 3)).ravel()
+    return sp.csc_matrix((vals.ravel(), (rows, cols)), shape=(n, n))
+
+
+@njit(cache=True, inline="always")
+def _gradient(x, i, j, k, b0, b1, b2, b3):
+    """``F`` (4 entries) of one triangle."""
+    e1x = x[j, 0] - x[i, 0]
+    e1y = x[j, 1] - x[i, 1]
+    e2x = x[k, 0] - x[i, 0]
+    e2y = x[k, 1] - x[i, 1]
+    return e1x * b0 + e2x * b2, e1x * b1 + e2x * b3, e1y * b0 + e2y * b2, e1y * b1 + e2y * b3
+
+
+@njit(cache=True, inline="always")
+def stress(kind, f00, f01, f10, f11, mu, lam):
+    """The elastic stress ``P`` (4) of element kind ``kind`` at ``F``."""
+    if kind == KIND_COROTATED:
+        return corotated.stress(f00, f01, f10, f11, mu, lam)
+    return neo_hookean.stress(f00, f01, f10, f11, mu, lam)
+
+
+@njit(cache=True, inline="always")
+def rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu, lam):
+    """The corotated linear stress ``R (2 mu sym(R^T G) + lambda tr(R^T G) I)`` of a rate (or
+    increment) ``G`` (4 entries ``r..``) in the rotated frame of ``F``: the damping stress per
+    unit ``beta``."""
+    c, s, _ = corotated.polar_rotation(f00, f01, f10, f11)
+    # G' = R^T G, R = [[c, -s], [s, c]]
+    g00 = c * r00 + s * r10
+    g01 = c * r01 + s * r11
+    g10 = -s * r00 + c * r10
+    g11 = -s * r01 + c * r11
+    off = mu * (g01 + g10)
+    tr = lam * (g00 + g11)
+    q00 = 2.0 * mu * g00 + tr
+    q11 = 2.0 * mu * g11 + tr
+    return c * q00 - s * off, c * off - s * q11, s * q00 + c * off, s * off + c * q11
+
+
+@njit(cache=True, inline="always")
+def element_force(x, v, i, j, k, b0, b1, b2, b3, area, mu, lam, beta, kind):
+    """Forces (N) on vertices ``j`` and ``k`` of one element (``i`` feels minus their sum):
+    elastic plus damping, ``-A (P + P_damp) D_v``."""
+    f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+    p00, p01, p10, p11 = stress(kind, f00, f01, f10, f11, mu, lam)
+    if beta > 0.0:
+        r00, r01, r10, r11 = _gradient(v, i, j, k, b0, b1, b2, b3)
+        d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu, lam)
+        p00 += beta * d00
+        p01 += beta * d01
+        p10 += beta * d10
+        p11 += beta * d11
+    # -A P B^T: column 0 on j, column 1 on k
+    return (-area * (p00 * b0 + p01 * b1), -area * (p10 * b0 + p11 * b1),
+            -area * (p00 * b2 + p01 * b3), -area * (p10 * b2 + p11 * b3))
+
+
+@njit(cache=True)
+def element_forces(x, v, elem, b, area, mu, lam, beta, kind, f):
+    """Add every element's force (N) to ``f`` (N, 2).
+
+    Parameters
+    ----------
+    x, v : (N, 2) float64
+        Positions (m), velocities (m/s).
+    elem : (T, 3) int32
+        Triangles (global vertex indices, counter-clockwise at rest).
+    b : (T, 4) float64
+        Rest-shape inverses, row-major (1/m).
+    area, mu, lam, beta : (T,) float64
+        Rest areas (m^2), Lamé parameters (Pa), damping (s).
+    kind : (T,) int32
+        Element kinds (``material.KIND_*``).
+    f : (N, 2) float64
+        Accumulated into.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    >>> bb, a = rest_geometry(x, [[0, 1, 2]])
+    >>> f = np.zeros((3, 2))
+    >>> x[1, 0] = 1.1  # stretch along x
+    >>> element_forces(x, np.zeros((3, 2)), np.array([[0, 1, 2]], np.int32), bb, a, np.ones(1), np.ones(1),
+    ...                np.zeros(1), np.zeros(1, np.int32), f)
+    >>> f.sum(axis=0).round(12).tolist(), bool(f[1, 0] < 0)  # no net force; the stretch pulls back
+    ([0.0, 0.0], True)
+    """
+    for e in range(elem.shape[0]):
+        i = np.uint64(elem[e, 0])
+        j = np.uint64(elem[e, 1])
+        k = np.uint64(elem[e, 2])
+        fjx, fjy, fkx, fky = element_force(x, v, i, j, k, b[e, 0], b[e, 1], b[e, 2], b[e, 3], area[e], mu[e],
+                                           lam[e], beta[e], kind[e])
+        f[j, 0] += fjx
+        f[j, 1] += fjy
+        f[k, 0] += fkx
+        f[k, 1] += fky
+        f[i, 0] -= fjx + fkx
+        f[i, 1] -= fjy + fky
+
+
+@njit(cache=True)
+def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, rhs):
+    """Add the elements' part of the implicit solve's right-hand side to ``rhs`` (N, 2).
+
+    Element ``e`` enters the solve as ``weight_e / 2 |F_e(x) - T_e|^2`` with the target
+    ``T = F - A (h^2 P(F) + h beta P_rate(F - F_n)) / weight``: then solving with the fixed
+    matrix steps the backward Euler objective along its exact gradient (for the corotated
+    model, ``T`` is exactly the projective-dynamics projection: the blend of the nearest
+    rotation and the nearest shape of rest area). ``weight = A (h^2 + h beta) k`` with ``k``
+    the element's stiffness bound (:func:`max_stiffness`). Adds ``weight D^T T``.
+    """
+    h2 = h * h
+    for e in range(elem.shape[0]):
+        i = np.uint64(elem[e, 0])
+        j = np.uint64(elem[e, 1])
+        k = np.uint64(elem[e, 2])
+        b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+        p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
+        p00 *= h2
+        p01 *= h2
+        p10 *= h2
+        p11 *= h2
+        if beta[e] > 0.0:
+            n00, n01, n10, n11 = _gradient(x_n, i, j, k, b0, b1, b2, b3)
+            d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, f00 - n00, f01 - n01, f10 - n10, f11 - n11,
+                                             mu[e], lam[e])
+            hb = h * beta[e]
+            p00 += hb * d00
+            p01 += hb * d01
+            p10 += hb * d10
+            p11 += hb * d11
+        w = weight[e]
+        s = area[e] / w
+        t00 = w * (f00 - s * p00)
+        t01 = w * (f01 - s * p01)
+        t10 = w * (f10 - s * p10)
+        t11 = w * (f11 - s * p11)
+        # weight D_v^T T for v = j (D_j = b[0:2]), k (D_k = b[2:4]), i (minus both)
+        jx = t00 * b0 + t01 * b1
+        jy = t10 * b0 + t11 * b1
+        kx = t00 * b2 + t01 * b3
+        ky = t10 * b2 + t11 * b3
+        rhs[j, 0] += jx
+        rhs[j, 1] += jy
+        rhs[k, 0] += kx
+        rhs[k, 1] += ky
+        rhs[i, 0] -= jx + kx
+        rhs[i, 1] -= jy + ky
+
+
+@njit(cache=True, inline="always")
+def _vertex_gradients(g00, g01, g10, g11, b0, b1, b2, b3):
+    """Gradients at vertices ``i, j, k`` (6) of a constraint whose gradient in ``F`` is ``g``:
+    ``g D_v`` with ``D_j = (b0, b1)``, ``D_k = (b2, b3)``, ``D_i = -D_j - D_k``."""
+    jx = g00 * b0 + g01 * b1
+    jy = g10 * b0 + g11 * b1
+    kx = g00 * b2 + g01 * b3
+    ky = g10 * b2 + g11 * b3
+    return -jx - kx, -jy - ky, jx, jy, kx, ky
+
+
+@njit(cache=True, inline="always")
+def _dot(wi, wj, wk, a, b):
+    """Inverse-mass weighted dot product of two vertex gradients (6 entries each)."""
+    return wi * (a[0] * b[0] + a[1] * b[1]) + wj * (a[2] * b[2] + a[3] * b[3]) + wk * (a[4] * b[4] + a[5] * b[5])
+
+
+@njit(cache=True, inline="always")
+def _rate(x, x_prev, i, j, k, a):
+    """``grad C . (x - x_prev)`` over the three vertices."""
+    return a[0] * (x[i, 0] - x_prev[i, 0]) + a[1] * (x[i, 1] - x_prev[i, 1]) \
+        + a[2] * (x[j, 0] - x_prev[j, 0]) + a[3] * (x[j, 1] - x_prev[j, 1]) \
+        + a[4] * (x[k, 0] - x_prev[k, 0]) + a[5] * (x[k, 1] - x_prev[k, 1])
+
+
+@njit(cache=True)
+def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, lam_acc, h):
+    """One Gauss-Seidel XPBD sweep over the elements, both constraints of each solved together.
+
+    Corotated: ``C_dev`` (stiffness ``2 mu A``) and ``C_vol = tr S - 2`` (``(mu + lambda)
+    A``); stable Neo-Hookean: ``C_S`` (``mu A``) and ``C_H = J - 1`` (``lambda' A``), after
+    Macklin and Mueller 2021 (see :mod:`~deforma.physics.neo_hookean` for the 2D form).
+    Damping ``beta`` gives each constraint ``kd = beta * stiffness``. ``lam_acc`` (T, 2) holds
+    the multipliers of the substep.
+
+    The two are solved as one 2 x 2 system per element rather than one after the other, so
+    that neither undoes the other's correction within a sweep (one sequential sweep left a
+    hanging column's width barely contracted: Poisson ratio 0.09 measured instead of 0.3).
+    """
+    h2 = h * h
+    for e in range(elem.shape[0]):
+        i = np.uint64(elem[e, 0])
+        j = np.uint64(elem[e, 1])
+        k = np.uint64(elem[e, 2])
+        b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        a, m, lm, be = area[e], mu[e], lam[e], beta[e]
+        f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+        if kind[e] == KIND_COROTATED:
+            c1, d00, d01, d10, d11, c2, v00, v01, v10, v11 = corotated.constraints(f00, f01, f10, f11)
+            k1 = 2.0 * m * a
+        else:
+            c1, d00, d01, d10, d11, c2, v00, v01, v10, v11 = neo_hookean.constraints(f00, f01, f10, f11)
+            k1 = m * a
+        k2 = (m + lm) * a
+        wi, wj, wk = inv_mass[i], inv_mass[j], inv_mass[k]
+        g1 = _vertex_gradients(d00, d01, d10, d11, b0, b1, b2, b3)
+        g2 = _vertex_gradients(v00, v01, v10, v11, b0, b1, b2, b3)
+        # rows scaled by k h^2 (as the springs' update): (kt + dt) G dlam + dlam = -(kt C + lam + dt rate)
+        s1 = (1.0 + be / h) * k1 * h2  # kt + dt, dt = beta k h
+        s2 = (1.0 + be / h) * k2 * h2
+        g11 = _dot(wi, wj, wk, g1, g1)
+        g12 = _dot(wi, wj, wk, g1, g2)
+        g22 = _dot(wi, wj, wk, g2, g2)
+        r1 = -(k1 * h2 * c1 + lam_acc[e, 0] + be * k1 * h * _rate(x, x_prev, i, j, k, g1))
+        r2 = -(k2 * h2 * c2 + lam_acc[e, 1] + be * k2 * h * _rate(x, x_prev, i, j, k, g2))
+        a11 = s1 * g11 + 1.0
+        a12 = s1 * g12
+        a21 = s2 * g12
+        a22 = s2 * g22 + 1.0
+        det = a11 * a22 - a12 * a21  # > 0: det(S G + I) with S, G positive semi-definite
+        dl1 = (r1 * a22 - a12 * r2) / det
+        dl2 = (a11 * r2 - a21 * r1) / det
+        lam_acc[e, 0] += dl1
+        lam_acc[e, 1] += dl2
+        x[i, 0] += wi * (g1[0] * dl1 + g2[0] * dl2)
+        x[i, 1] += wi * (g1[1] * dl1 + g2[1] * dl2)
+        x[j, 0] += wj * (g1[2] * dl1 + g2[2] * dl2)
+        x[j, 1] += wj * (g1[3] * dl1 + g2[3] * dl2)
+        x[k, 0] += wk * (g1[4] * dl1 + g2[4] * dl2)
+        x[k, 1] += wk * (g1[5] * dl1 + g2[5] * dl2)

@@ -1,0 +1,159 @@
+"""Materials: what a body is made of, in SI units.
+
+A :class:`Material` names a constitutive model and its parameters. ``"springs"`` is the
+original's mass-spring model (one spring per mesh edge, with the world's or the body's
+``stiffness``, ``damping`` and ``mass``). ``"corotated"`` and ``"neo-hookean"`` are finite
+elements: every triangle of the mesh is a linear (constant-strain) element of an elastic
+sheet with Young's modulus ``E``, Poisson ratio ``nu`` and areal density ``rho``, so the
+same object meshed finer is the same object.
+
+Units. The world is 2D: a body is a slab of unit thickness seen from its face, in plane
+stress. ``youngs_modulus`` is in Pa (N/m^2, i.e. N/m per metre of thickness), ``density``
+in kg/m^2 (mass per area: a body weighs ``density * area``). Plane stress gives the Lamé
+parameters
+
+    mu = E / (2 (1 + nu)),    lambda = E nu / (1 - nu^2),
+
+so that a strip pulled along its length contracts across by ``nu`` times its stretch.
+
+Damping (``damping``, seconds) is stiffness-proportional (Rayleigh, Kelvin-Voigt): a
+viscous stress equal to the elastic stress of the strain *rate*, times ``damping``. A
+vibration of angular frequency ``omega`` then has damping ratio ``damping * omega / 2``:
+fine ripples die at once, the slow sway of the whole body lives on. Rigid motion (moving,
+turning) is never damped.
+
+Examples
+--------
+>>> rubber = Material("neo-hookean", youngs_modulus=1e6, poisson_ratio=0.45, density=1100.0)
+>>> mu, lam = rubber.lame()
+>>> round(mu), round(lam)
+(344828, 564263)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import KW_ONLY, dataclass
+
+MODELS = ("springs", "corotated", "neo-hookean")
+# Element kind codes stored per triangle in the Model (springs bodies have no elements).
+KIND_COROTATED = 0
+KIND_NEO_HOOKEAN = 1
+KIND_CODES = {"corotated": KIND_COROTATED, "neo-hookean": KIND_NEO_HOOKEAN}
+
+
+def _number(value, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if isinstance(value, bool):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class Material:
+    """A constitutive model with its parameters (immutable; assign a new one to change).
+
+    Parameters
+    ----------
+    model : {"springs", "corotated", "neo-hookean"}
+        ``"springs"``: the original's mass-spring model (takes none of the keywords below;
+        the body's ``stiffness``, ``damping`` and ``mass`` apply). ``"corotated"``: linear
+        elasticity in each triangle's rotated frame (cheapest element, exact for small
+        strains at any rotation). ``"neo-hookean"``: stable Neo-Hookean (Smith et al.
+        2018), stiffer than corotated in large compression and defined for inverted
+        triangles, which it pushes back out.
+    youngs_modulus : float
+        E in Pa (> 0, finite). Rubber ~1e6, a soft gel ~1e4.
+    poisson_ratio : float
+        nu in (-1, 0.5): how much a stretched sheet narrows (0.5 would be incompressible).
+    density : float
+        kg/m^2 (> 0, finite): mass per area of the sheet.
+    damping : float, optional
+        Stiffness-proportional viscous damping in seconds (>= 0, finite; default 0): a mode
+        of angular frequency ``omega`` gets damping ratio ``damping * omega / 2``.
+
+    Raises
+    ------
+    ValueError
+        Unknown model, a missing or out-of-range parameter, or FEM keywords given to
+        ``"springs"``; the message names the value and the allowed range.
+
+    Examples
+    --------
+    >>> Material("corotated", youngs_modulus=1e5, poisson_ratio=0.3, density=100.0).is_fem
+    True
+    >>> Material("springs").is_fem
+    False
+    """
+
+    model: str
+    _: KW_ONLY
+    youngs_modulus: float | None = None
+    poisson_ratio: float | None = None
+    density: float | None = None
+    damping: float = 0.0
+
+    def __post_init__(self):
+        if self.model not in MODELS:
+            raise ValueError(f"material model must be one of {', '.join(repr(m) for m in MODELS)}, "
+                             f"got {self.model!r}")
+        given = [k for k in ("youngs_modulus", "poisson_ratio", "density") if getattr(self, k) is not None]
+        if self.model == "springs":
+            if given or self.damping != 0.0:
+                extra = ", ".join(given + (["damping"] if self.damping != 0.0 else []))
+                raise ValueError(f"the 'springs' material takes no {extra}: its springs use the body's "
+                                 f"stiffness (N/m), damping (N*s/m) and mass (kg)")
+            return
+        missing = [k for k in ("youngs_modulus", "poisson_ratio", "density") if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"the {self.model!r} material needs {', '.join(missing)} "
+                             f"(E in Pa, nu in (-1, 0.5), density in kg/m^2)")
+        e = _number(self.youngs_modulus, "youngs_modulus")
+        nu = _number(self.poisson_ratio, "poisson_ratio")
+        rho = _number(self.density, "density")
+        d = _number(self.damping, "damping")
+        if not (math.isfinite(e) and 0.0 < e <= 1e15):
+            raise ValueError(f"youngs_modulus must be in (0, 1e15] Pa, got {self.youngs_modulus!r}")
+        if not (math.isfinite(nu) and -1.0 < nu < 0.5):
+            raise ValueError(f"poisson_ratio must be in (-1, 0.5), got {self.poisson_ratio!r}")
+        if not (math.isfinite(rho) and 0.0 < rho <= 1e12):
+            raise ValueError(f"density must be in (0, 1e12] kg/m^2, got {self.density!r}")
+        if not (math.isfinite(d) and 0.0 <= d <= 1e6):
+            raise ValueError(f"damping must be in [0, 1e6] s, got {self.damping!r}")
+        object.__setattr__(self, "youngs_modulus", e)
+        object.__setattr__(self, "poisson_ratio", nu)
+        object.__setattr__(self, "density", rho)
+        object.__setattr__(self, "damping", d)
+
+    @property
+    def is_fem(self) -> bool:
+        """True for the finite-element models (``"corotated"``, ``"neo-hookean"``)."""
+        return self.model != "springs"
+
+    @property
+    def kind(self) -> int:
+        """The element kind code the kernels read (``KIND_COROTATED`` / ``KIND_NEO_HOOKEAN``)."""
+        if not self.is_fem:
+            raise ValueError("the 'springs' material has no elements")
+        return KIND_CODES[self.model]
+
+    def lame(self) -> tuple[float, float]:
+        """Plane-stress Lamé parameters ``(mu, lambda)`` in Pa.
+
+        Examples
+        --------
+        >>> Material("corotated", youngs_modulus=2.6, poisson_ratio=0.3, density=1.0).lame()[0]
+        1.0
+        """
+        if not self.is_fem:
+            raise ValueError("the 'springs' material has no Lamé parameters")
+        e, nu = self.youngs_modulus, self.poisson_ratio
+        return e / (2.0 * (1.0 + nu)), e * nu / (1.0 - nu * nu)
+
+    def wave_speed(self) -> float:
+        """Speed of the fastest (dilatational) wave in the sheet, m/s: ``sqrt((lambda + 2 mu) / rho)``."""
+        mu, lam = self.lame()
+        return math.sqrt((lam + 2.0 * mu) / self.density)

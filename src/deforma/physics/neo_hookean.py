@@ -1,0 +1,103 @@
+"""Stable Neo-Hookean elasticity of one triangle (Smith, de Goes and Kim 2018), in 2D.
+
+Energy density (J/m^2 of rest area), with ``J = det F`` and the 2D bulk modulus
+``lambda' = lambda + mu``:
+
+    psi = mu / 2 (|F|^2 - 2) + lambda' / 2 (J - alpha)^2 - mu^2 / (2 lambda'),
+    alpha = 1 + mu / lambda'.
+
+``alpha`` makes the rest shape stress-free (``mu F + lambda' (J - alpha) cof F = 0`` at
+``F = I``), and ``lambda' = lambda + mu`` makes the energy agree with linear elasticity of
+Lamé parameters ``(mu, lambda)`` for small strains (the ``J`` term's curvature shifts the
+linearised ``lambda`` by ``-mu`` in 2D). The last term only puts the rest energy at zero.
+Unlike the classical ``log J`` Neo-Hookean this is finite for every ``F``: a flattened or
+inverted triangle (``J <= 0``) has a finite energy whose stress pushes it back out.
+
+Stress: ``P = mu F + lambda' (J - alpha) cof F`` with ``cof F = dJ/dF =
+[[F11, -F10], [-F01, F00]]``.
+
+In 2D the energy has an exact form with two terms that vanish at rest. Since ``|F|^2 - 2 J
+= (F00 - F11)^2 + (F01 + F10)^2 =: C_S^2`` (``C_S`` measures how far ``F`` is from a scaled
+rotation: the shear), ``psi = mu / 2 C_S^2 + lambda' / 2 (J - 1)^2``.
+
+XPBD (Macklin and Mueller 2021, "A Constraint-based Formulation of Stable Neo-Hookean
+Materials") solves the energy's terms as constraints with compliances ``1 / mu`` and ``1 /
+lambda'`` (per unit rest area). Their deviatoric constraint ``|F|`` is not zero at rest:
+its multiplier must carry the rest stress, which XPBD restarts from zero every substep, and
+the shear stiffness then acts only through the constraint's curvature, one substep late
+(explicitly): a box at rest measured unstable with one substep at 1/60 s. The 2D form's
+``C_S`` and ``C_H = J - 1`` are both zero at rest, so the rest shape carries no multiplier
+and shear is resisted directly; with the two solved together (see
+:func:`~deforma.physics.elements.project_elements`) a body rests at any step.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def bulk(mu, lam):
+    """``(lambda', alpha)``: the 2D bulk modulus ``lambda + mu`` (Pa) and the rest ``J`` shift.
+
+    Examples
+    --------
+    >>> bulk(1.0, 1.0)
+    (2.0, 1.5)
+    """
+    lp = lam + mu
+    return lp, 1.0 + mu / lp
+
+
+@njit(cache=True, inline="always")
+def stress(f00, f01, f10, f11, mu, lam):
+    """First Piola-Kirchhoff stress ``P`` (Pa, 4 entries, row-major) of deformation ``F``.
+
+    Examples
+    --------
+    >>> stress(1.0, 0.0, 0.0, 1.0, 1.0, 1.0)  # at rest
+    (0.0, 0.0, 0.0, 0.0)
+    >>> [round(p, 6) for p in stress(1.0, 0.0, 0.0, -1.0, 1.0, 1.0)]  # mirrored: pushed back
+    [6.0, 0.0, 0.0, -6.0]
+    """
+    lp, alpha = bulk(mu, lam)
+    k = lp * (f00 * f11 - f01 * f10 - alpha)
+    return mu * f00 + k * f11, mu * f01 - k * f10, mu * f10 - k * f01, mu * f11 + k * f00
+
+
+def energy_density(f, mu, lam):
+    """Energy density (J/m^2) of deformation gradients ``f`` (T, 2, 2); vectorised NumPy.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> float(energy_density(np.array([[[1.0, 0.0], [0.0, 1.0]]]), 1.0, 1.0)[0])
+    0.0
+    """
+    # the 2D form (module docstring): exactly zero at rest, no cancellation of large terms
+    j = f[:, 0, 0] * f[:, 1, 1] - f[:, 0, 1] * f[:, 1, 0]
+    shear2 = (f[:, 0, 0] - f[:, 1, 1]) ** 2 + (f[:, 0, 1] + f[:, 1, 0]) ** 2
+    return 0.5 * mu * shear2 + 0.5 * (lam + mu) * (j - 1.0) ** 2
+
+
+@njit(cache=True, inline="always")
+def constraints(f00, f01, f10, f11):
+    """The XPBD constraints of ``F``: ``(C_S, gradient (4), C_H, gradient (4))``, stiffness
+    ``mu`` and ``lambda'`` per unit area. ``C_S``'s gradient is zero where ``C_S = 0``.
+
+    Examples
+    --------
+    >>> c = constraints(1.0, 0.0, 0.0, 1.0)
+    >>> c[0], c[5]  # at rest both vanish
+    (0.0, 0.0)
+    >>> round(constraints(1.0, 0.0, 0.0, -1.0)[5], 6)  # mirrored: J - 1 = -2
+    -2.0
+    """
+    a = f00 - f11
+    b = f01 + f10
+    cs = np.sqrt(a * a + b * b)
+    inv = 1.0 / cs if cs > 0.0 else 0.0
+    # d C_S / dF = [[a, b], [b, -a]] / C_S
+    return (cs, a * inv, b * inv, b * inv, -a * inv,
+            f00 * f11 - f01 * f10 - 1.0, f11, -f10, -f01, f00)
