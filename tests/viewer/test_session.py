@@ -1,5 +1,7 @@
 """The viewer's model without a window: parameters, mesh rebuilds, colliders, save/load."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -14,7 +16,8 @@ def test_every_original_inspector_value_is_a_parameter():
     assert {"detail", "edges", "scale", "resolution", "detect_edges", "edge_step", "dt", "gravity_x", "gravity_y",
             "damping", "mass", "stiffness", "static_friction", "friction", "explosive_force", "collider_x",
             "collider_y", "collider_width", "collider_height", "collider_angle", "mouse_strength"} <= names
-    assert [g for g, _ in GROUPS] == ["Square", "Texture", "Physics", "Contact", "Collision", "Mouse"]
+    assert {"youngs_modulus", "poisson_ratio", "density", "material_damping"} <= names
+    assert [g for g, _ in GROUPS] == ["Square", "Texture", "Physics", "Material", "Contact", "Collision", "Mouse"]
     s = Session("demo")
     for name in names:  # every parameter reads back from a live session
         assert s.get_param(name) is not None
@@ -40,7 +43,9 @@ def test_physics_values_apply_to_the_running_world():
                                          ("detail", 5000), ("resolution", 1), ("scale", 0.0), ("substeps", 2.5),
                                          ("collider_width", -2.0), ("collider_angle", 1000.0),
                                          ("explosive_force", -1.0), ("air_drag", -1.0),
-                                         ("contact_thickness", 1.0)])
+                                         ("contact_thickness", 1.0), ("youngs_modulus", 0.0),
+                                         ("poisson_ratio", 0.5), ("density", -1.0), ("material_damping", -0.1),
+                                         ("youngs_modulus", "stiff")])
 def test_invalid_values_are_refused_and_change_nothing(name, value):
     s = Session("demo")
     before = s.scene
@@ -168,3 +173,131 @@ def test_switching_to_the_explicit_method_with_stiff_springs_warns():
     s.set_param("stiffness", 1e6)
     s.set_integrator("symplectic-euler")
     assert "exceeds the explicit stable estimate" in s.note and "\n" not in s.note
+
+
+# -- material ------------------------------------------------------------------------------------
+
+def test_material_model_switches_on_the_running_world_with_the_defaults():
+    s = Session("sample")
+    world = s.world
+    assert s.material_model == "springs" and world.material is None
+    assert s.get_param("youngs_modulus") == 1e4 and s.get_param("material_damping") == 0.0
+    s.set_material("neo-hookean")
+    assert s.world is world and s.material_model == "neo-hookean"
+    assert world.material == deforma.Material("neo-hookean", youngs_modulus=1e4, poisson_ratio=0.3, density=1.0,
+                                              damping=0.01)
+    rest = world.bodies[0].topology.rest_positions  # the sample's body is a rectangle
+    area = np.prod(rest.max(axis=0) - rest.min(axis=0))
+    assert world.bodies[0].is_fem and world.bodies[0].mass == pytest.approx(1.0 * area)  # density * area
+    s.set_param("youngs_modulus", 5e4)
+    s.set_param("poisson_ratio", 0.2)
+    assert (world.material.youngs_modulus, world.material.poisson_ratio) == (5e4, 0.2)
+    s.set_material("springs")
+    assert world.material is None and not world.bodies[0].is_fem
+    s.set_param("density", 3.0)  # kept while springs ...
+    assert world.material is None and "kept for when" in s.note
+    s.set_material("corotated")  # ... and used when a model needs it; the rest was kept too
+    assert (world.material.model, world.material.youngs_modulus, world.material.density) == ("corotated", 5e4, 3.0)
+
+
+def test_a_fem_scene_shows_its_material():
+    scene = deforma.scene.load("sample")
+    physics = dataclasses.replace(scene.physics, material="corotated", youngs_modulus=2e5, poisson_ratio=0.25,
+                                  density=7.0, material_damping=0.0)
+    s = Session(dataclasses.replace(scene, physics=physics))
+    assert s.material_model == "corotated"
+    assert [s.get_param(n) for n in ("youngs_modulus", "poisson_ratio", "density", "material_damping")] == \
+        [2e5, 0.25, 7.0, 0.0]
+
+
+def test_fem_under_the_explicit_integrator_raises_substeps_or_says_what_to_do():
+    s = Session("sample")
+    s.world.substeps = 1
+    s.material_values["material_damping"] = 0.0
+    s.set_material("corotated")
+    w = s.world
+    assert w.substeps > 1 and "substeps raised to" in s.note and not s.note_is_warning
+    assert w.dt / w.substeps <= w.stable_dt()
+    for _ in range(120):
+        w.step()  # stable as raised
+    s.set_param("youngs_modulus", 1e8)  # far beyond what a live window raises substeps to
+    assert s.note_is_warning and "implicit-euler or xpbd" in s.note and "\n" not in s.note
+    s.set_integrator("implicit-euler")
+    s.set_param("youngs_modulus", 1e7)  # a stable integrator needs no more substeps
+    assert s.note == ""
+
+
+def test_a_body_that_cannot_be_fem_refuses_the_material_and_nothing_changes():
+    s = Session("sample")
+    chain = type("Chain", (), {"vertices": np.array([[5.0, 5.0], [6.0, 5.0], [7.0, 5.0]]),
+                               "edges": np.array([[0, 1], [1, 2]])})()
+    s.world.add_body(chain)
+    with pytest.raises(ValueError, match="needs a mesh with triangles") as e:
+        s.set_material("neo-hookean")
+    assert "\n" not in str(e.value)
+    assert s.world.material is None and s.material_model == "springs"
+    with pytest.raises(ValueError, match="material model must be one of springs, corotated, neo-hookean"):
+        s.set_material("jelly")
+
+
+def test_material_is_saved_and_survives_a_mesh_change(tmp_path):
+    s = Session("demo")
+    s.set_integrator("xpbd")
+    s.set_material("neo-hookean")
+    s.set_param("youngs_modulus", 3e4)
+    s.select_object("box")  # a rebuild from the scene keeps the world's material
+    assert s.world.material.youngs_modulus == 3e4 and s.world.bodies[0].is_fem
+    scene = deforma.scene.load(s.save(tmp_path / "fem.toml"))
+    assert (scene.physics.material, scene.physics.youngs_modulus) == ("neo-hookean", 3e4)
+    assert Session(tmp_path / "fem.toml").material_model == "neo-hookean"
+
+
+# -- pins ----------------------------------------------------------------------------------------
+
+def test_toggle_pin_pins_the_nearest_vertex_of_the_body_under_the_point():
+    s = Session("sample")
+    b = s.world.bodies[0]
+    x = b.positions.copy()
+    target = int(np.argmax(x[:, 1] - x[:, 0]))  # the top-left corner
+    point = x[target] + (0.02, -0.02)  # just inside the body
+    assert s.toggle_pin(point) == (0, target, True)
+    assert b.pinned.sum() == 1 and b.pinned[target]
+    for _ in range(60):
+        s.world.step()
+    np.testing.assert_array_equal(b.positions[target], x[target])
+    assert s.toggle_pin(point) == (0, target, False)  # again: free
+    assert not b.pinned.any()
+    assert s.toggle_pin((50.0, 50.0)) is None  # nothing there
+    outside = x[target] + (-0.05, 0.05)  # just off the outline: found within the radius only
+    assert s.toggle_pin(outside) is None
+    assert s.toggle_pin(outside, radius=0.1) == (0, target, True)
+
+
+def test_unpin_all_and_pins_survive_reset_and_save(tmp_path):
+    s = Session("jelly")
+    for k, body in enumerate(s.world.bodies):
+        s.toggle_pin(body.center_of_mass)
+    pinned = [b.pinned.copy() for b in s.world.bodies]
+    assert all(p.sum() == 1 for p in pinned)
+    s.reset()  # a rebuild from the scene: pins are part of it
+    assert all(np.array_equal(b.pinned, p) for b, p in zip(s.world.bodies, pinned))
+    world = deforma.load_scene(s.save(tmp_path / "pins.toml"))
+    assert all(np.array_equal(b.pinned, p) for b, p in zip(world.bodies, pinned))
+    assert s.unpin_all() == 3
+    assert not any(b.pinned.any() for b in s.world.bodies)
+    assert s.unpin_all() == 0
+
+
+def test_a_mesh_change_keeps_a_pin_box_that_still_holds_vertices_and_clears_vertex_pins(tmp_path):
+    p = tmp_path / "hang.toml"
+    p.write_text("[[body]]\nshape = 'box'\ndetail = 4\nposition = [0, 3]\npin = [[-1, 3.45], [1, 3.55]]\n")
+    s = Session(p)
+    top = s.world.bodies[0].pinned.sum()
+    assert top > 0
+    s.set_param("detail", 6)
+    b = s.world.bodies[0]
+    assert b.pinned.sum() > top and np.allclose(b.positions[b.pinned, 1], 3.5)  # the new top edge
+    s.unpin_all()
+    s.toggle_pin(b.center_of_mass)
+    s.set_param("detail", 3)
+    assert not s.world.bodies[0].pinned.any() and "pins cleared" in s.note

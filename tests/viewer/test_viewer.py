@@ -342,3 +342,116 @@ def test_selected_drop_down_switches_the_object(demo):
     run(demo, 2)
     assert demo.session.mesh.selected == "donut"
     assert demo.view._bodies[0] is body(demo)
+
+
+def scroll_into_view(v, element):
+    """Turn the mouse wheel over the panel until ``element`` is inside its scrolling area."""
+    area = v.inspector.scroll.rect
+    pos = (v.world_size[0] + area.centerx, area.centery)
+    post(pygame.MOUSEMOTION, pos=pos, rel=(0, 0), buttons=(0, 0, 0))
+    run(v, 1)
+    for _ in range(100):
+        top = element.rect.top
+        run(v, 1)
+        if element.rect.top != top:
+            continue  # still gliding (pygame_gui scrolls smoothly): click only where it stops
+        if area.top <= top and element.rect.bottom + 4 * 26 <= area.bottom:  # room to expand below
+            return
+        post(pygame.MOUSEWHEEL, x=0, y=-1 if element.rect.bottom > area.centery else 1, flipped=False,
+             precise_x=0.0, precise_y=0.0)
+    raise AssertionError(f"could not scroll {element} into view")
+
+
+def test_material_drop_down_makes_the_bodies_finite_elements(demo):
+    ins = demo.inspector
+    scroll_into_view(demo, ins.material_menu)
+    assert ins.material_menu.selected_option[0] == "springs"
+    demo.session.set_integrator("xpbd")  # stable at any step: no substeps to raise
+    choose_from_menu(demo, ins.material_menu, "corotated")
+    w = demo.session.world
+    assert w.material is not None and w.material.model == "corotated" and body(demo).is_fem
+    assert not ins.message_is_error and "material: corotated" in ins.message
+    assert ins.rows["youngs_modulus"].entry.get_text() == "1e+04"
+    entry = ins.rows["youngs_modulus"].entry
+    entry.set_text("3e4")
+    post(pygame_gui_event("UI_TEXT_ENTRY_FINISHED"), ui_element=entry, text="3e4")
+    run(demo, 30)
+    assert w.material.youngs_modulus == 3e4
+    assert demo.unstable is None and np.isfinite(body(demo).positions).all()
+
+
+def test_fem_under_the_explicit_integrator_shows_the_hint(demo):
+    ins = demo.inspector
+    scroll_into_view(demo, ins.material_menu)
+    choose_from_menu(demo, ins.material_menu, "neo-hookean")
+    assert demo.session.world.material.model == "neo-hookean"
+    assert ins.message_is_error and "implicit-euler or xpbd" in ins.message
+    run(demo, 5)  # the step that runs away pauses the viewer instead of drawing garbage
+    assert demo.paused and demo.unstable and np.isfinite(body(demo).positions).all()
+
+
+def test_a_body_that_cannot_be_fem_refuses_the_model_in_the_panel(demo):
+    ins = demo.inspector
+    w = demo.session.world
+    chain = type("Chain", (), {"vertices": np.array([[30.0, 30.0], [31.0, 30.0]]), "edges": np.array([[0, 1]])})()
+    b = w.add_body(chain)  # (the renderer draws only bodies with triangles: applied between frames)
+    assert not ins.apply_material("neo-hookean")
+    assert ins.message_is_error and "triangles" in ins.message
+    assert w.material is None and ins.material_menu.selected_option[0] == "springs"
+    w.remove_body(b)
+    run(demo, 2)
+    assert not demo.paused
+
+
+def vertex_pixel(v, index):
+    px = v.to_pixel(body(v).positions[index])
+    return int(round(px[0])), int(round(px[1]))
+
+
+def test_pin_key_pins_the_vertex_under_the_pointer_and_draws_it(demo):
+    run(demo, 40)  # the bunny lands on the first slope
+    x = body(demo).positions
+    centre = body(demo).center_of_mass
+    i = int(np.argmin(np.linalg.norm(x - centre, axis=1)))  # a vertex well inside the body
+    pos = vertex_pixel(demo, i)
+    post(pygame.MOUSEMOTION, pos=pos, rel=(0, 0), buttons=(0, 0, 0))
+    key(pygame.K_f)
+    run(demo, 1)
+    pinned = body(demo).pinned
+    assert pinned.sum() == 1 and pinned[i], demo.inspector.message
+    held = body(demo).positions[i].copy()
+    demo.session.explosive_force = 8.0
+    key(pygame.K_SPACE)
+    run(demo, 20)
+    np.testing.assert_array_equal(body(demo).positions[i], held)  # the rest of the body flew up
+    img = demo.screenshot()
+    c = vertex_pixel(demo, i)
+    patch = img[c[1] - 1:c[1] + 2, c[0] - 1:c[0] + 2].reshape(-1, 3).astype(int)
+    assert (patch.sum(axis=1) < 120).all()  # the dark square
+    frame = img[c[1] - 4, c[0] - 3:c[0] + 4].astype(int)
+    assert (frame.sum(axis=1) > 650).all()  # in its light frame
+    key(pygame.K_u)
+    run(demo, 1)
+    assert not body(demo).pinned.any() and "unpinned 1" in demo.inspector.message
+
+
+def test_shift_click_pins_instead_of_grabbing(demo):
+    run(demo, 40)
+    x = body(demo).positions
+    i = int(np.argmin(np.linalg.norm(x - body(demo).center_of_mass, axis=1)))
+    pos = vertex_pixel(demo, i)
+    pygame.key.set_mods(pygame.KMOD_SHIFT)
+    try:
+        post(pygame.MOUSEBUTTONDOWN, pos=pos, button=1)
+        post(pygame.MOUSEBUTTONUP, pos=pos, button=1)
+        run(demo, 1)
+    finally:
+        pygame.key.set_mods(0)
+    assert demo.grab is None and body(demo).pinned[i] and body(demo).pinned.sum() == 1
+    pygame.key.set_mods(pygame.KMOD_SHIFT)
+    try:
+        post(pygame.MOUSEBUTTONDOWN, pos=pos, button=1)  # again: free it
+        run(demo, 1)
+    finally:
+        pygame.key.set_mods(0)
+    assert not body(demo).pinned.any()

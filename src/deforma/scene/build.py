@@ -17,15 +17,15 @@ from pathlib import Path
 import numpy as np
 
 from .assets import scene_path
-from .schema import (BoxBody, ColliderSpec, ImageBody, InteractionSettings, MeshBody, PhysicsSettings, Scene,
-                     SceneError, parse_scene, scene_to_dict)
+from .schema import (MATERIAL_KEYS, BoxBody, ColliderSpec, ImageBody, InteractionSettings, MaterialKeyError,
+                     MeshBody, PhysicsSettings, Scene, SceneError, material_settings, parse_scene, scene_to_dict)
 
 try:  # Python >= 3.11
     import tomllib
 except ImportError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["build", "load", "load_scene", "make_mesh", "save_scene", "scene_of"]
+__all__ = ["build", "load", "load_scene", "make_mesh", "pin_mask", "save_scene", "scene_of"]
 
 
 @dataclass
@@ -89,6 +89,62 @@ def make_mesh(spec):
     raise TypeError(f"not a body spec: {spec!r}")
 
 
+def _material(settings, *, world=False):
+    from ..physics import Material
+
+    if settings is None or (world and settings["model"] == "springs"):
+        return None  # a body following the world; a world of the seed's springs
+    return Material(**settings)
+
+
+def _box_mask(box, positions) -> np.ndarray:
+    (x0, y0), (x1, y1) = box
+    x, y = positions[:, 0], positions[:, 1]
+    return (x >= min(x0, x1)) & (x <= max(x0, x1)) & (y >= min(y0, y1)) & (y <= max(y0, y1))
+
+
+def pin_mask(spec, positions) -> np.ndarray:
+    """(N,) bool: the vertices a body spec pins (its ``pin`` box and its ``pin_vertices``).
+
+    Parameters
+    ----------
+    spec : BoxBody, ImageBody or MeshBody
+    positions : (N, 2) array
+        The body's vertices where the scene places them, metres.
+
+    Raises
+    ------
+    ValueError
+        A ``pin`` box holding no vertex, or a ``pin_vertices`` index past the last vertex;
+        the message starts with the key (``pin: ...``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pin_mask(BoxBody(pin=((-1, -1), (0, 1))), np.array([[-0.5, 0.0], [0.5, 0.0]])).tolist()
+    [True, False]
+    """
+    x = np.asarray(positions, dtype=np.float64)
+    mask = np.zeros(len(x), bool)
+    if spec.pin is not None:
+        inside = _box_mask(spec.pin, x)
+        if not inside.any():
+            (x0, y0), (x1, y1) = spec.pin
+            lo, hi = x.min(axis=0), x.max(axis=0)
+            raise ValueError(f"pin: the box [[{x0:g}, {y0:g}], [{x1:g}, {y1:g}]] holds no vertex of the body, which "
+                             f"spans x {lo[0]:.3g}..{hi[0]:.3g} m, y {lo[1]:.3g}..{hi[1]:.3g} m once placed: move "
+                             f"the box over the part to hold")
+        mask |= inside
+    if spec.pin_vertices:
+        idx = np.asarray(spec.pin_vertices, dtype=np.int64)
+        if idx.min() < 0 or idx.max() >= len(x):
+            bad = int(idx[(idx < 0) | (idx >= len(x))][0])
+            raise ValueError(f"pin_vertices: vertex index {bad} is out of range; the body has vertices "
+                             f"0..{len(x) - 1}")
+        mask[idx] = True
+    return mask
+
+
 def build(scene: Scene):
     """A new :class:`deforma.World` holding the scene's bodies and colliders.
 
@@ -106,18 +162,31 @@ def build(scene: Scene):
         world = World(gravity=p.gravity, dt=p.dt, substeps=p.substeps, mass=p.mass, stiffness=p.stiffness,
                       damping=p.damping, friction=p.friction, static_friction=p.static_friction,
                       grab_strength=scene.interaction.mouse_strength, max_speed=p.max_speed,
-                      integrator=p.integrator, contact_thickness=p.contact_thickness, air_drag=p.air_drag)
+                      integrator=p.integrator, contact_thickness=p.contact_thickness, air_drag=p.air_drag,
+                      material=_material(material_settings(p), world=True))
+    except MaterialKeyError as e:
+        raise SceneError(f"{source}: physics{'' if e.key is None else '.' + e.key}: {e}") from None
     except ValueError as e:
         raise SceneError(f"{source}: physics: {e}") from None
     bodies = []
     for i, spec in enumerate(scene.body):
         try:
+            material = _material(material_settings(p, spec))
             m = make_mesh(spec)
-            b = world.add_body(m, position=spec.position, mass=spec.mass, stiffness=spec.stiffness,
-                               damping=spec.damping, collide=spec.collide, self_collision=spec.self_collision,
-                               friction=spec.friction, static_friction=spec.static_friction)
+            b = world.add_body(m, position=spec.position, material=material, mass=spec.mass,
+                               stiffness=spec.stiffness, damping=spec.damping, collide=spec.collide,
+                               self_collision=spec.self_collision, friction=spec.friction,
+                               static_friction=spec.static_friction)
+        except MaterialKeyError as e:
+            raise SceneError(f"{source}: body[{i}]{'' if e.key is None else '.' + e.key}: {e}") from None
         except ValueError as e:
             raise SceneError(f"{source}: body[{i}]: {e}") from None
+        try:
+            mask = pin_mask(spec, b.positions)
+        except ValueError as e:  # the message starts with the key: body[i].pin: ...
+            raise SceneError(f"{source}: body[{i}].{e}") from None
+        if mask.any():
+            b.pin(mask)
         bodies.append((weakref.ref(b), spec))
     colliders = []
     for c in scene.collider:
@@ -156,12 +225,73 @@ def load_scene(name_or_path):
     return build(load(name_or_path))
 
 
+def _material_keys(world, recorded: PhysicsSettings) -> dict:
+    """``[physics]``'s material keys for the world as it is now."""
+    m = world.material
+    if m is not None and m.is_fem:
+        return dict(material=m.model, youngs_modulus=m.youngs_modulus, poisson_ratio=m.poisson_ratio,
+                    density=m.density, material_damping=m.damping)
+    # A springs world: finite-element keys in [physics] are defaults for bodies that choose a
+    # finite-element model. The world does not hold them, so keep the scene's while some body
+    # is made of elements (a file must not hold defaults that no body uses: load refuses it).
+    keep = any(b.is_fem for b in world.bodies)
+    return dict(material="springs",
+                youngs_modulus=recorded.youngs_modulus if keep else None,
+                poisson_ratio=recorded.poisson_ratio if keep else None,
+                density=recorded.density if keep else None,
+                material_damping=recorded.material_damping if keep else 0.0)
+
+
+def _expected_material(physics: PhysicsSettings, spec):
+    """The material ``spec`` gives its body under ``physics`` (None if the spec cannot be used)."""
+    from ..physics import Material
+
+    try:
+        own = material_settings(physics, spec)
+        settings = own if own is not None else material_settings(physics)
+        return Material(**settings)
+    except ValueError:
+        return None
+
+
+def _body_material_keys(material) -> dict:
+    """A body spec's material keys that give it exactly ``material`` whatever [physics] says."""
+    if not material.is_fem:
+        return dict(material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
+                    material_damping=None)
+    return dict(material=material.model, youngs_modulus=material.youngs_modulus,
+                poisson_ratio=material.poisson_ratio, density=material.density, material_damping=material.damping)
+
+
+def _pin_keys(spec, body) -> dict:
+    """The spec's pin keys for the body's pins now: the spec's own if they still say it, else
+    its ``pin`` box alone if that does, else the pinned vertices by number."""
+    mask = body.pinned
+    rest = body.topology.rest_positions  # where the scene placed the body: what a box is tested on
+    try:
+        if np.array_equal(mask, pin_mask(spec, rest)):
+            return {}
+    except ValueError:  # the spec's pins do not fit this body (e.g. a mesh made in code)
+        pass
+    if spec.pin is not None and np.array_equal(mask, _box_mask(spec.pin, rest)):
+        return dict(pin_vertices=None)
+    pinned = tuple(int(i) for i in np.flatnonzero(mask))
+    return dict(pin=None, pin_vertices=pinned or None)
+
+
 def scene_of(world) -> Scene:
     """The scene of ``world`` as it is now: its current parameters, bodies and colliders.
 
     Bodies made from a scene keep their recipe (box or image parameters, colour, texture);
     other bodies are written as ``shape = "mesh"`` with their rest vertices. Positions are
     the starting positions: a scene describes a setup, not a moment of a run.
+
+    Materials: the world's material goes to ``[physics]``; a body whose material differs from
+    what its spec and ``[physics]`` give it gets all five material keys of its own (so a body
+    whose own material equals the world's is written as following the world). A
+    finite-element body has no spring mass, stiffness or damping to write. Pins: the spec's
+    ``pin`` box is kept while the body's pinned vertices are exactly those inside it;
+    otherwise they are written as ``pin_vertices``.
     """
     rec = _REGISTRY.get(world)
     scene = rec.scene if rec is not None else Scene()
@@ -171,7 +301,7 @@ def scene_of(world) -> Scene:
         friction=float(world.friction), static_friction=float(world.static_friction),
         max_speed=float(world.max_speed), integrator=world.integrator,
         contact_thickness=None if world.contact_thickness is None else float(world.contact_thickness),
-        air_drag=float(world.air_drag),
+        air_drag=float(world.air_drag), **_material_keys(world, scene.physics),
     )
     interaction = InteractionSettings(explosive_force=scene.interaction.explosive_force,
                                       mouse_strength=float(world.grab_strength))
@@ -191,7 +321,13 @@ def scene_of(world) -> Scene:
                             triangles=tuple(map(tuple, np.asarray(b.triangles).tolist())),
                             uv=None if uv is None else tuple(map(tuple, np.asarray(uv).tolist())))
         overrides = {}
+        fem = b.is_fem
         for name in ("mass", "stiffness", "damping", "friction", "static_friction"):
+            if fem and name in ("mass", "stiffness", "damping"):
+                # elements take their mass from the density and have no springs
+                if getattr(spec, name) is not None:
+                    overrides[name] = None
+                continue
             expected = getattr(spec, name)
             expected = getattr(world, name) if expected is None else expected
             actual = float(getattr(b, name))
@@ -200,7 +336,14 @@ def scene_of(world) -> Scene:
         for name in ("collide", "self_collision"):
             if getattr(b, name) != getattr(spec, name):
                 overrides[name] = getattr(b, name)
-        bodies.append(replace(spec, **overrides) if overrides else spec)
+        spec = replace(spec, **overrides) if overrides else spec
+        if _expected_material(physics, spec) != b.material:
+            following = replace(spec, **dict.fromkeys(MATERIAL_KEYS))
+            # a body that now has the world's material is written as following it
+            keys = MATERIAL_KEYS if _expected_material(physics, following) == b.material else ()
+            spec = replace(spec, **(dict.fromkeys(keys) or _body_material_keys(b.material)))
+        pins = _pin_keys(spec, b)
+        bodies.append(replace(spec, **pins) if pins else spec)
     colour_of = {id(r): c for r, c in (rec.colliders if rec is not None else [])}
     colliders = []
     for r in world.colliders:

@@ -31,6 +31,12 @@ A file looks like::
     [[collider]]
     center = [0.0, 0.0]
     size = [8.0, 0.4]
+
+Materials: ``[physics] material`` (with ``youngs_modulus``, ``poisson_ratio``, ``density``,
+``material_damping``) is the world's default; the same five keys on a ``[[body]]`` give it
+its own material, each key it leaves out taken from ``[physics]``. :func:`material_settings`
+says what a table means and refuses the combinations that mean nothing (finite-element
+parameters on springs, spring mass on finite elements, a finite-element model without E).
 """
 
 from __future__ import annotations
@@ -44,8 +50,21 @@ from typing import Any
 
 __all__ = [
     "BodyPhysics", "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
-    "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "parse_scene", "scene_to_dict",
+    "MaterialKeyError", "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "material_settings",
+    "parse_scene",
+    "scene_to_dict",
 ]
+
+#: Material models a scene may name (``deforma.Material``'s; kept here so that reading a file
+#: needs no physics import).
+MATERIAL_MODELS = ("springs", "corotated", "neo-hookean")
+#: The keys that describe a material, on ``[physics]`` and on a ``[[body]]``.
+MATERIAL_KEYS = ("material", "youngs_modulus", "poisson_ratio", "density", "material_damping")
+# the finite-element keys and the Material keyword each one sets
+_FEM_KEYWORD = {"youngs_modulus": "youngs_modulus", "poisson_ratio": "poisson_ratio", "density": "density",
+                "material_damping": "damping"}
+_FEM_NEEDS = ("youngs_modulus", "poisson_ratio", "density")
+_SPRING_KEYS = ("mass", "stiffness", "damping")
 
 
 class SceneError(ValueError):
@@ -61,14 +80,15 @@ class _Problem(Exception):
         self.message = message
 
 
-def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, choices=None, unit="",
-         doc="") -> Any:
+def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, hi_open=False, choices=None,
+         unit="", doc="") -> Any:
     """A dataclass field with what the validator and the docs need to know about it.
 
     ``kind`` is one of float, int, bool, str, vec2, size2, quad, color, colors2, file, points,
-    triangles. ``lo``/``hi`` bound numbers (``lo_open`` makes the lower bound exclusive).
+    triangles, box2 (two corners of an axis-aligned box), indices (a list of integers >= 0).
+    ``lo``/``hi`` bound numbers (``lo_open``/``hi_open`` make a bound exclusive).
     """
-    meta = dict(kind=kind, lo=lo, hi=hi, lo_open=lo_open, choices=choices, unit=unit, doc=doc)
+    meta = dict(kind=kind, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, choices=choices, unit=unit, doc=doc)
     if default is MISSING:
         return field(metadata=meta)
     return field(default=default, metadata=meta)
@@ -135,6 +155,21 @@ class PhysicsSettings:
     air_drag: float = spec("float", 0.0, lo=0.0, unit="1/s",
                            doc="Every velocity decays as dv/dt = -air_drag v; a little lets stacks and heaps come "
                                "to rest.")
+    material: str = spec("str", "springs", choices=MATERIAL_MODELS,
+                         doc="What bodies are made of unless they say: springs (the original's springs on the mesh "
+                             "edges, with mass, stiffness, damping), or finite elements on the triangles: corotated "
+                             "or neo-hookean (need youngs_modulus, poisson_ratio, density; see deforma.Material).")
+    youngs_modulus: float | None = spec("float", None, lo=0.0, hi=1e15, lo_open=True, unit="Pa",
+                                        doc="Young's modulus E of finite-element bodies: rubber ~1e6, a soft gel "
+                                            "~1e4.")
+    poisson_ratio: float | None = spec("float", None, lo=-1.0, hi=0.5, lo_open=True, hi_open=True,
+                                       doc="Poisson ratio nu of finite-element bodies: how much a stretched sheet "
+                                           "narrows (0.5 would be incompressible).")
+    density: float | None = spec("float", None, lo=0.0, hi=1e12, lo_open=True, unit="kg/m^2",
+                                 doc="Mass per area of finite-element bodies: a body weighs density * area.")
+    material_damping: float = spec("float", 0.0, lo=0.0, hi=1e6, unit="s",
+                                   doc="Viscous damping of finite-element bodies: a vibration of angular frequency "
+                                       "w gets damping ratio material_damping * w / 2.")
 
 
 @dataclass(frozen=True)
@@ -162,6 +197,17 @@ class BodyPhysics:
     mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
     stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
     damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
+    material: str | None = spec("str", None, choices=MATERIAL_MODELS,
+                                doc="Overrides physics.material: any of these five keys gives the body its own "
+                                    "material, the others taken from [physics].")
+    youngs_modulus: float | None = spec("float", None, lo=0.0, hi=1e15, lo_open=True, unit="Pa",
+                                        doc="Overrides physics.youngs_modulus.")
+    poisson_ratio: float | None = spec("float", None, lo=-1.0, hi=0.5, lo_open=True, hi_open=True,
+                                       doc="Overrides physics.poisson_ratio.")
+    density: float | None = spec("float", None, lo=0.0, hi=1e12, lo_open=True, unit="kg/m^2",
+                                 doc="Overrides physics.density.")
+    material_damping: float | None = spec("float", None, lo=0.0, hi=1e6, unit="s",
+                                          doc="Overrides physics.material_damping.")
     collide: bool = spec("bool", True, doc="Touch other bodies (both must have it on).")
     self_collision: bool = spec("bool", True, doc="Touch itself: its outline cannot fold through itself.")
     friction: float | None = spec("float", None, lo=0.0,
@@ -169,6 +215,12 @@ class BodyPhysics:
                                       "use sqrt(a * b) of theirs.")
     static_friction: float | None = spec("float", None, lo=0.0,
                                          doc="Overrides physics.static_friction against other bodies and itself.")
+    pin: tuple | None = spec("box2", None, unit="m",
+                             doc="Pin every vertex inside this box, [[x0, y0], [x1, y1]] in world coordinates after "
+                                 "the body is placed: they stay where they are.")
+    pin_vertices: tuple | None = spec("indices", None,
+                                      doc="Pin these vertices, [i, j, ...] (the body's own vertex numbers; what "
+                                          "save_scene writes for pins no box describes).")
 
 
 @dataclass(frozen=True)
@@ -302,17 +354,18 @@ def _range_text(meta) -> str:
     lo, hi = meta["lo"], meta["hi"]
     unit = f" {meta['unit']}" if meta["unit"] else ""
     if lo is not None and hi is not None:
-        return f"in {'(' if meta['lo_open'] else '['}{lo:g}, {hi:g}]{unit}"
+        return f"in {'(' if meta['lo_open'] else '['}{lo:g}, {hi:g}{')' if meta['hi_open'] else ']'}{unit}"
     if lo is not None:
         return f"{'>' if meta['lo_open'] else '>='} {lo:g}{unit}"
     if hi is not None:
-        return f"<= {hi:g}{unit}"
+        return f"{'<' if meta['hi_open'] else '<='} {hi:g}{unit}"
     return ""
 
 
 def _check_range(x, meta, path):
     lo, hi = meta["lo"], meta["hi"]
-    bad = (lo is not None and (x <= lo if meta["lo_open"] else x < lo)) or (hi is not None and x > hi)
+    bad = (lo is not None and (x <= lo if meta["lo_open"] else x < lo)) or \
+        (hi is not None and (x >= hi if meta["hi_open"] else x > hi))
     if bad:
         raise _Problem(path, f"must be {_range_text(meta)}, got {x:g}")
 
@@ -377,6 +430,22 @@ def _convert(value, meta, path, ctx):
                 raise _Problem(f"{path}[{i}]", f"expected three vertex indices, got {_show(t)}")
             out.append(tuple(_number(v, f"{path}[{i}][{k}]", integer=True) for k, v in enumerate(t)))
         return tuple(out)
+    if kind == "box2":
+        if not isinstance(value, list) or len(value) != 2:
+            raise _Problem(path, f"expected two corners [[x0, y0], [x1, y1]], got {_show(value)}")
+        a, b = (_pair(v, f"{path}[{i}]", "two numbers") for i, v in enumerate(value))
+        if a[0] == b[0] or a[1] == b[1]:
+            raise _Problem(path, f"the box must have a width and a height, got [[{a[0]:g}, {a[1]:g}], "
+                                 f"[{b[0]:g}, {b[1]:g}]]")
+        return (a, b)
+    if kind == "indices":
+        if not isinstance(value, list):
+            raise _Problem(path, f"expected vertex indices [i, j, ...], got {_show(value)}")
+        out = tuple(_number(v, f"{path}[{i}]", integer=True) for i, v in enumerate(value))
+        for i, v in enumerate(out):
+            if v < 0:
+                raise _Problem(f"{path}[{i}]", f"vertex indices must be >= 0, got {v}")
+        return out
     if kind == "color":
         return _color(value, path)
     if kind == "colors2":
@@ -426,6 +495,100 @@ def _body(data, path, ctx):
     return body
 
 
+class MaterialKeyError(ValueError):
+    """A material key that cannot be used with the others; ``key`` names it (None: the table)."""
+
+    def __init__(self, key, message: str):
+        super().__init__(message)
+        self.key = key
+
+
+def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None) -> dict | None:
+    """The :class:`deforma.Material` keywords that ``[physics]`` (and a body's overrides) describe.
+
+    Without ``body``: the world's default material. With ``body``: ``None`` when the body sets
+    none of :data:`MATERIAL_KEYS` (it follows the world's), else its own material, with model
+    and each parameter the body's or, where it leaves them out, ``[physics]``'s. A springs
+    material takes no parameters (the finite-element keys that ``[physics]`` holds then
+    matter only to bodies that choose a finite-element model).
+
+    Returns
+    -------
+    dict or None
+        ``{"model": ...}`` plus ``youngs_modulus``, ``poisson_ratio``, ``density`` and
+        ``damping`` for the finite-element models; ``Material(**settings)`` builds it.
+
+    Raises
+    ------
+    MaterialKeyError
+        A finite-element model without E, nu or density; finite-element keys on the body of
+        a springs material; spring mass/stiffness/damping on a finite-element body. ``key``
+        is the offending key.
+
+    Examples
+    --------
+    >>> p = PhysicsSettings(youngs_modulus=1e5, poisson_ratio=0.3, density=10.0)
+    >>> material_settings(p)
+    {'model': 'springs'}
+    >>> material_settings(p, BoxBody(material="corotated"))["youngs_modulus"]
+    100000.0
+    >>> material_settings(p, BoxBody()) is None
+    True
+    """
+    if body is None:
+        model, own = physics.material, {}
+    else:
+        own = {k: getattr(body, k) for k in MATERIAL_KEYS if getattr(body, k) is not None}
+        model = own.get("material", physics.material)
+    springs = [k for k in _SPRING_KEYS if body is not None and getattr(body, k) is not None]
+    if model != "springs" and springs:
+        where = "" if "material" in own else " (physics.material)"
+        raise MaterialKeyError(springs[0], f"the body is made of {model!r} finite elements{where}, whose mass is "
+                                           f"density * area and whose elasticity is youngs_modulus and "
+                                           f"poisson_ratio: remove {springs[0]}, or set material = \"springs\"")
+    if body is not None and not own:
+        return None
+    if model == "springs":
+        fem = [k for k in _FEM_KEYWORD if k in own]
+        if fem:
+            raise MaterialKeyError(fem[0], f"the 'springs' material takes no {fem[0]} (its springs use mass, "
+                                           f"stiffness and damping): set material = \"corotated\" or "
+                                           f"\"neo-hookean\" too, or remove {fem[0]}")
+        return {"model": "springs"}
+    values = {k: own.get(k, getattr(physics, k)) for k in _FEM_KEYWORD}
+    missing = [k for k in _FEM_NEEDS if values[k] is None]
+    if missing:
+        where = "on the body or in [physics]" if body is not None else "in [physics]"
+        raise MaterialKeyError(None, f"the {model!r} material needs {', '.join(missing)} (E in Pa, nu in (-1, 0.5), "
+                                     f"density in kg/m^2): set {'it' if len(missing) == 1 else 'them'} {where}")
+    out = {"model": model}
+    out.update((_FEM_KEYWORD[k], float(v)) for k, v in values.items())
+    return out
+
+
+def _check_materials(values: dict) -> None:
+    """Refuse material keys that mean nothing together (see :func:`material_settings`)."""
+    physics = values.get("physics", PhysicsSettings())
+    try:
+        material_settings(physics)
+    except MaterialKeyError as e:
+        raise _Problem("physics" if e.key is None else f"physics.{e.key}", str(e)) from None
+    fem_bodies = 0
+    for i, body in enumerate(values.get("body", ())):
+        try:
+            own = material_settings(physics, body)
+        except MaterialKeyError as e:
+            raise _Problem(f"body[{i}]" if e.key is None else f"body[{i}].{e.key}", str(e)) from None
+        fem_bodies += own is not None and own["model"] != "springs"
+    if physics.material == "springs" and not fem_bodies:
+        # finite-element defaults that no body uses are most likely a forgotten material key
+        unused = [k for k in _FEM_KEYWORD if getattr(physics, k) not in (None, 0.0)]
+        if unused:
+            raise _Problem(f"physics.{unused[0]}", "no body is made of finite elements to use it (physics.material "
+                                                   "is 'springs'): set material = \"corotated\" or \"neo-hookean\" "
+                                                   "here or on a body, or remove it")
+
+
 def _check_integrator(name: str, path: str) -> None:
     # the registry, not a fixed list: an integrator registered by the user is allowed too
     from ..physics.integrators import available_integrators
@@ -462,7 +625,7 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
     >>> parse_scene({"physics": {"stifness": 10}}, source="my.toml")
     Traceback (most recent call last):
     ...
-    deforma.scene.schema.SceneError: my.toml: physics.stifness: unknown key; did you mean 'stiffness'? allowed: dt, substeps, gravity, damping, mass, stiffness, friction, static_friction, max_speed, integrator
+    deforma.scene.schema.SceneError: my.toml: physics.stifness: unknown key; did you mean 'stiffness'? allowed: dt, ...
     """
     from .assets import resolve_texture
 
@@ -498,6 +661,7 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
                     p = f"{name}[{i}]"
                     out.append(_body(item, p, ctx) if name == "body" else _table(cls, item, p, ctx))
                 values[name] = tuple(out)
+        _check_materials(values)
     except _Problem as e:
         where = f"{e.path}: " if e.path else ""
         raise SceneError(f"{source}: {where}{e.message}") from None

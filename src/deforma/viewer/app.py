@@ -9,7 +9,8 @@
    whole ``world.dt`` steps, so the motion is the same at any frame rate; a slow frame is
    capped instead of spiralling, and an unstable step pauses the viewer and shows the hint;
 3. drawing: the shared :class:`deforma.render.WorldView` paints the world into the window's
-   framebuffer, then the panel, status line and help are drawn over it as textures.
+   framebuffer, then the pinned vertices (small dark squares), the panel, status line and
+   help are drawn over it.
 
 With ``frames=N`` (``--frames``) the viewer runs N frames of exactly 1/60 s of simulated
 time each, without waiting for input or the wall clock, so a script gets the same picture
@@ -38,6 +39,8 @@ PHYSICS_BUDGET = 0.05
 STATUS_INTERVAL = 0.25   # seconds between status line updates
 GREETING = "Left-drag the body to pull it, Space blows it up, H lists every key."
 SELECTED_COLLIDER_COLOR = "#6d8fcb"  # a bluer slate: selected, not shouting
+#: How far off a body's outline (pixels) the pin key and shift+click still find a vertex.
+PIN_PICK_PIXELS = 10
 
 
 def _font_path() -> str | None:
@@ -250,6 +253,26 @@ class Viewer:
         """The space key: every vertex gets the explosive force upward (m/s)."""
         self.session.world.explode(self.session.explosive_force)
 
+    def toggle_pin(self, pos=None) -> None:
+        """Pin the vertex nearest the pointer (window pixel ``pos``) on the body under it, or
+        free it if it is pinned: the F key and shift+click."""
+        pos = self.pointer if pos is None else pos
+        if self._over_panel(pos):
+            return
+        radius = PIN_PICK_PIXELS * self._metres_per_pixel()
+        hit = self.session.toggle_pin(self.to_world(pos), radius=radius)
+        if hit is None:
+            self.inspector.say("no body under the pointer to pin")
+        else:
+            body, vertex, pinned = hit
+            self.inspector.say(f"{'pinned' if pinned else 'unpinned'} vertex {vertex} of body {body}"
+                               + ("; U unpins all" if pinned else ""))
+
+    def unpin_all(self) -> None:
+        """Free every pinned vertex (the U key)."""
+        n = self.session.unpin_all()
+        self.inspector.say(f"unpinned {n} vertices" if n else "nothing was pinned")
+
     def select_object(self, name: str) -> None:
         """Switch the edited body to ``bunny``, ``donut``, ``armadillo`` or ``box``."""
         self._release_grab()
@@ -286,6 +309,10 @@ class Viewer:
             self.reset()
         elif action == "wireframe":
             self.toggle_wireframe()
+        elif action == "pin":
+            self.toggle_pin()
+        elif action == "unpin":
+            self.unpin_all()
         elif action.startswith("object:"):
             self.select_object(action.split(":", 1)[1])
         elif action == "panel":
@@ -383,7 +410,10 @@ class Viewer:
         pg = self.pg
         s = self.session
         t = e.type
-        if t == pg.MOUSEBUTTONDOWN and e.button == 1:
+        if t == pg.MOUSEBUTTONDOWN and e.button == 1 and pg.key.get_mods() & pg.KMOD_SHIFT:
+            self._release_grab()
+            self.toggle_pin(e.pos)
+        elif t == pg.MOUSEBUTTONDOWN and e.button == 1:
             p = self.to_world(e.pos)
             self._release_grab()
             # the triangle under the pointer, as World.grab picks it: mouse strength is per held
@@ -514,6 +544,7 @@ class Viewer:
             r.camera = self._Camera(s.camera_center, s.camera_size)
         self.view.draw(read=False)
         win = self.window_size
+        self._draw_pins(win)
         if self.panel_visible:
             self.inspector.set_paused(self.paused)
             surf = self.inspector.update(frame_time)
@@ -538,6 +569,20 @@ class Viewer:
                 except (OSError, ValueError) as e:
                     self.inspector.say(f"cannot save the screenshot: {e}", error=True)
             self._screenshot_requests.clear()
+
+    def pinned_points(self) -> np.ndarray:
+        """(N, 2) world positions (metres) of every pinned vertex of every body."""
+        parts = [b.positions[b.pinned] for b in self.session.world.bodies]
+        return np.concatenate(parts) if parts else np.zeros((0, 2))
+
+    def _draw_pins(self, win) -> None:
+        points = self.pinned_points()
+        if not len(points):
+            return
+        px = self.renderer.camera.world_to_pixel(points, self.world_size)
+        ww, wh = self.world_size
+        shown = (px[:, 0] >= 0) & (px[:, 0] < ww) & (px[:, 1] >= 0) & (px[:, 1] < wh)  # not over the panel
+        self.overlay.draw_marks(px[shown], win)
 
     def screenshot(self) -> np.ndarray:
         """The window's current picture as an (H, W, 3) uint8 array, row 0 on top."""

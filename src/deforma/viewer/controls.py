@@ -15,6 +15,8 @@ KEYS: tuple[tuple[tuple[str, ...], str, str], ...] = (
     (("n", "."), "step", "one step while paused"),
     (("r",), "reset", "reset the bodies to their start"),
     (("w",), "wireframe", "springs on / off"),
+    (("f",), "pin", "pin / unpin the vertex under the pointer (fix it in place)"),
+    (("u",), "unpin", "unpin every vertex"),
     (("1",), "object:bunny", "bunny"),
     (("2",), "object:donut", "donut"),
     (("3",), "object:armadillo", "armadillo"),
@@ -29,6 +31,7 @@ KEYS: tuple[tuple[tuple[str, ...], str, str], ...] = (
 MOUSE: tuple[tuple[str, str], ...] = (
     ("left drag on a body", "pull it toward the pointer (mouse strength)"),
     ("left drag on a collider", "move it (and select it in the panel)"),
+    ("shift+left click on a body", "pin / unpin the vertex nearest the pointer"),
     ("right drag", "pan the view"),
     ("wheel", "zoom"),
 )

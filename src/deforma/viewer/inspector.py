@@ -1,8 +1,9 @@
 """The inspector panel: pygame_gui widgets drawn to a surface that the window shows as a texture.
 
 Rows follow the original Unity inspector's groups (Square, Texture, Physics, Collision,
-Mouse). Each number has a slider (a comfortable range, log-scaled where values span decades)
-and a text box (any value the session accepts; Enter applies it). A refused value leaves
+Mouse), plus Material (the world's model and its finite-element parameters) and Contact.
+Each number has a slider (a comfortable range, log-scaled where values span decades) and a
+text box (any value the session accepts; Enter applies it). A refused value leaves
 everything as it was and shows the reason in red at the bottom of the panel.
 
 The panel has its own :class:`pygame_gui.UIManager` sized to the panel, so mouse events are
@@ -20,7 +21,7 @@ from pygame_gui.elements import (UIButton, UICheckBox, UIDropDownMenu, UIHorizon
 
 from ..physics import available_integrators
 from .params import GROUPS, PARAMS, Param, format_value, parse_value
-from .session import OBJECTS
+from .session import MATERIAL_MODELS, OBJECTS
 
 __all__ = ["PANEL_WIDTH", "Inspector"]
 
@@ -155,6 +156,11 @@ class Inspector:
                 self._integrator_rect = pygame.Rect(124, y, 188, 24)
                 self._make_integrator_menu()
                 y += ROW
+            if group == "Material":
+                UILabel(pygame.Rect(14, y, 108, 24), "Model", m, container=c)
+                self._material_rect = pygame.Rect(124, y, 188, 24)
+                self._make_material_menu()
+                y += ROW
             if group == "Collision":
                 self.prev_collider = UIButton(pygame.Rect(14, y, 26, 24), "<", m, container=c,
                                               tool_tip_text="previous collider")
@@ -200,6 +206,12 @@ class Inspector:
                                               self.manager, container=self.scroll,
                                               expansion_height_limit=len(names) * 26)
 
+    def _make_material_menu(self) -> None:
+        self._material_menu_made_for = self.session.material_model
+        self.material_menu = UIDropDownMenu(list(MATERIAL_MODELS), self._material_menu_made_for,
+                                            self._material_rect, self.manager, container=self.scroll,
+                                            expansion_height_limit=len(MATERIAL_MODELS) * 26)
+
     def _selected_text(self) -> str:
         sel = self.session.mesh.selected
         return sel if sel in OBJECTS else OBJECTS[0]
@@ -234,6 +246,9 @@ class Inspector:
             used = True
         elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.integrator_menu:
             self.apply_integrator(event.text)
+            used = True
+        elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.material_menu:
+            self.apply_material(event.text)
             used = True
         return bool(used)
 
@@ -283,7 +298,9 @@ class Inspector:
             return True
         ok = self._try(lambda: self.session.set_param(name, value))
         if ok and PARAMS[name].rebuild:
-            self.say(self._mesh_summary())
+            self.say(self._mesh_summary(), error=self.session.note_is_warning)
+        elif ok and self.session.note:  # e.g. substeps raised for a stiffer material
+            self.say(self.session.note, error=self.session.note_is_warning)
         elif ok and self.message_is_error:
             self.say("")
         self.rows[name].shown = object()
@@ -296,7 +313,7 @@ class Inspector:
             return True
         ok = self._try(lambda: self.session.select_object(name))
         if ok:
-            self.say(self._mesh_summary())
+            self.say(self._mesh_summary(), error=self.session.note_is_warning)
         self.refresh(force=True)
         return ok
 
@@ -308,6 +325,21 @@ class Inspector:
         if ok:
             note = self.session.note
             self.say(f"integrator: {name}" + (f"; {note}" if note else ""), error=bool(note))
+        self.refresh(force=True)
+        return ok
+
+    def apply_material(self, model: str) -> bool:
+        """Switch the world's material model (the drop-down in the Material group).
+
+        A body that cannot be made of finite elements (a chain without triangles) refuses
+        it: the panel then shows why in red and the menu goes back to the model in force.
+        """
+        if model == self.session.material_model:
+            return True
+        ok = self._try(lambda: self.session.set_material(model))
+        if ok:
+            note = self.session.note
+            self.say(f"material: {model}" + (f"; {note}" if note else ""), error=self.session.note_is_warning)
         self.refresh(force=True)
         return ok
 
@@ -395,6 +427,11 @@ class Inspector:
         if integ != self._integrator_menu_made_for or (force and self.integrator_menu.selected_option[0] != integ):
             self.integrator_menu.kill()
             self._make_integrator_menu()
+            self.dirty = True
+        model = self.session.material_model
+        if model != self._material_menu_made_for or (force and self.material_menu.selected_option[0] != model):
+            self.material_menu.kill()
+            self._make_material_menu()
             self.dirty = True
         if self._message_shown != (self.message, self.message_is_error):
             self._message_shown = (self.message, self.message_is_error)

@@ -76,6 +76,16 @@ GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
         Param("friction", "Friction", "float", 0.0, 2.0),
         Param("explosive_force", "Explosive force", "float", 0.0, 30.0, unit="m/s", tip="the space key"),
     )),
+    # the world's material; the model is a drop-down above these rows (see the inspector)
+    ("Material", (
+        Param("youngs_modulus", "Young's E", "float", 1e2, 1e8, log=True, unit="Pa",
+              tip="stiffness of the finite elements: a gel ~1e4, rubber ~1e6"),
+        Param("poisson_ratio", "Poisson ratio", "float", 0.0, 0.49,
+              tip="how much a stretched body narrows (below 0.5)"),
+        Param("density", "Density", "float", 0.1, 1e4, log=True, unit="kg/m²", tip="mass per area"),
+        Param("material_damping", "Damping", "float", 0.0, 0.1, unit="s",
+              tip="viscous damping of the elements (stiffens the explicit step limit)"),
+    )),
     ("Contact", (
         Param("contact_thickness", "Thickness", "float", 1e-4, 0.05, log=True, unit="m",
               tip="how far apart touching bodies stay"),

@@ -7,6 +7,9 @@ A :class:`Session` owns the live :class:`deforma.World` and knows how it was mad
 - mesh values (the original's Square and Texture settings and "Selected") rebuild the world
   from its current scene with the edited body's recipe replaced: the bodies start again from
   their starting positions, every other setting is kept;
+- the world's material (springs or finite elements, with E, nu, density, damping) is
+  switched on the running world, raising substeps where the explicit integrator needs it;
+- vertices are pinned and unpinned where the pointer is;
 - colliders are added, removed and edited in place;
 - :meth:`Session.save` writes a scene file that ``deforma run`` renders the same way.
 
@@ -16,16 +19,28 @@ Everything here is testable without pygame; :mod:`deforma.viewer.app` only forwa
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..physics import Rect, available_integrators
+from ..physics import Material, Rect, available_integrators
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
+from ..scene.build import pin_mask
+from ..scene.schema import MATERIAL_MODELS, BodyPhysics
 
-__all__ = ["MESH_LIMITS", "OBJECTS", "MeshSettings", "Session"]
+__all__ = ["MATERIAL_DEFAULTS", "MATERIAL_MODELS", "MESH_LIMITS", "OBJECTS", "MeshSettings", "Session"]
+
+#: What a finite-element model starts with when the scene gives no value: a soft gel of
+#: 1 kg/m^2 (a 1.5 m box weighs 2.25 kg), undamped: stiffness-proportional damping shrinks
+#: symplectic Euler's stable step with the square of the finest element's frequency (0.01 s
+#: made the demo's bunny need ~65000 substeps instead of 74), so it is a choice, not a
+#: default. E in Pa, density in kg/m^2, damping in s.
+MATERIAL_DEFAULTS = {"youngs_modulus": 1e4, "poisson_ratio": 0.3, "density": 1.0, "material_damping": 0.0}
+# the inspector's material names and the Material keywords they set
+_MATERIAL_KEYWORD = {"youngs_modulus": "youngs_modulus", "poisson_ratio": "poisson_ratio", "density": "density",
+                     "material_damping": "damping"}
 
 #: The original's "Selected" choices, in the order of the number keys 1-4.
 OBJECTS = ("bunny", "donut", "armadillo", "box")
@@ -119,6 +134,23 @@ class Session:
         self.generation = 0
         #: A remark about the last change (e.g. substeps raised), for the panel to show.
         self.note = ""
+        #: True when :attr:`note` warns of trouble ahead (shown in red).
+        self.note_is_warning = False
+        #: E, nu, density and damping of the finite-element models: the world's while it has
+        #: one; kept while it is springs, so switching back restores them.
+        self.material_values = self._initial_material_values(scene.physics)
+
+    def _initial_material_values(self, physics) -> dict:
+        m = self.world.material
+        if m is not None and m.is_fem:
+            return {name: float(getattr(m, kw)) for name, kw in _MATERIAL_KEYWORD.items()}
+        # a springs world whose scene holds finite-element defaults for its bodies starts from them
+        values = dict(MATERIAL_DEFAULTS)
+        given = {k: getattr(physics, k) for k in ("youngs_modulus", "poisson_ratio", "density")}
+        values.update((k, float(v)) for k, v in given.items() if v is not None)
+        if any(v is not None for v in given.values()):
+            values["material_damping"] = float(physics.material_damping)
+        return values
 
     # -- what the inspector reads --------------------------------------------------------------
     @property
@@ -161,6 +193,8 @@ class Session:
             return getattr(w.bodies[self.body_index], name) if w.bodies else None
         if name == "explosive_force":
             return self.explosive_force
+        if name in _MATERIAL_KEYWORD:
+            return self.material_values[name]
         if name == "mouse_strength":
             return w.grab_strength
         if name in ("detail", "edges", "resolution", "detect_edges", "edge_step", "scale"):
@@ -182,6 +216,7 @@ class Session:
             One line naming the parameter and what is allowed; nothing changes then.
         """
         w = self.world
+        self.note, self.note_is_warning = "", False
         if name in ("gravity_x", "gravity_y"):
             g = list(w.gravity)
             g[0 if name == "gravity_x" else 1] = value
@@ -203,6 +238,8 @@ class Session:
             self.explosive_force = v
         elif name == "mouse_strength":
             w.grab_strength = value
+        elif name in _MATERIAL_KEYWORD:
+            self._set_material_value(name, value)
         elif name in ("detail", "resolution", "edge_step"):
             self._set_mesh(**{name: _check_int(value, name)})
         elif name in ("edges", "detect_edges"):
@@ -217,6 +254,111 @@ class Session:
             self._edit_collider(name, value)
         else:
             raise KeyError(f"unknown parameter {name!r}")
+
+    # -- material -----------------------------------------------------------------------------
+    @property
+    def material_model(self) -> str:
+        """The world's material model: ``"springs"``, ``"corotated"`` or ``"neo-hookean"``."""
+        m = self.world.material
+        return "springs" if m is None else m.model
+
+    def _material(self, model: str, values: dict) -> Material:
+        return Material(model, **{kw: values[name] for name, kw in _MATERIAL_KEYWORD.items()})
+
+    def set_material(self, model: str) -> None:
+        """Make the world's bodies (those without a material of their own) ``model``.
+
+        A finite-element model takes :attr:`material_values` (the scene's, or
+        :data:`MATERIAL_DEFAULTS`). Under the explicit integrator, substeps are raised to what
+        the new material needs, as after a mesh change; beyond what the viewer raises on its
+        own, :attr:`note` says what to do instead.
+
+        Raises
+        ------
+        ValueError
+            An unknown model, or a body that cannot be made of elements (a chain of springs
+            without triangles); one line, and nothing changes.
+        """
+        if model not in MATERIAL_MODELS:
+            raise ValueError(f"material model must be one of {', '.join(MATERIAL_MODELS)}, got {model!r}")
+        self.note, self.note_is_warning = "", False
+        material = None if model == "springs" else self._material(model, self.material_values)
+        self.world.material = material  # refuses (changing nothing) a body without triangles
+        self._keep_stable(f"the {model} material")
+
+    def _set_material_value(self, name: str, value) -> None:
+        if isinstance(value, bool):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        values = dict(self.material_values)
+        try:
+            values[name] = float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a number, got {value!r}") from None
+        model = self.material_model
+        # checked by the Material itself (ranges and units in its message), also while springs
+        material = self._material("corotated" if model == "springs" else model, values)
+        if model == "springs":
+            self.note = f"{name} is kept for when the model is corotated or neo-hookean"
+        else:
+            self.world.material = material
+            self._keep_stable(f"the {model} material")
+        self.material_values = values
+
+    # -- pins ---------------------------------------------------------------------------------
+    def vertex_at(self, point, *, radius: float = 0.0) -> tuple[int, int] | None:
+        """``(body index, vertex index)`` of the vertex nearest ``point`` on the body under it.
+
+        The body under the point is the topmost (last added) one with a triangle containing
+        it; failing that (the point just off an outline, or a chain without triangles), the
+        nearest vertex of any body within ``radius`` metres. None if there is neither.
+        """
+        p = np.asarray(point, dtype=np.float64)
+        bodies = self.world.bodies
+        for k in range(len(bodies) - 1, -1, -1):
+            x, t = bodies[k].positions, bodies[k].triangles
+            if not len(t):
+                continue
+            a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
+
+            def side(o, q):
+                return (q[:, 0] - o[:, 0]) * (p[1] - o[:, 1]) - (q[:, 1] - o[:, 1]) * (p[0] - o[:, 0])
+            d1, d2, d3 = side(a, b), side(b, c), side(c, a)
+            if np.any(((d1 >= 0) & (d2 >= 0) & (d3 >= 0)) | ((d1 <= 0) & (d2 <= 0) & (d3 <= 0))):
+                return k, int(np.argmin(np.linalg.norm(x - p, axis=1)))
+        best = None
+        for k, body in enumerate(bodies):
+            d = np.linalg.norm(body.positions - p, axis=1)
+            i = int(np.argmin(d)) if len(d) else -1
+            if i >= 0 and d[i] <= radius and (best is None or d[i] <= best[0]):
+                best = (float(d[i]), k, i)
+        return None if best is None else (best[1], best[2])
+
+    def toggle_pin(self, point, *, radius: float = 0.0) -> tuple[int, int, bool] | None:
+        """Pin the vertex nearest ``point`` (metres) on the body under it, or free it if pinned.
+
+        Returns
+        -------
+        (int, int, bool) or None
+            Body index, vertex index and whether it is pinned now; None if no body is there.
+        """
+        hit = self.vertex_at(point, radius=radius)
+        if hit is None:
+            return None
+        k, i = hit
+        body = self.world.bodies[k]
+        if body.pinned[i]:
+            body.unpin([i])
+        else:
+            body.pin([i])
+        return k, i, bool(body.pinned[i])
+
+    def unpin_all(self) -> int:
+        """Free every pinned vertex of every body; returns how many were pinned."""
+        n = 0
+        for body in self.world.bodies:
+            n += int(body.pinned.sum())
+            body.unpin()
+        return n
 
     # -- integrator ---------------------------------------------------------------------------
     @property
@@ -236,7 +378,7 @@ class Session:
         if name not in names:
             raise ValueError(f"integrator must be one of {', '.join(names)}, got {name!r}")
         self.world.integrator = name
-        self.note = ""
+        self.note, self.note_is_warning = "", False
         stable = self.world.stable_dt()
         h = self.world.dt / self.world.substeps
         if h > stable:
@@ -271,7 +413,11 @@ class Session:
         if position is None:  # keep the body where it is when the new mesh has other coordinates
             rest = self.world.bodies[self.body_index].topology.rest_positions
             position = tuple(float(v) for v in (rest.min(axis=0) + rest.max(axis=0)) / 2)
-        common = dict(position=position, mass=spec.mass, stiffness=spec.stiffness, damping=spec.damping)
+        # every per-body physics value stays (material, friction, contacts); vertex numbers
+        # mean nothing in the new mesh, so its pins go, except a pin box that still holds some
+        common = {f.name: getattr(spec, f.name) for f in fields(BodyPhysics) if f.name not in ("pin", "pin_vertices")}
+        common["position"] = position
+        pinned_before = bool(self.world.bodies[self.body_index].pinned.any())
         if new.selected == "box":
             color = spec.color if isinstance(spec, BoxBody) else None
             texture = spec.texture if isinstance(spec, BoxBody) else None
@@ -285,23 +431,44 @@ class Session:
             body = ImageBody(source=source, resolution=new.resolution, detect_edges=new.detect_edges,
                              edge_step=new.edge_step, scale=new.scale,
                              color=spec.color if keep else None, texture=spec.texture if keep else None, **common)
+        kept = False
+        if spec.pin is not None:
+            from ..scene import make_mesh
+
+            # where the new mesh will be: what build() places, to test the box on
+            x = np.array(make_mesh(body).vertices, dtype=np.float64)
+            x += np.asarray(position) - (x.min(axis=0) + x.max(axis=0)) / 2
+            try:
+                pin_mask(replace(body, pin=spec.pin), x)
+                body = replace(body, pin=spec.pin)
+                kept = True
+            except ValueError:
+                pass
         self._rebuild(body)
         self.mesh = new
         self._keep_stable()
+        if pinned_before and not kept:
+            self.note = "; ".join(n for n in (self.note, "pins cleared (the new mesh has other vertices)") if n)
 
-    def _keep_stable(self) -> None:
+    def _keep_stable(self, what: str = "the finer mesh") -> None:
         # mass per vertex is mass / N (the original's rule), so a finer mesh needs smaller
-        # substeps; raise them to what the world's own estimate asks rather than let the new
-        # body blow up on its first frame
+        # substeps, and a finite-element material its own; raise them to what the world's own
+        # estimate asks rather than let the body blow up on its first frame
         w = self.world
         stable = w.stable_dt()
         need = math.ceil(w.dt / stable) if stable > 0 else w.substeps
         if w.substeps < need <= MAX_AUTO_SUBSTEPS:
             w.substeps = need
-            self.note = f"substeps raised to {need} so the finer mesh stays stable (stable dt {stable:.2g} s)"
+            self.note = f"substeps raised to {need} so {what} stays stable (stable dt {stable:.2g} s)"
+        elif need > max(w.substeps, MAX_AUTO_SUBSTEPS):
+            # more than a live window can afford: say so before the first step blows up
+            self.note_is_warning = True
+            self.note = (f"{what} needs {need} substeps under {w.integrator} (stable dt {stable:.2g} s): "
+                         f"switch the integrator to implicit-euler or xpbd, or soften it (lower stiffness, E "
+                         f"or material damping)")
 
     def _rebuild(self, body_spec=None) -> None:
-        self.note = ""
+        self.note, self.note_is_warning = "", False
         scene = self.scene
         if body_spec is not None:
             bodies = list(scene.body)
