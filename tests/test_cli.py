@@ -274,3 +274,21 @@ def test_version_prints_the_installed_version_and_exits_0(capsys):
     out, _ = capsys.readouterr()
     assert e.value.code == 0
     assert out.strip() == f"deforma {deforma.__version__}" and deforma.__version__ == version("deforma")
+
+
+def test_springs_switch_runs_a_material_scene_with_the_original_springs(tmp_path, capsys):
+    import tomllib
+
+    assert scenes.load_scene("sample").bodies[0].is_fem  # shipped as finite elements
+    states = tmp_path / "s.npz"
+    code, _, err = run(capsys, "run", "sample", "--springs", "--seconds", "0.6", "--states", str(states), "--quiet")
+    assert code == 0, err
+    doc = tomllib.loads(str(np.load(states)["scene_toml"]))
+    assert doc["physics"]["material"] == "springs" and "material" not in doc["body"][0]
+    d = np.load(states)
+    world = scenes.load_scene("sample")
+    world.material = None  # what --springs makes of it: the same springs, stepped the same way
+    for _ in range(int(round(d["time"][-1] / world.dt))):
+        world.step()
+    assert not world.bodies[0].is_fem
+    np.testing.assert_allclose(d["body0_positions"][-1], world.bodies[0].positions, atol=1e-9)

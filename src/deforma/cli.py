@@ -79,6 +79,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--wireframe", action="store_true", help="draw the springs over the bodies")
     r.add_argument("--samples", type=int, default=4, choices=(0, 4), help="multisampling for smooth edges (default 4)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument("--springs", action="store_true",
+                   help="make every body of the original's springs instead of its material (finite elements)")
 
     m = sub.add_parser("mesh", help="a picture of a triangulation with its figures (points, triangles, min angle)",
                        description="Triangulate a built-in texture, an image file or a box (SOURCE = box) and "
@@ -110,6 +112,8 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--wireframe", action="store_true", help="draw the springs over the bodies")
     v.add_argument("--samples", type=int, default=0, choices=(0, 2, 4, 8), help="window multisampling (default 0)")
     v.add_argument("--paused", action="store_true", help="start paused")
+    v.add_argument("--springs", action="store_true",
+                   help="make every body of the original's springs instead of its material (finite elements)")
     return p
 
 
@@ -182,6 +186,8 @@ def cmd_run(a) -> int:
     from .physics import SimulationUnstable
 
     scene = scenes.load(a.scene)  # SceneError is a one-line ValueError
+    if a.springs:
+        scene = scenes.with_springs(scene)
     seconds = a.seconds if a.seconds is not None else scene.run.seconds
     fps = a.fps if a.fps is not None else scene.run.fps
     scene = replace(scene, run=replace(scene.run, seconds=float(seconds), fps=float(fps)))
@@ -369,7 +375,12 @@ def cmd_view(a) -> int:
         raise CliError(f"the viewer needs pygame-ce, pygame_gui and moderngl ({e}); "
                        f"pip install 'deforma[render]'", EXIT_NO_GL) from None
     try:
-        viewer.run(a.scene, size=a.size, frames=a.frames, screenshot=a.screenshot, panel=not a.no_panel,
+        scene = a.scene
+        if a.springs:
+            from . import scene as scenes
+
+            scene = scenes.with_springs(scenes.load(a.scene))
+        viewer.run(scene, size=a.size, frames=a.frames, screenshot=a.screenshot, panel=not a.no_panel,
                    wireframe=a.wireframe, samples=a.samples, paused=a.paused)
     except ImportError as e:  # pragma: no cover - pygame or moderngl missing
         raise CliError(f"the viewer needs pygame-ce, pygame_gui and moderngl ({e}); "

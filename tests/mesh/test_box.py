@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 import deforma
 from deforma.mesh import box
 from deforma.mesh.box import MAX_DETAIL
+from delaunay_checks import check_delaunay
 
 
 def shoelace(c):
@@ -182,3 +183,36 @@ def test_bad_edges_flag():
 def test_public_name():
     m = deforma.mesh.box(RECT, detail=1)
     assert isinstance(m, deforma.mesh.Mesh)
+
+
+def mirrored_edges(m, axis):
+    """The mesh's edge set, and the same set with every vertex replaced by its mirror image
+    across the box's centre line (x -> -x for axis 0)."""
+    x = m.vertices
+    flip = x.copy()
+    flip[:, axis] *= -1
+    key = {tuple(np.round(p, 9) + 0.0): k for k, p in enumerate(x)}
+    mirror = np.array([key[tuple(np.round(p, 9) + 0.0)] for p in flip])
+    edges = set(map(tuple, np.sort(m.edges, axis=1).tolist()))
+    return edges, set(map(tuple, np.sort(mirror[np.array(sorted(edges))], axis=1).tolist()))
+
+
+@pytest.mark.parametrize("n", [1, 3, 9])
+def test_rectangle_with_even_cell_count_is_mirror_symmetric_and_still_delaunay(n):
+    m = box(((-0.75, -0.5), (0.75, -0.5), (0.75, 0.5), (-0.75, 0.5)), detail=n, edges=True)
+    for axis in (0, 1):
+        edges, mirrored = mirrored_edges(m, axis)
+        assert edges == mirrored  # no lattice direction is preferred: dropped flat, it lands flat
+    check_delaunay(m.vertices, m.triangles)
+
+
+def test_odd_cell_count_has_no_preferred_shear_direction():
+    m = box(((-0.75, -0.5), (0.75, -0.5), (0.75, 0.5), (-0.75, 0.5)), detail=8, edges=True)
+    x, t = m.vertices, m.triangles
+    # diagonals of the cells: rising (/) and falling (\) in equal numbers, up to the middle column
+    d = np.array([[a, b] for tri in t for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0]))])
+    v = x[d[:, 1]] - x[d[:, 0]]
+    diagonal = (np.abs(v[:, 0]) > 1e-9) & (np.abs(v[:, 1]) > 1e-9)
+    rising = np.sign(v[diagonal, 0] * v[diagonal, 1])
+    assert abs(rising.sum()) / 2 <= 9  # each diagonal appears twice (once per triangle); one way: 81
+    check_delaunay(x, t)

@@ -348,3 +348,18 @@ def test_air_drag_slows_a_fall_to_the_terminal_speed_g_over_drag(name):
         w.step()
     assert b.velocities[:, 1].mean() == pytest.approx(-G / c, rel=1e-4)
     assert np.abs(b.velocities[:, 0]).max() < 1e-12  # only along gravity
+
+
+def test_implicit_euler_rests_where_forces_balance_whatever_the_air_drag():
+    # (1 + h c) belongs on the mass, not only on gravity: with it only on gravity a hanging
+    # body settled short of its stretch by the factor 1 / (1 + h c) (25% here)
+    ends = []
+    for integrator, dt in (("symplectic-euler", 1 / 2000), ("implicit-euler", 1 / 60)):
+        w = deforma.World(integrator=integrator, dt=dt, air_drag=20.0, stiffness=200.0, damping=0.0)
+        b = w.add_body(grid_mesh(0.2, 1.0, 3, 11), position=(0.0, 0.0))
+        b.pin(np.flatnonzero(b.positions[:, 1] > 0.499))
+        for _ in range(int(round(4.0 / dt))):
+            w.step()
+        ends.append(b.positions[:, 1].min())
+    stretch = [-0.5 - e for e in ends]
+    assert stretch[0] > 0.05 and abs(stretch[1] / stretch[0] - 1) < 0.01, stretch

@@ -75,3 +75,29 @@ def test_builtin_scene_frame_shows_each_body_where_it_is(gl_ctx, name):
     outside = (cols < lo[0]) | (cols > hi[0]) | (rows < lo[1]) | (rows > hi[1])
     assert not changed[outside].any()
     r.release()
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if n != "pile"])  # the pile: tests/physics/test_body_contact.py
+def test_builtin_scene_comes_to_rest_with_no_triangle_inside_out(name):
+    from deforma.physics.elements import signed_areas
+
+    world = scenes.load_scene(name)
+    seconds = max(6.0, scenes.load(name).run.seconds)
+    for _ in range(int(round(seconds / world.dt))):
+        world.step()
+    for k, b in enumerate(world.bodies):
+        area = signed_areas(b.positions, b.triangles)
+        assert (area > 0).all(), (name, k, np.flatnonzero(area <= 0)[:5].tolist())
+
+
+def test_sample_box_lands_flat_without_turning_or_drifting():
+    world = scenes.load_scene("sample")
+    b = world.bodies[0]
+    x0, c0 = b.positions.copy(), b.center_of_mass
+    for _ in range(int(round(4.0 / world.dt))):
+        world.step()
+    x, c = b.positions, b.center_of_mass
+    u, _, vt = np.linalg.svd((x0 - c0).T @ (x - c))  # best-fit rotation (Kabsch)
+    r = vt.T @ u.T
+    assert abs(np.degrees(np.arctan2(r[1, 0], r[0, 0]))) < 1.0 and abs(c[0] - c0[0]) < 0.01
+    assert abs(b.positions[:, 1].min() - 0.2) < 0.01  # on the plane, whose top is at y = 0.2

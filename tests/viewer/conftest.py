@@ -18,17 +18,20 @@ def viewer():
     """One window for the whole session (opening one costs about a second); tests load scenes into it."""
     from deforma.viewer.app import Viewer
 
-    v = Viewer("demo", size=(1280, 720))
+    from seed_scenes import seed
+
+    v = Viewer(seed("demo"), size=(1280, 720))
     yield v
     v.close()
 
 
 @pytest.fixture
 def demo(viewer):
-    """The viewer with a fresh demo scene, panel shown, running, no pending events."""
+    """The viewer with a fresh demo scene (the seed's springs), panel shown, running, no pending events."""
     import pygame
+    from seed_scenes import seed
 
-    viewer.load("demo")
+    viewer.load(seed("demo"))
     viewer.panel_visible = True
     viewer.help_visible = False
     viewer.running = True

@@ -9,6 +9,7 @@ import deforma
 from deforma.scene import BoxBody, ImageBody
 from deforma.viewer.params import GROUPS, PARAMS, parse_value
 from deforma.viewer.session import OBJECTS, Session
+from seed_scenes import seed
 
 
 def test_every_original_inspector_value_is_a_parameter():
@@ -148,7 +149,7 @@ def test_docs_list_every_key():
 
 
 def test_integrator_switches_on_the_running_world_and_is_saved(tmp_path):
-    s = Session("demo")
+    s = Session(seed("demo"))
     world = s.world
     assert s.integrator == "symplectic-euler"
     s.set_integrator("implicit-euler")
@@ -161,7 +162,7 @@ def test_integrator_switches_on_the_running_world_and_is_saved(tmp_path):
 
 
 def test_unknown_integrator_is_refused_with_the_names():
-    s = Session("demo")
+    s = Session(seed("demo"))
     with pytest.raises(ValueError, match="integrator must be one of .*xpbd.*got 'rk4'"):
         s.set_integrator("rk4")
     assert s.world.integrator == "symplectic-euler"
@@ -178,7 +179,7 @@ def test_switching_to_the_explicit_method_with_stiff_springs_warns():
 # -- material ------------------------------------------------------------------------------------
 
 def test_material_model_switches_on_the_running_world_with_the_defaults():
-    s = Session("sample")
+    s = Session(seed("sample"))
     world = s.world
     assert s.material_model == "springs" and world.material is None
     assert s.get_param("youngs_modulus") == 1e4 and s.get_param("material_damping") == 0.0
@@ -228,7 +229,7 @@ def test_fem_under_the_explicit_integrator_raises_substeps_or_says_what_to_do():
 
 
 def test_a_body_that_cannot_be_fem_refuses_the_material_and_nothing_changes():
-    s = Session("sample")
+    s = Session(seed("sample"))
     chain = type("Chain", (), {"vertices": np.array([[5.0, 5.0], [6.0, 5.0], [7.0, 5.0]]),
                                "edges": np.array([[0, 1], [1, 2]])})()
     s.world.add_body(chain)

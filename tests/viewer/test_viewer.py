@@ -10,6 +10,7 @@ import pytest
 from PIL import Image
 
 import deforma
+from seed_scenes import seed
 
 
 def post(kind, **fields):
@@ -329,7 +330,7 @@ def test_integrator_drop_down_makes_stiff_springs_stable(demo):
 def test_loaded_scene_shows_its_integrator(demo, tmp_path):
     demo.session.set_integrator("xpbd")
     path = demo.session.save(tmp_path / "xpbd.toml")
-    demo.load("demo")
+    demo.load(seed("demo"))
     run(demo, 1)
     assert demo.inspector.integrator_menu.selected_option[0] == "symplectic-euler"
     demo.load(str(path))

@@ -261,6 +261,11 @@ def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, 
     model, ``T`` is exactly the projective-dynamics projection: the blend of the nearest
     rotation and the nearest shape of rest area). ``weight = A (h^2 + h beta) k`` with ``k``
     the element's stiffness bound (:func:`max_stiffness`). Adds ``weight D^T T``.
+
+    The corotated target is a projection, so the iteration lowers the objective every time
+    (projective dynamics); for Neo-Hookean it is a gradient step, which the element shortens
+    where its curvature exceeds 1.9 times the matrix's (far from rest), so that it cannot
+    overshoot.
     """
     h2 = h * h
     for e in range(elem.shape[0]):
@@ -270,10 +275,20 @@ def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, 
         b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
         f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
         p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
-        p00 *= h2
-        p01 *= h2
-        p10 *= h2
-        p11 *= h2
+        scale = h2
+        if kind[e] != KIND_COROTATED:
+            # Neo-Hookean stiffens beyond the matrix's 2 (mu + lambda) when stretched or
+            # squashed; a step along the gradient then overshoots (and can run away) where its
+            # curvature passes twice the matrix's. Shorten this element's step there; at rest
+            # and at moderate strain (curvature below 1.9x) the step, and the answer, are exact.
+            c = neo_hookean.max_curvature(f00, f01, f10, f11, mu[e], lam[e])
+            bound = 1.9 * weight[e] / (area[e] * (h2 + h * beta[e]))
+            if c > bound:
+                scale *= bound / c
+        p00 *= scale
+        p01 *= scale
+        p10 *= scale
+        p11 *= scale
         if beta[e] > 0.0:
             n00, n01, n10, n11 = _gradient(x_n, i, j, k, b0, b1, b2, b3)
             d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, f00 - n00, f01 - n01, f10 - n10, f11 - n11,

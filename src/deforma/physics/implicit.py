@@ -64,7 +64,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from .colliders import contact_planes, finish_position_step
+from .colliders import contact_planes, finish_position_step, push_edges_off_corners
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start
 from .elements import element_matrix, implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
@@ -448,6 +448,8 @@ class ImplicitEuler:
             if bad:
                 return bad
             # scr.xp still holds x_n (detect_contacts only read it): no second gather_start
+            topo = model.contact
+            push_edges_off_corners(x, v, model.vertex_inv_mass, topo.ce_a, topo.ce_b, topo.cv_vertex, inputs.rects)
             if contact_stage(x, v, model.vertex_inv_mass, model.contact, scr, inputs.contacts, inputs.rects,
                              inputs.hits, float(h)) < 0:
                 return 0  # the contact buffer is too small; the world grows it and repeats the step

@@ -18,6 +18,7 @@ Semi-implicit (symplectic) Euler, per substep::
     v = (v + h * F(x, v) / m) / (1 + h * air_drag)
     x += h * v
     x, v = collide(x_before, x, v)              # colliders, per vertex
+    x, v = push_edges_off_corners(x, v)         # collider corners against body outlines
     x, v = contact_stage(x_before, x, v)        # bodies against bodies and themselves
 
 Every integrator ends its substeps with the same two responses: the collider response per
@@ -43,7 +44,8 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from .colliders import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, jump_reach, record_hit
+from .colliders import (RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, jump_reach,
+                        push_edges_off_corners, record_hit)
 from .contacts import ST_STAMP, contact_stage, gather_start
 from .elements import element_forces
 from .forces import spring_force
@@ -240,6 +242,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
             bad += is_bad(px, py, vx, vy, vmax2)
         if bad:
             return bad
+        push_edges_off_corners(x, v, inv_mass, ctopo.ce_a, ctopo.ce_b, ctopo.cv_vertex, rects)
         if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
             return 0
     return 0

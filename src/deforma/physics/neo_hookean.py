@@ -66,6 +66,32 @@ def stress(f00, f01, f10, f11, mu, lam):
     return mu * f00 + k * f11, mu * f01 - k * f10, mu * f10 - k * f01, mu * f11 + k * f00
 
 
+@njit(cache=True, inline="always")
+def max_curvature(f00, f01, f10, f11, mu, lam):
+    """The largest eigenvalue (Pa) of the energy's Hessian in ``F`` at ``F``: exactly ``2 (mu +
+    lambda)`` at rest, larger when stretched or squashed.
+
+    In the conformal / anti-conformal coordinates ``a = (F00 + F11) / 2``, ``b = (F10 - F01)
+    / 2``, ``c = (F00 - F11) / 2``, ``d = (F01 + F10) / 2`` the energy is ``2 mu (c^2 + d^2) +
+    lambda' / 2 (a^2 + b^2 - c^2 - d^2 - 1)^2``, whose Hessian splits into two tangential
+    eigenvalues and one 2 x 2 radial block (halved, as ``|dF|^2 = 2 |dq|^2``).
+
+    Examples
+    --------
+    >>> max_curvature(1.0, 0.0, 0.0, 1.0, 1.0, 2.0)  # 2 (mu + lambda)
+    6.0
+    """
+    lp = lam + mu
+    r2 = 0.25 * ((f00 + f11) ** 2 + (f10 - f01) ** 2)
+    s2 = 0.25 * ((f00 - f11) ** 2 + (f01 + f10) ** 2)
+    g = r2 - s2 - 1.0  # J - 1
+    p = lp * g + 2.0 * lp * r2
+    q = 2.0 * mu - lp * g + 2.0 * lp * s2
+    off = 2.0 * lp * np.sqrt(r2 * s2)
+    radial = 0.5 * (p + q) + np.sqrt(0.25 * (p - q) ** 2 + off * off)
+    return max(radial, lp * g, 2.0 * mu - lp * g)
+
+
 def energy_density(f, mu, lam):
     """Energy density (J/m^2) of deformation gradients ``f`` (T, 2, 2); vectorised NumPy.
 

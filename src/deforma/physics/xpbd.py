@@ -52,7 +52,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .colliders import contact_planes, finish_position_step
+from .colliders import contact_planes, finish_position_step, push_edges_off_corners
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, project_contacts
 from .elements import project_elements
 from .integrators import register_integrator
@@ -218,6 +218,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         if bad:
             return bad
         # cscr.xp still holds x_prev (detect_contacts only read it): no second gather_start
+        push_edges_off_corners(x, v, inv_mass, ctopo.ce_a, ctopo.ce_b, ctopo.cv_vertex, rects)
         if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
             return 0  # the contact buffer is too small; the world grows it and repeats the step
     return 0

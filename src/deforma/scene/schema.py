@@ -503,6 +503,27 @@ class MaterialKeyError(ValueError):
         self.key = key
 
 
+def with_springs(scene: "Scene") -> "Scene":
+    """The same scene with every body made of the original's springs (its material keys
+    dropped; ``[physics]``'s stiffness, damping and mass, or the body's own, apply).
+
+    The switch behind ``deforma run --springs`` and ``deforma view --springs``.
+
+    Examples
+    --------
+    >>> from deforma.scene import load
+    >>> s = with_springs(load("sample"))
+    >>> s.physics.material, s.body[0].material
+    ('springs', None)
+    """
+    from dataclasses import replace
+
+    physics = replace(scene.physics, material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
+                      material_damping=0.0)
+    bodies = tuple(replace(b, **dict.fromkeys(MATERIAL_KEYS)) for b in scene.body)
+    return replace(scene, physics=physics, body=bodies)
+
+
 def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None) -> dict | None:
     """The :class:`deforma.Material` keywords that ``[physics]`` (and a body's overrides) describe.
 
