@@ -528,7 +528,7 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
     over metres, others folded flat). Per edge ``(a, b)`` (directed with the body on its
     left) that crosses a rectangle, the corner deepest on the body's side, at depth ``d``,
     is a contact with an infinitely heavy point: the edge point ``p = (1 - s) a + s b``
-    facing it moves out by ``d`` along the edge's normal, split by the inverse masses as for
+    facing it moves out by ``d`` (plus the collider's nanometre skin) along the edge's normal, split by the inverse masses as for
     a vertex against an edge (``da = (1 - s) w_a lam n``, ``db = s w_b lam n``, ``lam = d /
     ((1 - s)^2 w_a + s^2 w_b)``), and the two vertices lose their velocity into the corner.
     Frictionless: a body slides off a corner rather than snagging on it.
@@ -555,7 +555,7 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
     >>> push_edges_off_corners(x, v, np.ones(2), np.array([0], np.int32), np.array([1], np.int32),
     ...                        np.arange(2, dtype=np.int32), r)
     1
-    >>> x.round(6).tolist(), v.tolist()  # the top corner is at y = sqrt 2: the edge moved up onto it
+    >>> x.round(6).tolist(), v.tolist()  # the top corner is at y = sqrt 2: the edge moved up past it
     ([[-1.0, 1.414214], [1.0, 1.414214]], [[0.0, 0.0], [0.0, 0.0]])
     """
     moved = 0
@@ -604,7 +604,7 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
             den = sa * sa * wa + sb * sb * wb
             if den == 0.0:
                 continue  # both ends pinned
-            lam = best / den
+            lam = (best + rects[r, RECT_SKIN]) / den  # to just outside, as the response puts vertices
             ax += sa * wa * lam * nx
             ay += sa * wa * lam * ny
             bx += sb * wb * lam * nx
