@@ -82,7 +82,7 @@ def test_parallel_and_serial_steps_agree_exactly(material):
         for _ in range(50):
             kernel(s.x, s.v, s.x_start, s.v_start, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
                    m.spring_stiffness, m.spring_damping, elem_chunks, m.elem, m.elem_b, m.elem_area, m.elem_mu,
-                   m.elem_lambda, m.elem_damping, m.elem_kind, m.vertex_inv_mass, 0.0, -9.81, 1.0,
+                   m.elem_lambda, m.elem_damping, m.elem_kind, bool(m.elem_damping.any()), m.vertex_inv_mass, 0.0, -9.81, 1.0,
                    inp.grab_slot, inp.grab_pull, inp.rects, inp.hits, m.contact, inp.contact_scratch, inp.contacts,
                    h, 2, 1e6)
         assert not fbuf.any()  # scratch left zeroed

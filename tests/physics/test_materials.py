@@ -101,7 +101,7 @@ def test_element_forces_are_minus_the_energy_gradient_and_sum_to_zero(kind):
     x = mesh.vertices + 0.1 * rng.normal(size=mesh.vertices.shape)
     x[5] = x[0] + (x[0] - x[5])  # folds the triangles at vertex 5 over
     f = np.zeros_like(x)
-    elements.element_forces(x, np.zeros_like(x), tris, b, area, mu, lam, np.zeros(len(tris)), kinds, f)
+    elements.element_forces(x, np.zeros_like(x), tris, b, area, mu, lam, np.zeros(len(tris)), kinds, False, f)
     assert np.allclose(f.sum(axis=0), 0.0, atol=1e-12)
     eps = 1e-6
     for v in range(len(x)):
@@ -122,10 +122,10 @@ def test_damping_resists_stretching_but_not_rigid_rotation():
     x = mesh.vertices.copy()
     spin = np.c_[-x[:, 1], x[:, 0]]  # rigid rotation about the origin
     f = np.zeros_like(x)
-    elements.element_forces(x, spin, *args, f)
+    elements.element_forces(x, spin, *args, True, f)
     assert np.abs(f).max() < 1e-12
     stretch = np.c_[x[:, 0], 0 * x[:, 1]]  # stretching along x
-    elements.element_forces(x, stretch, *args, f)
+    elements.element_forces(x, stretch, *args, True, f)
     assert np.sum(f * stretch) < 0  # dissipates
 
 

@@ -16,7 +16,7 @@ I)`` with ``E' = sym(R^T dF/dt)``, the corotated linear stress of the strain rat
 motion is never damped, and a mode of angular frequency ``omega`` gets the damping ratio
 ``beta omega / 2``.
 
-Here: the per-element force (:func:`element_forces`, used by the symplectic step), the
+Here: the element forces (:func:`element_forces`, used by the symplectic step), the
 implicit solve's right-hand side (:func:`implicit_element_rhs`) and matrix
 (:func:`element_matrix`), the XPBD projection (:func:`project_elements`), and NumPy helpers
 (deformation gradients, energies, the stable-step bound).
@@ -189,26 +189,25 @@ def rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu, lam):
 
 
 @njit(cache=True, inline="always")
-def element_force(x, v, i, j, k, b0, b1, b2, b3, area, mu, lam, beta, kind):
-    """Forces (N) on vertices ``j`` and ``k`` of one element (``i`` feels minus their sum):
-    elastic plus damping, ``-A (P + P_damp) D_v``."""
-    f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
-    p00, p01, p10, p11 = stress(kind, f00, f01, f10, f11, mu, lam)
-    if beta > 0.0:
-        r00, r01, r10, r11 = _gradient(v, i, j, k, b0, b1, b2, b3)
-        d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu, lam)
-        p00 += beta * d00
-        p01 += beta * d01
-        p10 += beta * d10
-        p11 += beta * d11
-    # -A P B^T: column 0 on j, column 1 on k
+def _nodal(p00, p01, p10, p11, b0, b1, b2, b3, area):
+    """``-A P B^T``: the forces (N) on vertices ``j`` (column 0) and ``k`` (column 1)."""
     return (-area * (p00 * b0 + p01 * b1), -area * (p10 * b0 + p11 * b1),
             -area * (p00 * b2 + p01 * b3), -area * (p10 * b2 + p11 * b3))
 
 
+@njit(cache=True, inline="always")
+def _scatter(f, i, j, k, fjx, fjy, fkx, fky):
+    f[j, 0] += fjx
+    f[j, 1] += fjy
+    f[k, 0] += fkx
+    f[k, 1] += fky
+    f[i, 0] -= fjx + fkx
+    f[i, 1] -= fjy + fky
+
+
 @njit(cache=True)
-def element_forces(x, v, elem, b, area, mu, lam, beta, kind, f):
-    """Add every element's force (N) to ``f`` (N, 2).
+def element_forces(x, v, elem, b, area, mu, lam, beta, kind, damped, f):
+    """Add every element's force (N) to ``f`` (N, 2): ``-A (P + beta P_rate) D_v`` on each vertex.
 
     Parameters
     ----------
@@ -222,6 +221,10 @@ def element_forces(x, v, elem, b, area, mu, lam, beta, kind, f):
         Rest areas (m^2), Lamé parameters (Pa), damping (s).
     kind : (T,) int32
         Element kinds (``material.KIND_*``).
+    damped : bool
+        Whether any ``beta`` is positive. Without damping a loop with no damping code runs:
+        the damping branch alone, never taken, made the loop 1.6x slower (7.6 against 4.6 ms
+        for 2e5 elements, one thread), the code size costing the compiler its registers.
     f : (N, 2) float64
         Accumulated into.
 
@@ -233,22 +236,34 @@ def element_forces(x, v, elem, b, area, mu, lam, beta, kind, f):
     >>> f = np.zeros((3, 2))
     >>> x[1, 0] = 1.1  # stretch along x
     >>> element_forces(x, np.zeros((3, 2)), np.array([[0, 1, 2]], np.int32), bb, a, np.ones(1), np.ones(1),
-    ...                np.zeros(1), np.zeros(1, np.int32), f)
+    ...                np.zeros(1), np.zeros(1, np.int32), False, f)
     >>> f.sum(axis=0).round(12).tolist(), bool(f[1, 0] < 0)  # no net force; the stretch pulls back
     ([0.0, 0.0], True)
     """
+    if not damped:
+        for e in range(elem.shape[0]):
+            i = np.uint64(elem[e, 0])
+            j = np.uint64(elem[e, 1])
+            k = np.uint64(elem[e, 2])
+            b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+            f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+            p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
+            fjx, fjy, fkx, fky = _nodal(p00, p01, p10, p11, b0, b1, b2, b3, area[e])
+            _scatter(f, i, j, k, fjx, fjy, fkx, fky)
+        return
     for e in range(elem.shape[0]):
         i = np.uint64(elem[e, 0])
         j = np.uint64(elem[e, 1])
         k = np.uint64(elem[e, 2])
-        fjx, fjy, fkx, fky = element_force(x, v, i, j, k, b[e, 0], b[e, 1], b[e, 2], b[e, 3], area[e], mu[e],
-                                           lam[e], beta[e], kind[e])
-        f[j, 0] += fjx
-        f[j, 1] += fjy
-        f[k, 0] += fkx
-        f[k, 1] += fky
-        f[i, 0] -= fjx + fkx
-        f[i, 1] -= fjy + fky
+        b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+        p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
+        r00, r01, r10, r11 = _gradient(v, i, j, k, b0, b1, b2, b3)
+        d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu[e], lam[e])
+        be = beta[e]
+        fjx, fjy, fkx, fky = _nodal(p00 + be * d00, p01 + be * d01, p10 + be * d10, p11 + be * d11, b0, b1, b2, b3,
+                                    area[e])
+        _scatter(f, i, j, k, fjx, fjy, fkx, fky)
 
 
 @njit(cache=True)

@@ -169,7 +169,7 @@ def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
 # Scalar-only helpers are free.
 
 def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
-                      elem_ptr, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind,
+                      elem_ptr, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind, elem_damped,
                       inv_mass, gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps,
                       vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions.
@@ -199,7 +199,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
             lo, hi = elem_ptr[t], elem_ptr[t + 1]
             if hi > lo:
                 element_forces(x, v, elem[lo:hi], elem_b[lo:hi], elem_area[lo:hi], elem_mu[lo:hi], elem_lam[lo:hi],
-                               elem_beta[lo:hi], elem_kind[lo:hi], fbuf[t])
+                               elem_beta[lo:hi], elem_kind[lo:hi], elem_damped, fbuf[t])
         save = sub == 0
         bad = 0
         for i in prange(x.shape[0]):
@@ -415,7 +415,7 @@ class SymplecticEuler:
                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
                      model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
                      model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
-                     model.vertex_inv_mass, float(gx), float(gy),
+                     bool(model.elem_damping.any()), model.vertex_inv_mass, float(gx), float(gy),
                      1.0 / (1.0 + float(h) * inputs.air_drag), inputs.grab_slot,
                      inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch,
                      inputs.contacts,
