@@ -24,7 +24,9 @@ How it works (the reasons are in ``docs/mesh.md``):
    is an edge, each triangle lies wholly inside or wholly outside the outline, and the
    ones whose centroid is outside (even-odd over all rings) are dropped. Holes stay holes.
    Last, the rare tiny triangle against the outline whose centroid falls in a pixel whose
-   centre is background is dropped too, so every centroid is on a foreground pixel.
+   centre is background is dropped too, so every centroid is on a foreground pixel, and so
+   are sliver "ears" (two or three outline edges, an angle under 10 degrees): they hold
+   almost no area, flatten inside out against a wall and set a finite element's step.
 5. **Without an outline** (``detect_edges=False``, the original's behaviour made safe): the
    grid points are triangulated and every triangle that covers a background pixel centre
    is dropped, so the mesh is a slightly shrunken, stair-stepped version of the shape.
@@ -183,6 +185,7 @@ def from_image(
             rr = np.clip(cen[:, 1].astype(np.int64), 0, h - 1)
             cc = np.clip(cen[:, 0].astype(np.int64), 0, w - 1)
             tris = tris[mask[rr, cc]]
+        tris = _peel_ears(points, tris)
     else:
         rows, cols = np.nonzero(grid)
         points = np.c_[cols + 0.5, rows + 0.5]
@@ -604,6 +607,31 @@ def _peel_slivers(points, tris):
         on_boundary = (counts[inv.ravel()] == 1).reshape(3, -1).any(axis=0)
         thin = on_boundary & (quality.triangle_min_angles(points, tris) < _PEEL_ANGLE)
         if not thin.any():
+            return tris
+        tris = tris[~thin]
+    return tris
+
+
+def _peel_ears(points, tris):
+    """Repeatedly drop sliver "ears": triangles with two or three outline edges and an angle
+    below ``_PEEL_ANGLE``.
+
+    Three outline points almost in a line (two resampled points a fraction of a pixel apart,
+    or a triangle left behind by the centroid check above) make a triangle of almost no
+    area whose corners are all on the outline. Nothing inside holds it open: pressed against
+    a wall it is flattened onto it, inside out by a hair, and as a finite element its tiny
+    height sets a tiny stable step. Dropping it cuts that corner of the outline by less than
+    the triangle's own area (its middle point leaves the mesh).
+    """
+    for _ in range(16):
+        if len(tris) == 0:
+            return tris
+        e = np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]])
+        e.sort(axis=1)
+        _, inv, counts = np.unique(e, axis=0, return_inverse=True, return_counts=True)
+        outline_edges = (counts[inv.ravel()] == 1).reshape(3, -1).sum(axis=0)
+        thin = (outline_edges >= 2) & (quality.triangle_min_angles(points, tris) < _PEEL_ANGLE)
+        if not thin.any() or thin.all():
             return tris
         tris = tris[~thin]
     return tris

@@ -189,6 +189,13 @@ def rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu, lam):
 
 
 @njit(cache=True, inline="always")
+def _corners(elem, b, e):
+    """Vertex indices (unsigned: no negative-index test) and rest-shape inverse of element ``e``."""
+    return (np.uint64(elem[e, 0]), np.uint64(elem[e, 1]), np.uint64(elem[e, 2]),
+            b[e, 0], b[e, 1], b[e, 2], b[e, 3])
+
+
+@njit(cache=True, inline="always")
 def _nodal(p00, p01, p10, p11, b0, b1, b2, b3, area):
     """``-A P B^T``: the forces (N) on vertices ``j`` (column 0) and ``k`` (column 1)."""
     return (-area * (p00 * b0 + p01 * b1), -area * (p10 * b0 + p11 * b1),
@@ -242,20 +249,14 @@ def element_forces(x, v, elem, b, area, mu, lam, beta, kind, damped, f):
     """
     if not damped:
         for e in range(elem.shape[0]):
-            i = np.uint64(elem[e, 0])
-            j = np.uint64(elem[e, 1])
-            k = np.uint64(elem[e, 2])
-            b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+            i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
             f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
             p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
             fjx, fjy, fkx, fky = _nodal(p00, p01, p10, p11, b0, b1, b2, b3, area[e])
             _scatter(f, i, j, k, fjx, fjy, fkx, fky)
         return
     for e in range(elem.shape[0]):
-        i = np.uint64(elem[e, 0])
-        j = np.uint64(elem[e, 1])
-        k = np.uint64(elem[e, 2])
-        b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
         f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
         p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
         r00, r01, r10, r11 = _gradient(v, i, j, k, b0, b1, b2, b3)
@@ -278,32 +279,36 @@ def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, 
     the element's stiffness bound (:func:`max_stiffness`). Adds ``weight D^T T``.
 
     The corotated target is a projection, so the iteration lowers the objective every time
-    (projective dynamics); for Neo-Hookean it is a gradient step, which the element shortens
-    where its curvature exceeds 1.9 times the matrix's (far from rest), so that it cannot
-    overshoot.
+    (projective dynamics); for Neo-Hookean it is a gradient step, which the element blends
+    toward the corotated projection where its curvature exceeds 1.9 times the matrix's (far
+    from rest), so that it cannot overshoot.
     """
     h2 = h * h
     for e in range(elem.shape[0]):
-        i = np.uint64(elem[e, 0])
-        j = np.uint64(elem[e, 1])
-        k = np.uint64(elem[e, 2])
-        b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
         f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
         p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
-        scale = h2
         if kind[e] != KIND_COROTATED:
             # Neo-Hookean stiffens beyond the matrix's 2 (mu + lambda) when stretched or
-            # squashed; a step along the gradient then overshoots (and can run away) where its
-            # curvature passes twice the matrix's. Shorten this element's step there; at rest
-            # and at moderate strain (curvature below 1.9x) the step, and the answer, are exact.
+            # squashed; a step along its gradient then overshoots (and can run away) where its
+            # curvature passes twice the matrix's. There the step blends toward the corotated
+            # one, a projection, which cannot overshoot and still pulls with the full force of
+            # the stretch (only shortening the step let a vertex stretched 9x over a corner
+            # stay behind, held by friction). At rest and at moderate strain (curvature below
+            # 1.9x) the step, and the answer, are Neo-Hookean's exactly.
             c = neo_hookean.max_curvature(f00, f01, f10, f11, mu[e], lam[e])
             bound = 1.9 * weight[e] / (area[e] * (h2 + h * beta[e]))
             if c > bound:
-                scale *= bound / c
-        p00 *= scale
-        p01 *= scale
-        p10 *= scale
-        p11 *= scale
+                s_nh = bound / c
+                c00, c01, c10, c11 = corotated.stress(f00, f01, f10, f11, mu[e], lam[e])
+                p00 = s_nh * p00 + (1.0 - s_nh) * c00
+                p01 = s_nh * p01 + (1.0 - s_nh) * c01
+                p10 = s_nh * p10 + (1.0 - s_nh) * c10
+                p11 = s_nh * p11 + (1.0 - s_nh) * c11
+        p00 *= h2
+        p01 *= h2
+        p10 *= h2
+        p11 *= h2
         if beta[e] > 0.0:
             n00, n01, n10, n11 = _gradient(x_n, i, j, k, b0, b1, b2, b3)
             d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, f00 - n00, f01 - n01, f10 - n10, f11 - n11,
@@ -373,10 +378,7 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, la
     """
     h2 = h * h
     for e in range(elem.shape[0]):
-        i = np.uint64(elem[e, 0])
-        j = np.uint64(elem[e, 1])
-        k = np.uint64(elem[e, 2])
-        b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
         a, m, lm, be = area[e], mu[e], lam[e], beta[e]
         f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
         if kind[e] == KIND_COROTATED:

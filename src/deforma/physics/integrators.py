@@ -261,13 +261,18 @@ def element_chunks(elem, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
     >>> ptr.tolist(), verts.tolist()
     ([0, 1, 2], [[0, 3], [1, 4]])
     """
-    n = len(elem)
+    return _row_chunks(elem, n_chunks)
+
+
+def _row_chunks(rows, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n_chunks`` equal runs of the rows of an (E, k) vertex-index array, and the vertex range each touches."""
+    n = len(rows)
     ptr = (np.arange(n_chunks + 1, dtype=np.int64) * n) // n_chunks
     verts = np.zeros((n_chunks, 2), np.int64)
     for t in range(n_chunks):
         lo, hi = ptr[t], ptr[t + 1]
         if hi > lo:
-            verts[t] = elem[lo:hi].min(), elem[lo:hi].max() + 1
+            verts[t] = rows[lo:hi].min(), rows[lo:hi].max() + 1
     return ptr, verts
 
 
@@ -303,15 +308,7 @@ def spring_chunks(spring_i, spring_j, n_chunks: int) -> tuple[np.ndarray, np.nda
     >>> ptr.tolist(), verts.tolist()
     ([0, 2, 4], [[0, 3], [1, 4]])
     """
-    n = len(spring_i)
-    ptr = (np.arange(n_chunks + 1, dtype=np.int64) * n) // n_chunks
-    verts = np.zeros((n_chunks, 2), np.int64)
-    for t in range(n_chunks):
-        lo, hi = ptr[t], ptr[t + 1]
-        if hi > lo:
-            ends = np.concatenate([spring_i[lo:hi], spring_j[lo:hi]])
-            verts[t] = ends.min(), ends.max() + 1
-    return ptr, verts
+    return _row_chunks(np.stack([spring_i, spring_j], axis=1), n_chunks)
 
 
 @register_integrator("symplectic-euler")
