@@ -102,6 +102,7 @@ def test_run_writes_png_frames_and_states(tmp_path, capsys):
 def test_run_without_output_only_simulates(capsys):
     code, out, _ = run(capsys, "run", "sample", "--seconds", "0.2", "--quiet")
     assert code == 0 and "frames" in out
+    assert out.count("\n") == 1 and "nothing written: add -o sample.mp4" in out and "--states sample.npz" in out
 
 
 def test_unknown_scene_lists_builtins(capsys):

@@ -256,7 +256,9 @@ def cmd_run(a) -> int:
     sim = world.time
     print(f"{label}: {n_frames} frames, {sim:.2f} s simulated in {wall:.2f} s wall "
           f"({sim / wall if wall > 0 else float('inf'):.2f}x real time)"
-          + (f" -> {', '.join(outputs)}" if outputs else ""))
+          + (f" -> {', '.join(outputs)}" if outputs else
+             f"; nothing written: add -o {label}.mp4 (or .gif, or a folder/ for PNGs) for a video, "
+             f"--states {label}.npz for the positions"))
     return 0
 
 
