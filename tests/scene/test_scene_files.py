@@ -199,3 +199,18 @@ def test_missing_and_unreadable_files(tmp_path):
 
 def test_scene_error_is_a_value_error():
     assert issubclass(SceneError, ValueError)
+
+
+def test_saved_vectors_are_written_on_one_line(tmp_path):
+    from deforma.scene.build import _inline_short_arrays
+    import tomli_w
+    import tomllib
+
+    text = scenes.save_scene(scenes.load_scene("sample"), tmp_path / "s.toml").read_text()
+    assert "gravity = [0.0, -9.81]\n" in text and "center = [0.0, 0.0]\n" in text
+    assert "corners = [[-0.75, -0.5], [0.75, -0.5], [0.75, 0.5], [-0.75, 0.5]]\n" in text
+    # nested and long arrays keep their values; a long one keeps one element per line
+    doc = {"v": [[0.123456789, -2.5]] * 9, "t": [[0, 1, 2], [2, 3, 0]], "s": ["#ffffff", "#000000"]}
+    compact = _inline_short_arrays(tomli_w.dumps(doc))
+    assert tomllib.loads(compact) == doc
+    assert "    [0.123456789, -2.5],\n" in compact and "t = [[0, 1, 2], [2, 3, 0]]\n" in compact

@@ -9,6 +9,7 @@ with what only the scene knows (mesh recipes, colours, camera, run length).
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 import weakref
 from dataclasses import dataclass, replace
@@ -359,6 +360,33 @@ def body_specs(world) -> list:
     return list(scene_of(world).body)
 
 
+# an array as tomli_w writes it, one element per line ending in a comma, whose elements are
+# each on one line (scalars, or arrays already put on one line)
+_SCALAR_ARRAY = re.compile(r"\[\n((?:[ ]+[^ \]\n][^\n]*,\n)+)[ ]*\]")  # (an element never starts with ])
+
+
+def _inline_short_arrays(text: str) -> str:
+    r"""Put arrays on one line, innermost first, while the line stays within 80 characters
+    (``center = [0.0, 3.6]``, a box's four corners; a mesh's vertices one ``[x, y]`` per line).
+
+    Examples
+    --------
+    >>> print(_inline_short_arrays("c = [\n    0.0,\n    3.6,\n]\n"))
+    c = [0.0, 3.6]
+    <BLANKLINE>
+    """
+    def inline(m):
+        items = [line.strip().rstrip(",") for line in m.group(1).splitlines()]
+        one = "[" + ", ".join(items) + "]"
+        return one if len(one) <= 80 else m.group(0)
+
+    while True:
+        new = _SCALAR_ARRAY.sub(inline, text)
+        if new == text:
+            return text
+        text = new
+
+
 def save_scene(world, path) -> Path:
     """Write ``world`` (or a :class:`Scene`) to a TOML scene file that :func:`load_scene` reads back.
 
@@ -394,7 +422,7 @@ def save_scene(world, path) -> Path:
     if not target.parent.is_dir():
         raise ValueError(f"{path}: the folder {str(target.parent)!r} does not exist")
     doc = scene_to_dict(scene, base_dir=target.parent.resolve())
-    text = "# deforma scene: see docs/scenes.md for every key\n" + tomli_w.dumps(doc)
+    text = "# deforma scene: see docs/scenes.md for every key\n" + _inline_short_arrays(tomli_w.dumps(doc))
     fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".partial.toml", dir=target.parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
