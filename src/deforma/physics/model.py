@@ -1,11 +1,15 @@
-"""Constant topology and parameters of the soft bodies: spring pairs, rest lengths, masses.
+"""Constant topology and parameters of the soft bodies: springs or triangle elements, masses, pins.
 
 A :class:`Model` is everything a step reads but never writes. It concatenates all bodies
-of a world into flat arrays (global vertex and spring indices) so that one kernel call
-advances every body; ``body_vertex_offsets`` / ``body_spring_offsets`` say where each body
-starts. Parameters (mass, stiffness, damping) can change live, topology only by rebuilding.
+of a world into flat arrays (global vertex, spring and element indices) so that one kernel
+call advances every body; ``body_vertex_offsets`` / ``body_spring_offsets`` /
+``body_elem_offsets`` say where each body starts. A body of the springs material has
+springs and no elements; a finite-element body (``deforma.Material``) has elements and no
+springs. Parameters (mass, stiffness, damping, material constants, pins) can change live,
+topology (and springs <-> elements) only by rebuilding.
 
-Units: metres, kilograms, newtons per metre (stiffness), newton-seconds per metre (damping).
+Units: metres, kilograms, newtons per metre (stiffness), newton-seconds per metre (damping),
+pascals (Lamé parameters), seconds (element damping).
 """
 
 from __future__ import annotations
