@@ -92,11 +92,12 @@ class Viewer:
 
     Examples
     --------
-    >>> import os; os.environ.setdefault("SDL_VIDEODRIVER", "offscreen")  # doctest: +SKIP
-    >>> v = Viewer("demo", size=(640, 360))                               # doctest: +SKIP
-    >>> for _ in range(30): v.frame(1 / 60)                               # doctest: +SKIP
-    >>> v.screenshot().shape                                              # doctest: +SKIP
+    >>> import os; _ = os.environ.setdefault("SDL_VIDEODRIVER", "offscreen")  # works without a display
+    >>> v = Viewer("demo", size=(640, 360))
+    >>> for _ in range(30): v.frame(1 / 60)
+    >>> v.screenshot().shape
     (360, 640, 3)
+    >>> v.close()
     """
 
     def __init__(self, scene="demo", *, size=(1280, 720), panel: bool = True, vsync: bool = False,
