@@ -598,18 +598,7 @@ def _peel_slivers(points, tris):
     that hold no background pixel centre; they add almost no area and make stiff, badly
     conditioned springs, so they go.
     """
-    for _ in range(16):
-        if len(tris) == 0:
-            return tris
-        e = np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]])
-        e.sort(axis=1)
-        _, inv, counts = np.unique(e, axis=0, return_inverse=True, return_counts=True)
-        on_boundary = (counts[inv.ravel()] == 1).reshape(3, -1).any(axis=0)
-        thin = on_boundary & (quality.triangle_min_angles(points, tris) < _PEEL_ANGLE)
-        if not thin.any():
-            return tris
-        tris = tris[~thin]
-    return tris
+    return _peel(points, tris, 1)
 
 
 def _peel_ears(points, tris):
@@ -623,15 +612,21 @@ def _peel_ears(points, tris):
     height sets a tiny stable step. Dropping it cuts that corner of the outline by less than
     the triangle's own area (its middle point leaves the mesh).
     """
+    return _peel(points, tris, 2, keep_all=True)
+
+
+def _peel(points, tris, outline_edges, keep_all=False):
+    """Repeatedly drop triangles with at least ``outline_edges`` outline edges and an angle
+    below ``_PEEL_ANGLE`` (``keep_all``: unless that would drop every triangle)."""
     for _ in range(16):
         if len(tris) == 0:
             return tris
         e = np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]])
         e.sort(axis=1)
         _, inv, counts = np.unique(e, axis=0, return_inverse=True, return_counts=True)
-        outline_edges = (counts[inv.ravel()] == 1).reshape(3, -1).sum(axis=0)
-        thin = (outline_edges >= 2) & (quality.triangle_min_angles(points, tris) < _PEEL_ANGLE)
-        if not thin.any() or thin.all():
+        on_outline = (counts[inv.ravel()] == 1).reshape(3, -1).sum(axis=0)
+        thin = (on_outline >= outline_edges) & (quality.triangle_min_angles(points, tris) < _PEEL_ANGLE)
+        if not thin.any() or (keep_all and thin.all()):
             return tris
         tris = tris[~thin]
     return tris
