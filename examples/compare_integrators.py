@@ -4,7 +4,10 @@ Usage (from the repository root)::
 
     python examples/compare_integrators.py                       # jelly scene at its own dt
     python examples/compare_integrators.py --dt 0.0166667 --substeps 4 \
-        --video docs/integrators_60hz.gif --plot docs/integrators_60hz.png
+        --video jelly_60hz.gif --plot jelly_60hz.png
+
+By default it writes ``integrators.gif`` and ``integrators.png`` in the current folder; the
+pictures in docs/ are made by naming them (docs/integrators.md, "Commands").
 
 Each panel is the same scene (same bodies, stiffness, damping, friction) stepped by one
 integrator. A panel whose integrator becomes unstable freezes on the last good state and
@@ -201,8 +204,10 @@ def main(argv=None) -> None:
     p.add_argument("--substeps", type=int, default=None, help="substeps for every integrator (default the scene's)")
     p.add_argument("--fps", type=float, default=30.0, help="video frames per second (default 30)")
     p.add_argument("--panel", type=int, nargs=2, default=(426, 240), metavar=("W", "H"), help="panel size in px")
-    p.add_argument("--video", default="docs/integrators.gif", help="output .mp4/.gif ('' for none)")
-    p.add_argument("--plot", default="docs/integrators.png", help="output PNG of energy vs time")
+    # the defaults go to the current folder: running the example must not overwrite the
+    # pictures tracked in docs/ (name them to refresh those)
+    p.add_argument("--video", default="integrators.gif", help="output .mp4/.gif ('' for none; default integrators.gif)")
+    p.add_argument("--plot", default="integrators.png", help="output PNG of energy vs time (default integrators.png)")
     args = p.parse_args(argv)
     for out in (args.video, args.plot):
         if out:

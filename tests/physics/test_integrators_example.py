@@ -38,3 +38,14 @@ def test_example_writes_a_side_by_side_gif_and_a_plot(tmp_path):
     with Image.open(png) as im:
         a = np.asarray(im.convert("RGB"))
         assert a.shape[1] > a.shape[0] and a.std() > 10  # a wide figure with something drawn
+
+
+def test_example_writes_into_the_current_folder_by_default(tmp_path, monkeypatch):
+    pytest.importorskip("matplotlib")
+    ex = load_example()
+    docs = Path(__file__).resolve().parents[2] / "docs"
+    before = {p.name: p.stat().st_mtime_ns for p in docs.iterdir()}
+    monkeypatch.chdir(tmp_path)
+    ex.main(["--seconds", "0.2", "--fps", "10", "--panel", "80", "48", "--dt", "0.0166667", "--substeps", "4"])
+    assert (tmp_path / "integrators.gif").is_file() and (tmp_path / "integrators.png").is_file()
+    assert {p.name: p.stat().st_mtime_ns for p in docs.iterdir()} == before  # the tracked pictures untouched
