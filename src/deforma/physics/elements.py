@@ -196,10 +196,12 @@ def _corners(elem, b, e):
 
 
 @njit(cache=True, inline="always")
-def _nodal(p00, p01, p10, p11, b0, b1, b2, b3, area):
-    """``-A P B^T``: the forces (N) on vertices ``j`` (column 0) and ``k`` (column 1)."""
-    return (-area * (p00 * b0 + p01 * b1), -area * (p10 * b0 + p11 * b1),
-            -area * (p00 * b2 + p01 * b3), -area * (p10 * b2 + p11 * b3))
+def _columns(m00, m01, m10, m11, b0, b1, b2, b3, scale):
+    """``scale M B^T`` (4): the vectors ``scale M D_j`` and ``scale M D_k`` (``D_i`` is minus
+    their sum). With ``M = P`` and ``scale = -A`` they are the element's forces on ``j`` and
+    ``k``; with a constraint's gradient in ``F``, its gradients at ``j`` and ``k``."""
+    return (scale * (m00 * b0 + m01 * b1), scale * (m10 * b0 + m11 * b1),
+            scale * (m00 * b2 + m01 * b3), scale * (m10 * b2 + m11 * b3))
 
 
 @njit(cache=True, inline="always")
@@ -252,7 +254,7 @@ def element_forces(x, v, elem, b, area, mu, lam, beta, kind, damped, f):
             i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
             f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
             p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
-            fjx, fjy, fkx, fky = _nodal(p00, p01, p10, p11, b0, b1, b2, b3, area[e])
+            fjx, fjy, fkx, fky = _columns(p00, p01, p10, p11, b0, b1, b2, b3, -area[e])
             _scatter(f, i, j, k, fjx, fjy, fkx, fky)
         return
     for e in range(elem.shape[0]):
@@ -262,8 +264,8 @@ def element_forces(x, v, elem, b, area, mu, lam, beta, kind, damped, f):
         r00, r01, r10, r11 = _gradient(v, i, j, k, b0, b1, b2, b3)
         d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu[e], lam[e])
         be = beta[e]
-        fjx, fjy, fkx, fky = _nodal(p00 + be * d00, p01 + be * d01, p10 + be * d10, p11 + be * d11, b0, b1, b2, b3,
-                                    area[e])
+        fjx, fjy, fkx, fky = _columns(p00 + be * d00, p01 + be * d01, p10 + be * d10, p11 + be * d11, b0, b1, b2,
+                                      b3, -area[e])
         _scatter(f, i, j, k, fjx, fjy, fkx, fky)
 
 
@@ -325,26 +327,15 @@ def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, 
         t10 = w * (f10 - s * p10)
         t11 = w * (f11 - s * p11)
         # weight D_v^T T for v = j (D_j = b[0:2]), k (D_k = b[2:4]), i (minus both)
-        jx = t00 * b0 + t01 * b1
-        jy = t10 * b0 + t11 * b1
-        kx = t00 * b2 + t01 * b3
-        ky = t10 * b2 + t11 * b3
-        rhs[j, 0] += jx
-        rhs[j, 1] += jy
-        rhs[k, 0] += kx
-        rhs[k, 1] += ky
-        rhs[i, 0] -= jx + kx
-        rhs[i, 1] -= jy + ky
+        jx, jy, kx, ky = _columns(t00, t01, t10, t11, b0, b1, b2, b3, 1.0)
+        _scatter(rhs, i, j, k, jx, jy, kx, ky)
 
 
 @njit(cache=True, inline="always")
 def _vertex_gradients(g00, g01, g10, g11, b0, b1, b2, b3):
     """Gradients at vertices ``i, j, k`` (6) of a constraint whose gradient in ``F`` is ``g``:
     ``g D_v`` with ``D_j = (b0, b1)``, ``D_k = (b2, b3)``, ``D_i = -D_j - D_k``."""
-    jx = g00 * b0 + g01 * b1
-    jy = g10 * b0 + g11 * b1
-    kx = g00 * b2 + g01 * b3
-    ky = g10 * b2 + g11 * b3
+    jx, jy, kx, ky = _columns(g00, g01, g10, g11, b0, b1, b2, b3, 1.0)
     return -jx - kx, -jy - ky, jx, jy, kx, ky
 
 

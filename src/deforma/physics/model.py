@@ -122,6 +122,34 @@ class BodyTopology:
         return np.linalg.norm(x[e[:, 1]] - x[e[:, 0]], axis=1)
 
 
+def element_geometry(topology: BodyTopology):
+    """A body's triangles as finite elements: ``(triangles, B, rest areas, lumped vertex areas)``.
+
+    Triangles are sorted by their lowest vertex (a run of them touches a narrow band of
+    vertices); ``B`` and the areas come from :func:`~deforma.physics.elements.rest_geometry`;
+    each vertex gets a third of the area of each triangle around it (m^2).
+
+    Raises
+    ------
+    ValueError
+        The body has no triangles, a triangle has zero area, or a vertex is a corner of no
+        triangle (it would have no mass): the message says which and what to do.
+    """
+    t = topology
+    if not len(t.triangles):
+        raise ValueError("a finite-element material needs a mesh with triangles; this body has only springs "
+                         "(use the 'springs' material)")
+    tri = t.triangles[np.argsort(t.triangles.min(axis=1), kind="stable")]
+    bmat, area = rest_geometry(t.rest_positions, tri)
+    lumped = np.bincount(tri.ravel(), np.repeat(area / 3.0, 3), minlength=t.n_vertices)
+    if not np.all(lumped > 0):
+        k = int(np.flatnonzero(lumped <= 0)[0])
+        raise ValueError(f"vertex {k} belongs to no triangle: a finite-element body gets its mass from "
+                         f"its triangles' area, so every vertex must be a corner of one (or use the "
+                         f"'springs' material)")
+    return tri, bmat, area, lumped
+
+
 def _boundary(x: np.ndarray, t: np.ndarray):
     """Directed boundary edges, boundary vertices and their rest clearances of one body
     (counter-clockwise triangles ``t``)."""
@@ -226,17 +254,10 @@ class Model:
                 self.spring_rest_length[s0:s1] = t.spring_rest_length
                 continue
             t0, t1 = self.body_elem_offsets[b], self.body_elem_offsets[b + 1]
-            tri = t.triangles[np.argsort(t.triangles.min(axis=1), kind="stable")]
-            bmat, area = rest_geometry(t.rest_positions, tri)
+            tri, bmat, area, lumped = element_geometry(t)
             self.elem[t0:t1] = tri + v0
             self.elem_b[t0:t1] = bmat
             self.elem_area[t0:t1] = area
-            lumped = np.bincount(tri.ravel(), np.repeat(area / 3.0, 3), minlength=t.n_vertices)
-            if not np.all(lumped > 0):
-                k = int(np.flatnonzero(lumped <= 0)[0])
-                raise ValueError(f"vertex {k} belongs to no triangle: a finite-element body gets its mass from "
-                                 f"its triangles' area, so every vertex must be a corner of one (or use the "
-                                 f"'springs' material)")
             self.vertex_area[v0:v0 + t.n_vertices] = lumped
         self.elem_mu = np.zeros(ntot, np.float64)
         self.elem_lambda = np.zeros(ntot, np.float64)

@@ -20,13 +20,11 @@ from .colliders import Rect, make_hits, pack_rects
 from .elements import element_energy, gradient_row_sums, max_stiffness
 from .integrators import make_integrator
 from .material import Material
-from .model import BodyTopology, Model
+from .model import BodyTopology, Model, element_geometry
 from .state import State
 
 # Automatic contact thickness: this fraction of a body's median boundary edge (see World).
 AUTO_THICKNESS = 0.05
-# Any finite-element material: builds a probe Model to check that a mesh can be one.
-_PROBE = Material("corotated", youngs_modulus=1.0, poisson_ratio=0.0, density=1.0)
 
 
 class SimulationUnstable(RuntimeError):
@@ -106,10 +104,7 @@ def _material(value):
 
 def _fem_mesh_check(topology) -> None:
     """Refuse a mesh that cannot be made of finite elements (before anything changes)."""
-    if not len(topology.triangles):
-        raise ValueError("a finite-element material needs a mesh with triangles; this body has only springs "
-                         "(use the 'springs' material)")
-    Model([topology], masses=[1.0], stiffness=[0.0], damping=[0.0], materials=[_PROBE])  # raises with the reason
+    element_geometry(topology)  # raises with the reason
 
 
 def _pair(value, name: str) -> tuple[float, float]:
