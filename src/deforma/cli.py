@@ -90,6 +90,12 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--detect-edges", action=argparse.BooleanOptionalAction, default=True,
                    help="image: add points along the outline (default on)")
     m.add_argument("--edge-step", type=_positive(int), default=2, help="image: every n-th outline pixel (default 2)")
+    m.add_argument("--background", default="black", metavar="COLOUR",
+                   help="image without transparency: what the shape is on, black (default), white, auto (the "
+                        "border's colour) or '#rrggbb' (quote it: # starts a shell comment)")
+    m.add_argument("--threshold", type=float, metavar="T",
+                   help="image: how far from the background a pixel must be to be the shape, 0 <= T < 1 of full "
+                        "scale in the channel that differs most (default 0.06; for alpha 0.5)")
     m.add_argument("--detail", type=int, default=8, help="box: n*n interior points (default 8)")
     m.add_argument("--edges", action=argparse.BooleanOptionalAction, default=False,
                    help="box: points on the sides too (default off, as in the original)")
@@ -334,11 +340,14 @@ def cmd_mesh(a) -> int:
         what = f"box, detail {a.detail}{', edges' if a.edges else ''}"
     else:
         ref = resolve_texture(a.source, base_dir=Path.cwd())
-        m = meshes.from_image(ref, resolution=a.resolution, detect_edges=a.detect_edges, edge_step=a.edge_step)
+        # a bad background or threshold is a ValueError: main() makes it one line, exit 1
+        m = meshes.from_image(ref, resolution=a.resolution, detect_edges=a.detect_edges, edge_step=a.edge_step,
+                              background=a.background, threshold=a.threshold)
         picture = m.texture if getattr(m, "texture", None) is not None else load_texture(ref)
         name = a.source if a.source in builtin_textures() else Path(a.source).name
         what = (f"{name}, resolution {a.resolution}"
-                + (f", edges every {a.edge_step} px" if a.detect_edges else ", no edge detection"))
+                + (f", edges every {a.edge_step} px" if a.detect_edges else ", no edge detection")
+                + ("" if a.background == "black" else f", background {a.background}"))
     seconds = time.perf_counter() - t0
     min_angle = float(m.min_angle) if hasattr(m, "min_angle") else float("nan")
     caption = (f"{what}: {len(m.vertices)} points, {len(m.triangles)} triangles, "

@@ -139,8 +139,10 @@ def test_grid_only_mesh_covers_no_background(name, masks):
 
 
 def test_full_rectangle_grid_known_answer():
-    # 40 x 60 all foreground, every 5th pixel from pixel 2: 8 rows x 12 columns of points
-    img = np.ones((40, 60), bool)
+    # 40 x 60 foreground in a 5 px black frame (a picture that is all foreground is refused),
+    # every 5th pixel from pixel 2: rows and columns 7, 12, ...: 8 rows x 12 columns of points
+    img = np.zeros((50, 70), bool)
+    img[5:45, 5:65] = True
     m = from_image(img, resolution=5, detect_edges=False, scale=0.1)
     assert len(m.vertices) == 96
     assert m.area == pytest.approx(35 * 55 * 0.1**2, rel=1e-12)
@@ -255,7 +257,7 @@ def test_no_foreground():
         ({"scale": 0}, r"scale must be .* > 0"),
         ({"scale": float("inf")}, r"scale must be .* > 0"),
         ({"detect_edges": "yes"}, "detect_edges must be True or False"),
-        ({"threshold": 1.0}, r"threshold must be a number in \(0, 1\)"),
+        ({"threshold": 1.0}, r"threshold must be a number in \[0, 1\)"),
         ({"max_points": 0}, r"max_points must be an integer >= 3"),
     ],
 )

@@ -2,10 +2,15 @@
 
 How it works (the reasons are in ``docs/mesh.md``):
 
-1. **Foreground.** A pixel is foreground when its alpha is above half (images with
-   transparency) or, without transparency, when its brightest channel is above about 6 %
-   (not black, with room for JPEG noise). Specks and pin-holes smaller than a few pixels
-   are dropped: they would become tiny separate pieces or tiny holes in the body.
+1. **Foreground.** In a picture with transparency (some alpha below 255) a pixel is
+   foreground when its alpha is above half. Without transparency it is foreground when its
+   colour differs from the background's by more than ``threshold`` in at least one channel
+   (``max(|R - Rb|, |G - Gb|, |B - Bb|) / 255``); the background is black unless the
+   caller names another (``"white"``, ``"auto"``: the colour of the picture's border, or any
+   colour), and the default threshold, about 6 %, leaves room for JPEG noise. With a black
+   background this is the seed's rule, "the brightest channel is not black". Specks and
+   pin-holes smaller than a few pixels are dropped: they would become tiny separate pieces
+   or tiny holes in the body.
 2. **Outline** (``detect_edges=True``). Sub-pixel contours (marching squares,
    :func:`skimage.measure.find_contours`): of the alpha channel at the threshold, so an
    antialiased edge is located to a fraction of a pixel, or of the mask itself for pictures
@@ -43,6 +48,7 @@ import operator
 import os
 import warnings
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -53,8 +59,33 @@ from . import quality
 from .delaunay import delaunay
 from .mesh import Mesh
 
-#: Names of the pictures shipped in ``deforma/assets/textures``.
-BUILTIN_TEXTURES = ("bunny", "donut", "armadillo")
+#: File types a built-in texture may be stored as (what Pillow reads).
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
+
+
+def builtin_textures() -> dict:
+    """The pictures shipped in ``deforma/assets/textures``: name -> file, sorted by name.
+
+    The one list of built-in textures: ``from_image``, scene files, the CLI and the viewer
+    all take their names from here, so a picture added to the folder is everywhere at once.
+
+    Returns
+    -------
+    dict of str to pathlib.Path
+
+    Examples
+    --------
+    >>> sorted(builtin_textures())
+    ['armadillo', 'bunny', 'donut']
+    """
+    folder = Path(str(resources.files("deforma") / "assets" / "textures"))
+    if not folder.is_dir():
+        return {}
+    return {p.stem: p for p in sorted(folder.iterdir()) if p.suffix.lower() in IMAGE_SUFFIXES}
+
+
+#: Names of the pictures shipped in ``deforma/assets/textures`` (``builtin_textures()``'s keys).
+BUILTIN_TEXTURES = tuple(builtin_textures())
 #: Largest picture accepted, in pixels (about 6300 x 6300): the per-pixel arrays of a
 #: larger one take gigabytes before a single point is made.
 MAX_PIXELS = 40_000_000
@@ -64,8 +95,17 @@ DEFAULT_MAX_POINTS = 1_000_000
 #: Rounds of outline recovery (split missing segments, triangulate again).
 RECOVERY_ROUNDS = 8
 
-_ALPHA_LEVEL = 0.5
-_BRIGHTNESS_LEVEL = 0.06
+_NAMED_RGB = {"black": (0, 0, 0), "white": (255, 255, 255)}
+#: Names ``background`` accepts besides a colour.
+BACKGROUND_NAMES = (*_NAMED_RGB, "auto")
+#: Default ``threshold`` of the alpha channel (pictures with transparency).
+ALPHA_THRESHOLD = 0.5
+#: Default ``threshold`` of the colour distance to the background (pictures without
+#: transparency): about 15 of 255, above the noise of a JPEG's flat background.
+COLOR_THRESHOLD = 0.06
+# "auto" needs a border that is mostly one colour: at least this share of the border pixels
+# within ``threshold`` of its median colour, or the guess would be a colour nobody chose
+_AUTO_AGREEMENT = 0.5
 
 
 def from_image(
@@ -75,6 +115,7 @@ def from_image(
     detect_edges=True,
     edge_step=2,
     scale=0.01,
+    background="black",
     threshold=None,
     max_points=DEFAULT_MAX_POINTS,
 ) -> Mesh:
@@ -100,10 +141,18 @@ def from_image(
         merged into it, so spacings range from below ``edge_step`` to ``1.5 * edge_step``.
     scale : float, keyword-only
         Metres per pixel, > 0.
+    background : str or tuple of int, keyword-only
+        What the shape is on, for pictures without transparency: ``"black"`` (the default,
+        the seed's rule), ``"white"``, ``"auto"`` (the median colour of the picture's
+        outermost pixels, which must mostly agree with it) or a colour, ``"#rrggbb"`` or an
+        ``(r, g, b)`` tuple of integers 0-255. Ignored when the picture has transparency
+        (some alpha below 255): then alpha decides, whatever the colours.
     threshold : float, optional, keyword-only
-        Level in (0, 1) above which a pixel is foreground: of the alpha channel when the
-        picture has transparency (default 0.5), otherwise of its brightest colour channel
-        (default 0.06, so only black and near-black is background).
+        In [0, 1), a fraction of full scale. Without transparency: how far a pixel's colour
+        must be from the background to be foreground, measured in the channel that differs
+        most, ``max(|R - Rb|, |G - Gb|, |B - Bb|) / 255`` (default ``COLOR_THRESHOLD`` =
+        0.06, about 15 of 255). With transparency: the alpha level above which a pixel is
+        foreground (default ``ALPHA_THRESHOLD`` = 0.5).
     max_points : int, keyword-only
         Refuse pictures that would give more mesh points than this (they would exhaust
         memory or take minutes); raise ``resolution`` and ``edge_step`` instead.
@@ -112,13 +161,15 @@ def from_image(
     -------
     Mesh
         Vertices in metres, centred on the origin, y up; ``uv`` into the picture (v up);
-        ``texture`` the picture as an RGBA array (row 0 at the top).
+        ``texture`` the picture as an RGBA array (row 0 at the top), see :func:`load_rgba`.
 
     Raises
     ------
     ValueError
-        On a missing or unreadable file, a picture larger than ``MAX_PIXELS``, no
-        foreground, a parameter out of range, or more points than ``max_points``.
+        On a missing or unreadable file, a picture larger than ``MAX_PIXELS``, an unknown
+        or malformed ``background``, ``threshold`` outside [0, 1), a border with no main
+        colour for ``"auto"``, no foreground or nothing but foreground (the picture is not
+        on that background), a parameter out of range, or more points than ``max_points``.
 
     Examples
     --------
@@ -128,6 +179,14 @@ def from_image(
     (2, 0)
     >>> bool(abs(m.vertices.mean(axis=0)).max() < 0.05)  # centred on the origin
     True
+
+    A dark square on white, 40 x 40 px at 1 cm per pixel:
+
+    >>> import numpy as np
+    >>> picture = np.full((60, 60, 3), 255, np.uint8)
+    >>> picture[10:50, 10:50] = (40, 30, 30)
+    >>> round(deforma.mesh.from_image(picture, background="white").area, 3)  # m^2
+    0.16
     """
     r = _check_int("resolution", resolution, 1)
     e = _check_int("edge_step", edge_step, 1)
@@ -141,13 +200,10 @@ def from_image(
     if not (np.isfinite(scale) and scale > 0):
         raise ValueError(f"scale must be a finite number of metres per pixel > 0, got {scale!r}")
 
-    rgba, field, level, by_alpha = _load(source, threshold)
+    pic = _load(source, background, threshold)
+    field, level, by_alpha = pic.field, pic.level, pic.by_alpha
     mask = _clean(field > level)
-    if not mask.any():
-        raise ValueError(
-            "the picture has no foreground: every pixel is transparent or black at threshold "
-            f"{level / 255:.3g}; need pixels above it"
-        )
+    _check_foreground(pic, mask)
     h, w = mask.shape
     off = r // 2
     grid = np.zeros_like(mask)
@@ -214,15 +270,17 @@ def from_image(
     cx, cy = 0.5 * (lo + hi)
     vertices = np.c_[(points[:, 0] - cx) * scale, (cy - points[:, 1]) * scale]
     uv = np.clip(np.c_[points[:, 0] / w, 1.0 - points[:, 1] / h], 0.0, 1.0)
-    return Mesh(vertices, tris, uv, texture=rgba)
+    return Mesh(vertices, tris, uv, texture=_with_alpha(pic, None if by_alpha else mask))
 
 
-def foreground_mask(source, *, threshold=None) -> np.ndarray:
+def foreground_mask(source, *, background="black", threshold=None) -> np.ndarray:
     """The pixels :func:`from_image` treats as the shape.
 
     Parameters
     ----------
     source : str, os.PathLike, PIL.Image.Image or array_like
+        As for :func:`from_image`.
+    background : str or tuple of int, keyword-only
         As for :func:`from_image`.
     threshold : float, optional, keyword-only
         As for :func:`from_image`.
@@ -231,7 +289,8 @@ def foreground_mask(source, *, threshold=None) -> np.ndarray:
     -------
     (H, W) ndarray of bool
         True on foreground pixels, row 0 at the top of the picture (specks and pin-holes
-        of a few pixels removed, as the mesher does).
+        of a few pixels removed, as the mesher does). Unlike :func:`from_image` an empty or
+        full mask is returned, not refused: it shows what a background choice does.
 
     Examples
     --------
@@ -239,49 +298,266 @@ def foreground_mask(source, *, threshold=None) -> np.ndarray:
     >>> m.shape, bool(m[m.shape[0] // 2, m.shape[1] // 2])  # the hole is background
     ((384, 384), False)
     """
-    _, field, level, _ = _load(source, threshold)
-    return _clean(field > level)
+    pic = _load(source, background, threshold)
+    return _clean(pic.field > pic.level)
+
+
+def load_rgba(source, *, background="black", threshold=None) -> np.ndarray:
+    """The picture as :func:`from_image` reads it and puts in ``Mesh.texture``.
+
+    The one image loader of the package (scene textures use it too). A picture without
+    transparency gets alpha 0 on its background pixels (by :func:`foreground_mask`'s test
+    with the same ``background`` and ``threshold``), so a renderer draws no fringe of the
+    background colour around the body; a picture with transparency keeps its alpha.
+
+    Parameters
+    ----------
+    source, background, threshold
+        As for :func:`from_image`.
+
+    Returns
+    -------
+    (H, W, 4) ndarray of uint8
+        RGBA, row 0 at the top of the picture.
+
+    Raises
+    ------
+    ValueError
+        An unreadable source, or a bad ``background`` or ``threshold``. A picture that is
+        all background or all foreground is not an error here (a texture may be either).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> picture = np.zeros((20, 20, 3), np.uint8)
+    >>> picture[5:15, 5:15] = 200
+    >>> rgba = load_rgba(picture)
+    >>> rgba.shape, int(rgba[0, 0, 3]), int(rgba[10, 10, 3])  # black is see-through
+    ((20, 20, 4), 0, 255)
+    """
+    pic = _load(source, background, threshold)
+    return _with_alpha(pic, None if pic.by_alpha else _clean(pic.field > pic.level))
 
 
 # ---- loading -------------------------------------------------------------------------------
 
 
-def _load(source, threshold):
-    """(rgba uint8 (H, W, 4), field float (H, W) in 0..255, level, field is alpha)."""
-    if threshold is not None:
+class _Picture:
+    """A loaded picture and its foreground test: ``field > level`` is foreground."""
+
+    __slots__ = ("rgba", "field", "level", "by_alpha", "background", "rgb")
+
+    def __init__(self, rgba, field, level, by_alpha, background, rgb):
+        self.rgba = rgba          # (H, W, 4) uint8, as read
+        self.field = field        # (H, W) float32 in 0..255: alpha, or distance to the background
+        self.level = level        # 255 * threshold
+        self.by_alpha = by_alpha  # alpha decides (the picture has transparency)
+        self.background = background  # as the caller gave it (for messages)
+        self.rgb = rgb            # the background colour used, or None when alpha decides
+
+
+def _load(source, background, threshold):
+    """Read ``source`` and set up its foreground test (a :class:`_Picture`)."""
+    named = check_background(background)
+    threshold = check_threshold(threshold)
+    rgba = read_rgba(source)
+    if rgba[..., 3].min() < 255:
+        # transparency always wins: alpha is coverage, drawn by whoever made the picture
+        level = 255.0 * (ALPHA_THRESHOLD if threshold is None else threshold)
+        return _Picture(rgba, rgba[..., 3].astype(np.float32), level, True, background, None)
+    level = 255.0 * (COLOR_THRESHOLD if threshold is None else threshold)
+    rgb = _border_rgb(rgba, level) if named == "auto" else named
+    return _Picture(rgba, _colour_distance(rgba, rgb), level, False, background, rgb)
+
+
+def check_background(background):
+    """What a ``background`` argument means: an (r, g, b) tuple of ints 0-255, or ``"auto"``.
+
+    Accepted: ``"black"``, ``"white"``, ``"auto"`` (any case), a colour ``"#rrggbb"``, or a
+    sequence of three integers 0-255. Scene files use it to check their ``background`` key.
+
+    Raises
+    ------
+    ValueError
+        Anything else, in one line listing what is allowed.
+
+    Examples
+    --------
+    >>> check_background("white"), check_background("#1E78C8"), check_background("auto")
+    ((255, 255, 255), (30, 120, 200), 'auto')
+    """
+    if isinstance(background, str):
+        name = background.strip().lower()
+        if name == "auto":
+            return "auto"
+        if name in _NAMED_RGB:
+            return _NAMED_RGB[name]
+        if len(name) == 7 and name[0] == "#":
+            try:
+                return tuple(int(name[k : k + 2], 16) for k in (1, 3, 5))
+            except ValueError:
+                pass
+    elif isinstance(background, (tuple, list, np.ndarray)) and len(background) == 3:
         try:
-            threshold = float(threshold)
-        except (TypeError, ValueError):
-            raise ValueError(f"threshold must be a number in (0, 1), got {threshold!r}") from None
-        if not 0.0 < threshold < 1.0:
-            raise ValueError(f"threshold must be a number in (0, 1), got {threshold!r}")
+            rgb = tuple(operator.index(c) for c in background)
+        except TypeError:
+            rgb = None
+        if rgb is not None and all(0 <= c <= 255 for c in rgb) and not any(
+            isinstance(c, (bool, np.bool_)) for c in background
+        ):
+            return rgb
+    raise ValueError(
+        'background must be "black", "white", "auto" (the colour of the picture\'s border), '
+        f'a colour "#rrggbb" or an (r, g, b) tuple of integers 0-255, got {background!r}'
+    )
 
+
+def check_threshold(threshold):
+    """What a ``threshold`` argument means: a float in [0, 1), or None for the default.
+
+    Raises
+    ------
+    ValueError
+        Anything else (including ``True``), in one line saying what is allowed.
+
+    Examples
+    --------
+    >>> check_threshold(0.1), check_threshold(None)
+    (0.1, None)
+    """
+    if threshold is None:
+        return None
+    try:
+        # True is not a level (float(True) would be 1.0 and pass as a number)
+        t = float("nan") if isinstance(threshold, (bool, np.bool_)) else float(threshold)
+    except (TypeError, ValueError):
+        t = float("nan")
+    if not 0.0 <= t < 1.0:  # also refuses nan
+        raise ValueError(
+            "threshold must be a number in [0, 1), a fraction of full scale (of the colour distance to "
+            f"the background, or of alpha for pictures with transparency), got {threshold!r}"
+        )
+    return t
+
+
+def _colour_distance(rgba, rgb):
+    """(H, W) float32: ``max(|R - Rb|, |G - Gb|, |B - Bb|)`` in 0..255.
+
+    The channel that differs most, not the Euclidean distance: against black it is the
+    brightest channel, the seed's rule, exactly; it spans 0..255 for every background; and
+    a shape that differs in one channel only (red on black) counts fully.
+    """
+    out = np.zeros(rgba.shape[:2], np.float32)
+    for c in range(3):  # one channel at a time: a (H, W, 3) int16 copy of a large picture is big
+        np.maximum(out, np.abs(rgba[..., c].astype(np.int16) - rgb[c]), out=out)
+    return out
+
+
+def _border_rgb(rgba, level):
+    """The colour of the picture's outermost pixels (per-channel median) for ``"auto"``.
+
+    The median, not the mean: a shape touching the border on one side, or JPEG noise, does
+    not move it. It must describe the border, though: if fewer than half the border pixels
+    are within ``level`` of it, there is no background colour to guess and saying so beats
+    meshing a colour nobody chose.
+    """
+    h, w = rgba.shape[:2]
+    rim = np.concatenate([rgba[0, :, :3], rgba[h - 1, :, :3], rgba[1 : h - 1, 0, :3], rgba[1 : h - 1, w - 1, :3]])
+    rgb = tuple(int(v) for v in np.median(rim, axis=0).round())
+    near = (np.abs(rim.astype(np.int16) - np.array(rgb, np.int16)).max(axis=1) <= level).mean()
+    if near < _AUTO_AGREEMENT:
+        raise ValueError(
+            f'background="auto" found no main colour on the picture\'s border: only {near:.0%} of its pixels '
+            f"are within threshold {level / 255:.3g} of their median {_hex(rgb)}; give the background "
+            '("black", "white", "#rrggbb" or (r, g, b)) or a larger threshold'
+        )
+    return rgb
+
+
+def _hex(rgb):
+    return "#{:02x}{:02x}{:02x}".format(*rgb)
+
+
+def _describe(pic):
+    """How a message names the background: ``'white' (#ffffff)``."""
+    return f"{pic.background!r} ({_hex(pic.rgb)})" if isinstance(pic.background, str) else _hex(pic.rgb)
+
+
+def _check_foreground(pic, mask):
+    """Refuse a mask that is empty or full: the picture is not on that background."""
+    t = f"{pic.level / 255:.3g}"
+    choose = ('choose the background the shape is on ("black", "white", "auto" for the border\'s colour, '
+              '"#rrggbb" or (r, g, b))')
+    if not mask.any():
+        if pic.by_alpha:
+            raise ValueError(f"the picture has no foreground: every pixel's alpha is at or below threshold {t} "
+                             "(transparent); need pixels above it (a lower threshold, or a picture with an "
+                             "opaque shape)")
+        raise ValueError(f"the picture has no foreground: no pixel differs from the background {_describe(pic)} "
+                         f"by more than threshold {t}; {choose} or lower threshold")
+    if mask.all():
+        if pic.by_alpha:
+            raise ValueError(f"the whole picture is foreground: every pixel's alpha is above threshold {t}; "
+                             "need transparent pixels around the shape (or a higher threshold)")
+        border = _border_rgb_or_none(pic.rgba)
+        seen = f" (its border is {_hex(border)})" if border is not None and border != pic.rgb else ""
+        raise ValueError(f"the whole picture is foreground: every pixel differs from the background "
+                         f"{_describe(pic)} by more than threshold {t}, so the body would be the picture's "
+                         f"rectangle{seen}; {choose} or raise threshold")
+
+
+def _border_rgb_or_none(rgba):
+    try:
+        return _border_rgb(rgba, 255.0 * COLOR_THRESHOLD)
+    except ValueError:
+        return None
+
+
+def _with_alpha(pic, mask):
+    """The picture with alpha 0 off ``mask`` (None: keep the picture's own alpha)."""
+    if mask is None:
+        return pic.rgba
+    rgba = pic.rgba.copy()
+    rgba[..., 3] = np.where(mask, 255, 0).astype(np.uint8)
+    return rgba
+
+
+def read_rgba(source) -> np.ndarray:
+    """Read a picture as it is, without any foreground test: (H, W, 4) uint8 RGBA, row 0 on top.
+
+    Parameters
+    ----------
+    source : str, os.PathLike, PIL.Image.Image or array_like
+        As for :func:`from_image`. Pictures without alpha get alpha 255 everywhere, so "has
+        transparency" is simply "some alpha below 255", whatever the file's mode was.
+
+    Raises
+    ------
+    ValueError
+        A missing or unreadable file, a picture over ``MAX_PIXELS``, an array that is not an
+        image.
+
+    Examples
+    --------
+    >>> read_rgba("bunny").shape
+    (384, 384, 4)
+    """
     if isinstance(source, Image.Image):
-        rgba, has_alpha = _from_pil(source, "the image")
-    elif isinstance(source, (str, os.PathLike)):
-        rgba, has_alpha = _from_path(source)
-    else:
-        rgba, has_alpha = _from_array(source)
-
-    if has_alpha and rgba[..., 3].min() < 255:
-        field = rgba[..., 3].astype(np.float32)
-        level = 255.0 * (threshold if threshold is not None else _ALPHA_LEVEL)
-        return rgba, field, level, True
-    field = rgba[..., :3].max(axis=2).astype(np.float32)
-    level = 255.0 * (threshold if threshold is not None else _BRIGHTNESS_LEVEL)
-    return rgba, field, level, False
+        return _from_pil(source, "the image")
+    if isinstance(source, (str, os.PathLike)):
+        return _from_path(source)
+    return _from_array(source)
 
 
 def _from_path(source):
     name = os.fspath(source)
-    if isinstance(source, str) and name in BUILTIN_TEXTURES:
-        ref = resources.files("deforma") / "assets" / "textures" / f"{name}.png"
-        with resources.as_file(ref) as path:
-            return _open(path, name)
+    textures = builtin_textures()
+    if isinstance(source, str) and name in textures:
+        return _open(textures[name], name)
     if not os.path.isfile(name):
         raise ValueError(
             f"image file not found: {name!r}; give a path to a PNG or JPEG file or one of "
-            f"{', '.join(map(repr, BUILTIN_TEXTURES))}"
+            f"{', '.join(map(repr, textures))}"
         )
     return _open(name, name)
 
@@ -302,12 +578,11 @@ def _from_pil(im, label):
         raise ValueError(f"image {label!r} has {w}x{h} = {w * h} pixels; at most {MAX_PIXELS} allowed")
     if w == 0 or h == 0:
         raise ValueError(f"image {label!r} is empty ({w}x{h}); it needs at least one pixel")
-    has_alpha = im.mode in ("RGBA", "LA", "La", "RGBa", "PA") or "transparency" in im.info
     try:
         rgba = np.asarray(im.convert("RGBA"), dtype=np.uint8)
     except OSError as exc:  # truncated or corrupt data surfaces when pixels are decoded
         raise ValueError(f"cannot read image {label!r} ({exc}); a PNG or JPEG file is needed") from None
-    return np.ascontiguousarray(rgba), has_alpha
+    return np.ascontiguousarray(rgba)
 
 
 def _from_array(source):
@@ -337,10 +612,9 @@ def _from_array(source):
         a = a.astype(np.uint8)
     if a.ndim == 2:
         a = np.repeat(a[..., None], 3, axis=2)
-    has_alpha = a.shape[2] == 4
-    if not has_alpha:
+    if a.shape[2] == 3:
         a = np.concatenate([a, np.full(a.shape[:2] + (1,), 255, np.uint8)], axis=2)
-    return np.ascontiguousarray(a), has_alpha
+    return np.ascontiguousarray(a)
 
 
 # ---- foreground and outline ----------------------------------------------------------------

@@ -1,4 +1,9 @@
-"""Built-in scenes and textures (package data under ``deforma/assets/``) and image loading."""
+"""Built-in scenes (package data under ``deforma/assets/``) and the textures scenes name.
+
+Pictures are read by one loader, :func:`deforma.mesh.image.load_rgba`, and the built-in
+textures are listed in one place, :func:`deforma.mesh.image.builtin_textures`; this module
+resolves scene references to them and caches the pictures a renderer draws.
+"""
 
 from __future__ import annotations
 
@@ -8,10 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..mesh.image import builtin_textures
+
 __all__ = ["builtin_scenes", "builtin_textures", "load_texture", "resolve_texture", "scene_path",
            "texture_reference"]
-
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
 
 
 def _assets() -> Path:
@@ -22,14 +27,6 @@ def builtin_scenes() -> dict[str, Path]:
     """Built-in scene names and their files, sorted by name."""
     folder = _assets() / "scenes"
     return {p.stem: p for p in sorted(folder.glob("*.toml"))} if folder.is_dir() else {}
-
-
-def builtin_textures() -> dict[str, Path]:
-    """Built-in texture names (``bunny``, ``donut``, ``armadillo``) and their image files."""
-    folder = _assets() / "textures"
-    if not folder.is_dir():
-        return {}
-    return {p.stem: p for p in sorted(folder.iterdir()) if p.suffix.lower() in IMAGE_SUFFIXES}
 
 
 def scene_path(name_or_path) -> Path:
@@ -97,33 +94,48 @@ def texture_file(value: str) -> Path:
 
 
 @lru_cache(maxsize=32)
-def _load_rgba(path: str, mtime: float) -> np.ndarray:
-    from PIL import Image
+def _load_rgba(path: str, mtime: float, background, threshold) -> np.ndarray:
+    from ..mesh.image import load_rgba
 
-    with Image.open(path) as im:
-        has_alpha = im.mode in ("RGBA", "LA", "PA") or (im.mode == "P" and "transparency" in im.info)
-        rgba = np.array(im.convert("RGBA"))
-    if not has_alpha or rgba[..., 3].min() == 255:
-        # the original's rule for pictures without transparency: black pixels are not the
-        # object, so they must not be drawn either (no dark fringe around the body)
-        rgba[..., 3] = np.where(rgba[..., :3].max(axis=2) > 16, 255, 0).astype(np.uint8)
-    rgba.setflags(write=False)
+    rgba = load_rgba(path, background=background, threshold=threshold)
+    rgba.setflags(write=False)  # shared between every body that draws it
     return rgba
 
 
-def load_texture(value: str) -> np.ndarray:
+def load_texture(value: str, *, background="black", threshold=None) -> np.ndarray:
     """The picture of a texture reference as an (H, W, 4) uint8 RGBA array, row 0 on top.
 
-    Pictures without an alpha channel are made transparent where they are black, the
-    original's rule for what belongs to the object. The array is shared and read-only.
+    Read as :func:`deforma.mesh.from_image` reads pictures
+    (:func:`deforma.mesh.image.load_rgba`): a picture without transparency is made
+    transparent where it shows the background (black unless ``background`` says otherwise),
+    so the drawn body has no fringe of it. The array is shared and read-only.
+
+    Parameters
+    ----------
+    value : str
+        A built-in texture name or an image path (as :func:`resolve_texture` returns it).
+    background, threshold : keyword-only
+        As for :func:`deforma.mesh.from_image`.
 
     Raises
     ------
     ValueError
-        If the file cannot be read as an image.
+        If the file cannot be read as an image, or on a bad ``background``/``threshold``.
+
+    Examples
+    --------
+    >>> rgba = load_texture("donut")
+    >>> rgba.shape, rgba.dtype.name, rgba.flags.writeable
+    ((384, 384, 4), 'uint8', False)
     """
+    from ..mesh.image import check_background, check_threshold
+
     path = texture_file(value)
+    # checked before the cache, whose key they are: (r, g, b) or "auto", a float or None
+    background, threshold = check_background(background), check_threshold(threshold)
     try:
-        return _load_rgba(str(path), path.stat().st_mtime)
-    except (OSError, ValueError) as e:
-        raise ValueError(f"{path}: cannot read the image ({e})") from None
+        mtime = path.stat().st_mtime
+    except OSError as e:
+        raise ValueError(f"{path}: cannot read the image ({e.strerror or e})") from None
+    # the loader's messages name the file already
+    return _load_rgba(str(path), mtime, background, threshold)

@@ -83,7 +83,8 @@ def make_mesh(spec):
     if isinstance(spec, ImageBody):
         # a built-in name or an absolute path: from_image takes either
         return meshes.from_image(spec.source, resolution=spec.resolution, detect_edges=spec.detect_edges,
-                                 edge_step=spec.edge_step, scale=spec.scale)
+                                 edge_step=spec.edge_step, scale=spec.scale, background=spec.background,
+                                 threshold=spec.threshold)
     if isinstance(spec, MeshBody):
         return meshes.Mesh(np.array(spec.vertices, float), np.array(spec.triangles, np.int32),
                            None if spec.uv is None else np.array(spec.uv, float))

@@ -48,6 +48,9 @@ from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+# an image body's background: the names and the rule of deforma.mesh.from_image itself
+from ..mesh.image import BACKGROUND_NAMES, check_background
+
 __all__ = [
     "BodyPhysics", "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
     "MaterialKeyError", "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "material_settings",
@@ -85,7 +88,8 @@ def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, 
     """A dataclass field with what the validator and the docs need to know about it.
 
     ``kind`` is one of float, int, bool, str, vec2, size2, quad, color, colors2, file, points,
-    triangles, box2 (two corners of an axis-aligned box), indices (a list of integers >= 0).
+    triangles, box2 (two corners of an axis-aligned box), indices (a list of integers >= 0),
+    background (one of ``choices`` or a colour '#rrggbb').
     ``lo``/``hi`` bound numbers (``lo_open``/``hi_open`` make a bound exclusive).
     """
     meta = dict(kind=kind, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, choices=choices, unit=unit, doc=doc)
@@ -247,6 +251,15 @@ class ImageBody(BodyPhysics):
     detect_edges: bool = spec("bool", True, doc="Add points along the outline so the mesh follows the picture.")
     edge_step: int = spec("int", 2, lo=1, hi=10000, unit="px", doc="Take every n-th outline pixel.")
     scale: float = spec("float", 0.01, lo=0.0, lo_open=True, unit="m/px", doc="Metres per pixel.")
+    background: str = spec("background", "black", choices=BACKGROUND_NAMES,
+                           doc="What the shape is on, for pictures without transparency (transparency always "
+                               "decides when present): black (the seed's rule), white, auto (the colour of the "
+                               "picture's border) or a colour '#rrggbb'.")
+    threshold: float | None = spec("float", None, lo=0.0, hi=1.0, hi_open=True,
+                                   doc="How far a pixel's colour must be from the background to be the shape, as a "
+                                       "fraction of full scale in the channel that differs most (default 0.06, "
+                                       "about 15 of 255); for pictures with transparency, the alpha level instead "
+                                       "(default 0.5).")
     position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
     color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
     texture: str | None = spec("file", None, doc="A different picture to draw; by default the source itself.")
@@ -448,6 +461,18 @@ def _convert(value, meta, path, ctx):
         return out
     if kind == "color":
         return _color(value, path)
+    if kind == "background":
+        # a file names colours as strings only ('#rrggbb'), as its other colour keys do
+        name = value.strip().lower() if isinstance(value, str) else None
+        try:
+            if name is not None and check_background(name):
+                return name
+        except ValueError:
+            pass
+        close = difflib.get_close_matches(name or "", meta["choices"], n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise _Problem(path, f"unknown value {_show(value)}; {hint}allowed: {', '.join(meta['choices'])} or a colour "
+                             f"'#rrggbb'")
     if kind == "colors2":
         if not isinstance(value, list) or len(value) != 2:
             raise _Problem(path, f"expected two colours ['#rrggbb', '#rrggbb'], got {_show(value)}")
