@@ -199,6 +199,13 @@ class Mesh:
         """Worst (largest) radius ratio over all triangles; dimensionless, >= 1."""
         return float(self.aspect_ratios.max())
 
+    def _repr_png_(self) -> bytes:
+        """A wireframe picture (PNG bytes, 400 px on the longer side): what a notebook shows
+        for a Mesh. Drawn with Pillow by :func:`deforma.mesh.picture.mesh_picture`."""
+        from .picture import mesh_picture, png_bytes
+
+        return png_bytes(mesh_picture(self))
+
     def __repr__(self) -> str:
         return (
             f"Mesh({len(self.vertices)} vertices, {len(self.triangles)} triangles, "

@@ -1157,6 +1157,14 @@ class World:
                                               m.elem_lambda[ts], m.elem_kind[ts])))
         return Energy(kinetic, spring, gravitational, elastic)
 
+    def _repr_png_(self) -> bytes:
+        """A picture of the world as it is now (PNG bytes, 400 px on the longer side): what a
+        notebook shows for a World. Bodies are filled triangles in their picture's colours,
+        colliders grey; drawn with Pillow by :func:`deforma.mesh.picture.world_picture`."""
+        from ..mesh.picture import png_bytes, world_picture
+
+        return png_bytes(world_picture(self))
+
     def __repr__(self) -> str:
         return (f"World({len(self._bodies)} bodies, {self._model.n_vertices} vertices, "
                 f"{len(self._colliders)} colliders, t={self.time:.4g} s)")
