@@ -17,5 +17,20 @@ from .mesh.delaunay import delaunay
 from .physics import Material, Rect, SimulationUnstable, World
 from .scene import load_scene, save_scene
 
-__all__ = ["Material", "Rect", "SimulationUnstable", "World", "delaunay", "load_scene", "mesh", "save_scene"]
+__all__ = ["Material", "Rect", "SimulationUnstable", "World", "delaunay", "load_scene", "mesh", "save_scene", "show"]
 __version__ = "0.1.0"
+
+
+def __getattr__(name):
+    # deforma.show draws with OpenGL: its module is imported on first use, so that
+    # `import deforma` needs no GL package (deforma.render imports moderngl only to draw)
+    if name == "show":
+        from .render.notebook import show
+
+        globals()["show"] = show  # found directly from now on
+        return show
+    raise AttributeError(f"module 'deforma' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | {"show"})
