@@ -332,7 +332,7 @@ class ImplicitEuler:
                 or not np.array_equal(key[8], model.elem_mu)
                 or not np.array_equal(key[9], model.elem_lambda)
                 or not np.array_equal(key[10], model.elem_damping)
-                or key[11] != inputs.air_drag):
+                or key[11] != inputs.air_drag or key[12] != model.rest_version):
             return
         # Air drag -c v joins backward Euler as (1 + h c) M (x - y) / h^2 = f(x) + M g with
         # y = x_n + (h v_n + h^2 g) / (1 + h c): the heavier mass is in the matrix, so that
@@ -343,7 +343,7 @@ class ImplicitEuler:
         self._key = (model, h, model.vertex_mass.copy(), model.spring_stiffness.copy(),
                      model.spring_damping.copy(), inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy(),
                      model.vertex_inv_mass.copy(), model.elem_mu.copy(), model.elem_lambda.copy(),
-                     model.elem_damping.copy(), inputs.air_drag)
+                     model.elem_damping.copy(), inputs.air_drag, model.rest_version)
         self._wk = h * h * model.spring_stiffness
         self._wd = h * model.spring_damping
         self._we = element_weights(model, h)

@@ -74,6 +74,22 @@ class Material:
     damping : float, optional
         Stiffness-proportional viscous damping in seconds (>= 0, finite; default 0): a mode
         of angular frequency ``omega`` gets damping ratio ``damping * omega / 2``.
+    tear_strain : float, optional
+        Tearing (any model; the body needs triangles): where the material is stretched by
+        more than this strain (0.5 = 50% longer) across a mesh edge, the mesh splits along
+        that edge (:mod:`deforma.physics.tearing`). A springs body without triangles snaps
+        the spring instead. ``None`` (default): never tears. In (0, 100].
+    yield_strain : float, optional
+        Plasticity: strain beyond this in any direction moves the rest shape, so dents stay
+        (:mod:`deforma.physics.plasticity`). ``None`` (default): elastic. In (0, 100].
+    plastic_rate : float, optional
+        Share of the strain beyond ``yield_strain`` that becomes permanent at each step, in
+        (0, 1]; 1 (default) is perfectly plastic (independent of the step), smaller values
+        let the rest shape creep after the deformation over several steps.
+    max_stretch : float, optional
+        Strain limit: no spring or element ends a step stretched beyond this ratio of its
+        rest length in any direction (1.05 = at most 5% longer), however hard it is pulled
+        (:mod:`deforma.physics.strain_limit`). ``None`` (default): no limit. In (1, 100].
 
     Raises
     ------
@@ -87,6 +103,8 @@ class Material:
     True
     >>> Material("springs").is_fem
     False
+    >>> Material("springs", max_stretch=1.1).max_stretch  # behaviours work for springs too
+    1.1
     """
 
     model: str
@@ -95,11 +113,16 @@ class Material:
     poisson_ratio: float | None = None
     density: float | None = None
     damping: float = 0.0
+    tear_strain: float | None = None
+    yield_strain: float | None = None
+    plastic_rate: float = 1.0
+    max_stretch: float | None = None
 
     def __post_init__(self):
         if self.model not in MODELS:
             raise ValueError(f"material model must be one of {', '.join(repr(m) for m in MODELS)}, "
                              f"got {self.model!r}")
+        self._check_behaviours()
         given = [k for k in ("youngs_modulus", "poisson_ratio", "density") if getattr(self, k) is not None]
         if self.model == "springs":
             if given or self.damping != 0.0:
@@ -127,6 +150,30 @@ class Material:
         object.__setattr__(self, "poisson_ratio", nu)
         object.__setattr__(self, "density", rho)
         object.__setattr__(self, "damping", d)
+
+    def _check_behaviours(self) -> None:
+        for name in ("tear_strain", "yield_strain"):
+            value = getattr(self, name)
+            if value is not None:
+                v = _number(value, name)
+                if not (math.isfinite(v) and 0.0 < v <= 100.0):
+                    raise ValueError(f"{name} must be a strain in (0, 100] (0.5 = 50% stretch) or None, got {value!r}")
+                object.__setattr__(self, name, v)
+        r = _number(self.plastic_rate, "plastic_rate")
+        if not (math.isfinite(r) and 0.0 < r <= 1.0):
+            raise ValueError(f"plastic_rate must be in (0, 1] (1 = perfectly plastic), got {self.plastic_rate!r}")
+        object.__setattr__(self, "plastic_rate", r)
+        if self.max_stretch is not None:
+            m = _number(self.max_stretch, "max_stretch")
+            if not (math.isfinite(m) and 1.0 < m <= 100.0):
+                raise ValueError(f"max_stretch must be a stretch ratio in (1, 100] (1.05 = at most 5% longer) "
+                                 f"or None, got {self.max_stretch!r}")
+            object.__setattr__(self, "max_stretch", m)
+
+    @property
+    def has_behaviours(self) -> bool:
+        """True if the material tears, yields or limits its stretch."""
+        return self.tear_strain is not None or self.yield_strain is not None or self.max_stretch is not None
 
     @property
     def is_fem(self) -> bool:

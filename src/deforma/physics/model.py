@@ -46,6 +46,10 @@ class BodyTopology:
         edge (``inf`` beyond twice the shortest boundary edge); see
         :func:`deforma.physics.contacts.rest_clearance`. Caps the self-contact thickness so
         that a body at rest never touches itself.
+    mass_share : (N,) float64 or None
+        Share of the springs body's mass each vertex carries, summing to 1; ``None``: equal
+        shares (the original's ``mass / N``). A torn body keeps each split vertex's mass
+        divided among its copies (:mod:`deforma.physics.tearing`).
 
     Examples
     --------
@@ -62,9 +66,10 @@ class BodyTopology:
     boundary_edges: np.ndarray
     boundary_vertices: np.ndarray
     boundary_clearance: np.ndarray
+    mass_share: np.ndarray | None = None
 
     @classmethod
-    def from_arrays(cls, vertices, springs, triangles=None) -> "BodyTopology":
+    def from_arrays(cls, vertices, springs, triangles=None, *, mass_share=None) -> "BodyTopology":
         """Validate vertices and spring pairs and measure rest lengths.
 
         Raises
@@ -103,7 +108,7 @@ class BodyTopology:
             cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
             t[cw] = t[cw][:, [0, 2, 1]]
         edges, verts, clearance = _boundary(x, t)
-        return cls(x, np.ascontiguousarray(s), rest, t, edges, verts, clearance)
+        return cls(x, np.ascontiguousarray(s), rest, t, edges, verts, clearance, mass_share)
 
     @property
     def n_vertices(self) -> int:
@@ -209,6 +214,19 @@ class Model:
         around it, m^2; 0 for springs bodies): its mass is ``density * vertex_area``.
     pinned : (N,) bool
         Pinned vertices: they keep their position (``vertex_inv_mass`` 0, infinite mass).
+    spring_rest_length0, elem_b0, elem_area0 : arrays
+        The rest shape as built: plasticity (:mod:`deforma.physics.plasticity`) moves
+        ``spring_rest_length``, ``elem_b`` and ``elem_area`` and bounds them against these.
+    rest_version : int
+        Incremented whenever a rest shape changes in place (solvers that factor a matrix of
+        it refactor).
+    pressure_a, pressure_b : (P,) int32
+        Directed outline edges (global vertex indices, gas on the left) of the bodies that
+        hold a gas (:mod:`deforma.physics.pressure`); ``body_pressure_offsets`` (B + 1,) says
+        where each body's start.
+    body_pressure, body_pressure_area : (B,) float64
+        Each body's gas pressure at rest (N/m; 0 without gas) and the enclosed area at rest
+        (m^2).
     contact : ContactTopology
         Every body as the contact stage reads it (outline and other vertices, outline edges,
         triangles, per-vertex contact thickness, per-body flags, thickness and friction);
@@ -222,7 +240,8 @@ class Model:
     ([1.0, 1.0, 1.0], [0, 2, 4, 6])
     """
 
-    def __init__(self, topologies, *, masses, stiffness, damping, materials=None, pinned=None, contact=None):
+    def __init__(self, topologies, *, masses, stiffness, damping, materials=None, pinned=None, contact=None,
+                 pressure=None):
         self.topologies = list(topologies)
         nb = len(self.topologies)
         materials = [None] * nb if materials is None else list(materials)
@@ -278,6 +297,12 @@ class Model:
             else:
                 self.set_body_parameters(b, mass=masses[b], stiffness=stiffness[b], damping=damping[b])
 
+        self.spring_rest_length0 = self.spring_rest_length.copy()
+        self.elem_b0 = self.elem_b.copy()
+        self.elem_area0 = self.elem_area.copy()
+        self.rest_version = 0
+        self._pressure(pressure if pressure is not None else [None] * nb)
+
         # CSR adjacency: each spring appears once under each of its two ends.
         ends = np.concatenate([self.spring_i, self.spring_j])
         ids = np.concatenate([np.arange(e, dtype=np.int32)] * 2)
@@ -330,6 +355,28 @@ class Model:
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
 
+    def _pressure(self, pressure) -> None:
+        from .pressure import outline_loops
+
+        nb = len(self.topologies)
+        loops = [np.zeros((0, 2), np.int32)] * nb
+        self.body_pressure = np.zeros(nb)
+        self.body_pressure_area = np.zeros(nb)
+        for b, (t, p) in enumerate(zip(self.topologies, pressure)):
+            if p is None:
+                continue
+            loops[b] = outline_loops(t.rest_positions, t.boundary_edges, t.springs, t.triangles)
+            x = t.rest_positions
+            a, c = x[loops[b][:, 0]], x[loops[b][:, 1]]
+            self.body_pressure_area[b] = 0.5 * float(np.sum(a[:, 0] * c[:, 1] - c[:, 0] * a[:, 1]))
+            self.body_pressure[b] = p
+            loops[b] = loops[b] + self.body_vertex_offsets[b]
+        self.body_pressure_offsets = np.zeros(nb + 1, np.int64)
+        np.cumsum([len(lp) for lp in loops], out=self.body_pressure_offsets[1:])
+        edges = np.concatenate([np.zeros((0, 2), np.int32)] + loops).astype(np.int32)
+        self.pressure_a = np.ascontiguousarray(edges[:, 0])
+        self.pressure_b = np.ascontiguousarray(edges[:, 1])
+
     @property
     def n_vertices(self) -> int:
         """Total number of vertices over all bodies."""
@@ -355,7 +402,8 @@ class Model:
             return
         v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
         s0, s1 = self.body_spring_offsets[body], self.body_spring_offsets[body + 1]
-        self.vertex_mass[v0:v1] = mass / (v1 - v0)
+        share = self.topologies[body].mass_share
+        self.vertex_mass[v0:v1] = mass / (v1 - v0) if share is None else mass * share
         self._inverse_masses(v0, v1)
         self.spring_stiffness[s0:s1] = stiffness
         self.spring_damping[s0:s1] = damping
@@ -384,6 +432,22 @@ class Model:
         v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
         self.pinned[v0:v1] = mask
         self._inverse_masses(v0, v1)
+        self._attachments = {}
+
+    def attachments(self, body: int):
+        """Body ``body``'s long-range attachments to its pins (body-local anchor index and path
+        length, m; see :func:`deforma.physics.strain_limit.attachments`), cached until the pins
+        change."""
+        cache = self.__dict__.setdefault("_attachments", {})
+        if body not in cache:
+            from .strain_limit import attachments
+
+            t = self.topologies[body]
+            v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
+            edges = t.springs if not len(t.triangles) else np.concatenate(
+                [t.triangles[:, [0, 1]], t.triangles[:, [1, 2]], t.triangles[:, [2, 0]]])
+            cache[body] = attachments(t.rest_positions, edges, self.pinned[v0:v1])
+        return cache[body]
 
     def _inverse_masses(self, v0, v1):
         # a pinned vertex has infinite mass: no force, impulse or projection moves it

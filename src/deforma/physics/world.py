@@ -15,12 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import behaviours as _behaviours
 from . import contacts as _contacts
+from . import tearing as _tearing
 from .colliders import Rect, make_hits, pack_rects
 from .elements import element_energy, gradient_row_sums, max_stiffness
 from .integrators import make_integrator
 from .material import Material
 from .model import BodyTopology, Model, element_geometry
+from .pressure import outline_loops
 from .state import State
 
 # Automatic contact thickness: this fraction of a body's median boundary edge (see World).
@@ -107,6 +110,17 @@ def _fem_mesh_check(topology) -> None:
     element_geometry(topology)  # raises with the reason
 
 
+def _pressure(value, topology) -> float | None:
+    """Validate a body's gas pressure (N/m) and that the body can hold a gas."""
+    if value is None:
+        return None
+    p = _non_negative(value, "pressure", "N/m")
+    if p > 1e12:
+        raise ValueError(f"pressure must be in [0, 1e12] N/m, got {value!r}")
+    outline_loops(topology.rest_positions, topology.boundary_edges, topology.springs, topology.triangles)
+    return p
+
+
 def _pair(value, name: str) -> tuple[float, float]:
     try:
         a = np.asarray(value, dtype=np.float64)
@@ -144,6 +158,26 @@ class Body:
         self.topology = topology
         self._overrides = overrides
         self._pinned = np.zeros(topology.n_vertices, bool)
+        self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
+        self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
+
+    def _apply_tear(self, cut) -> None:
+        """Take the torn mesh ``cut`` (a :class:`~deforma.physics.tearing.Tear`) as the body's."""
+        from ..mesh import Mesh
+
+        t, src = self.topology, cut.source
+        rest = t.rest_positions[src]
+        tri = cut.triangles
+        share = (np.full(t.n_vertices, 1.0 / t.n_vertices) if t.mass_share is None else t.mass_share)[src]
+        share = share * cut.mass_share
+        edges = np.unique(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1), axis=0)
+        self.topology = BodyTopology.from_arrays(rest, edges, tri, mass_share=share)
+        uv = getattr(self.mesh, "uv", None)
+        if uv is not None and len(uv) == t.n_vertices:
+            self.mesh = Mesh(rest, tri, uv=np.asarray(uv)[src], texture=getattr(self.mesh, "texture", None))
+        self._pinned = self._pinned[src]
+        self._tear_source = src
+        self._overrides["pressure"] = None  # the gas escapes through the tear
 
     def _check(self) -> "World":
         if self._world is None:
@@ -376,6 +410,35 @@ class Body:
     def contact_thickness(self) -> float:
         """The contact thickness this body uses, metres (the world's, or its automatic value)."""
         return self._check()._body_thickness(self)
+
+    @property
+    def pressure(self) -> float | None:
+        """Gas pressure at the rest area, N/m (``None``: no gas); settable. See
+        :mod:`deforma.physics.pressure`. A body that tears lets its gas out (``None``)."""
+        self._check()
+        return self._overrides["pressure"]
+
+    @pressure.setter
+    def pressure(self, value):
+        world = self._check()
+        self._overrides["pressure"] = _pressure(value, self.topology)
+        world._rebuild(world._state.x, world._state.v)
+
+    @property
+    def pieces(self) -> np.ndarray:
+        """(N,) int: the connected piece each vertex belongs to (all 0 until the body tears).
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2))
+        >>> int(b.pieces.max()) + 1
+        1
+        """
+        self._check()
+        t = self.topology
+        return _tearing.pieces(t.n_vertices, t.springs if not len(t.triangles) else [], t.triangles)
 
     def __repr__(self) -> str:
         if self._world is None:
@@ -653,7 +716,7 @@ class World:
         return list(self._bodies)
 
     def add_body(self, mesh, *, position=None, material=None, mass=None, stiffness=None, damping=None, collide=True,
-                 self_collision=True, friction=None, static_friction=None) -> Body:
+                 self_collision=True, friction=None, static_friction=None, pressure=None) -> Body:
         """Make a soft body from a mesh: springs on its edges, or finite elements on its triangles.
 
         Parameters
@@ -682,6 +745,11 @@ class World:
         friction, static_friction : float, optional
             Coulomb coefficients against other bodies and itself (>= 0); ``None`` follows the
             world's. Two bodies use ``sqrt(a * b)`` of theirs; colliders use their own.
+        pressure : float, optional
+            A gas inside the body's outer outline, N/m at the rest area (>= 0), pushing
+            with ``pressure * A0 / A`` (:mod:`deforma.physics.pressure`); the body needs a
+            closed outline (triangles, or springs forming closed loops). ``None`` (default):
+            no gas.
 
         Returns
         -------
@@ -728,6 +796,7 @@ class World:
             else _non_negative(static_friction, "static_friction", "(dimensionless)"),
             "collide": _switch(collide, "collide"),
             "self_collision": _switch(self_collision, "self_collision"),
+            "pressure": _pressure(pressure, topo),
         }
         body = Body(self, len(self._bodies), mesh, topo, overrides)
         if self._contact_thickness is not None:
@@ -774,7 +843,8 @@ class World:
                             damping=[b.damping for b in self._bodies],
                             materials=[b.material for b in self._bodies],
                             pinned=[b._pinned for b in self._bodies],
-                            contact=[self._contact_parameters(b) for b in self._bodies])
+                            contact=[self._contact_parameters(b) for b in self._bodies],
+                            pressure=[b._overrides["pressure"] for b in self._bodies])
         self._state = State(x, v, self._model.body_vertex_offsets)
         self._grabs_dirty = True
         self._make_contact_scratch()
@@ -1015,6 +1085,10 @@ class World:
             self._rebuild_grabs()
         if self._model.n_vertices:
             status = self._inputs.contact_scratch.status
+            kicked = None
+            if self._model.body_pressure.any():
+                kicked = self._state.v.copy()  # what a failed step puts back
+                _behaviours.apply_pressure(self._model, self._state, self._dt)
             while True:
                 status[_contacts.ST_NEEDED] = status[_contacts.ST_PAIRS_NEEDED] = 0
                 bad = self._integrator.advance(self._model, self._state, self._inputs,
@@ -1028,11 +1102,45 @@ class World:
                 self._inputs.contacts = _contacts.make_buffer(max(2 * need_c, len(buf.vertex)),
                                                               max(2 * need_p, len(buf.pair_vertex)))
             if bad:
+                if kicked is not None:
+                    self._state.v_start[...] = kicked
                 self._fail()
             if moved:
                 self._check_not_trapped()
+            _behaviours.limit_and_yield(self._model, self._state, self._dt)
+            self._tear()
         self.time += self._dt
         self.step_count += 1
+
+    def _tear(self) -> None:
+        """Split the meshes of bodies stretched beyond their ``tear_strain`` (see
+        :mod:`deforma.physics.tearing`); rebuilds the Model when any tore."""
+        torn = False
+        for body in self._bodies:
+            limit = body.material.tear_strain
+            if limit is None:
+                continue
+            topo = body.topology
+            x = self._state.x[body.vertex_slice]
+            if not len(topo.triangles):
+                keep = _tearing.snap_springs(x, topo.springs, topo.spring_rest_length, limit)
+                if not keep.all():
+                    body.topology = BodyTopology.from_arrays(topo.rest_positions, topo.springs[keep],
+                                                             mass_share=topo.mass_share)
+                    torn = True
+                continue
+            if body._tear_topology is None or body._tear_topology[0] is not topo:
+                body._tear_topology = (topo, _tearing.TearTopology.of(topo.rest_positions, topo.triangles))
+            cut = _tearing.tear_mesh(body._tear_topology[1], x, limit)
+            if cut is None:
+                continue
+            body._apply_tear(cut)
+            torn = True
+        if torn:
+            self._rebuild(np.concatenate([self._state.x[b.vertex_slice][b._tear_source] for b in self._bodies]),
+                          np.concatenate([self._state.v[b.vertex_slice][b._tear_source] for b in self._bodies]))
+            for body in self._bodies:
+                body._tear_source = slice(None)
 
     def _check_not_trapped(self) -> None:
         """After colliders changed: refuse a step that left a vertex inside one.

@@ -50,6 +50,7 @@ class WorldView:
         self.collider_colors = None
         self._handles = []
         self._bodies = []
+        self._shown = None
         self.sync()
 
     def sync(self) -> None:
@@ -61,7 +62,7 @@ class WorldView:
         self.collider_colors = colors if any(colors) else None
         self._n_colliders = len(self.world.colliders)
         bodies = self.world.bodies
-        if [id(b) for b in bodies] == [id(b) for b in self._bodies]:
+        if [(id(b), id(b.topology)) for b in bodies] == self._shown:
             return
         for h in self._handles:
             self.renderer.remove_mesh(h)
@@ -81,11 +82,14 @@ class WorldView:
             self._handles.append(self.renderer.add_mesh(b.triangles, uv, texture=image, color=color,
                                                         edges=b.springs))
         self._bodies = bodies
+        self._shown = [(id(b), id(b.topology)) for b in bodies]  # a torn body has a new topology
+        self._topologies = [b.topology for b in bodies]
 
     def draw(self, *, read: bool = True):
         """Paint the world's current state; returns the picture (H, W, 3) uint8 when ``read``."""
         bodies = self.world.bodies
-        if len(bodies) != len(self._bodies) or any(a is not b for a, b in zip(bodies, self._bodies)) \
+        if len(bodies) != len(self._bodies) or any(a is not b or a.topology is not t
+                                                   for a, b, t in zip(bodies, self._bodies, self._topologies)) \
                 or len(self.world.colliders) != self._n_colliders:
             self.sync()
         r = self.renderer
