@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .assets import scene_path
-from .schema import (MATERIAL_KEYS, BoxBody, ColliderSpec, ImageBody, InteractionSettings, MaterialKeyError,
+from .schema import (BEHAVIOUR_KEYS, MATERIAL_KEYS, BoxBody, ColliderSpec, ImageBody, InteractionSettings, MaterialKeyError,
                      MeshBody, PhysicsSettings, Scene, SceneError, material_settings, parse_scene, scene_to_dict)
 
 try:  # Python >= 3.11
@@ -94,8 +94,8 @@ def make_mesh(spec):
 def _material(settings, *, world=False):
     from ..physics import Material
 
-    if settings is None or (world and settings["model"] == "springs"):
-        return None  # a body following the world; a world of the seed's springs
+    if settings is None or (world and settings == {"model": "springs"}):
+        return None  # a body following the world; a world of the seed's plain springs
     return Material(**settings)
 
 
@@ -183,6 +183,11 @@ def build(scene: Scene):
             raise SceneError(f"{source}: body[{i}]{'' if e.key is None else '.' + e.key}: {e}") from None
         except ValueError as e:
             raise SceneError(f"{source}: body[{i}]: {e}") from None
+        if spec.pressure is not None:
+            try:
+                b.pressure = spec.pressure
+            except ValueError as e:  # e.g. an outline that is not one closed loop
+                raise SceneError(f"{source}: body[{i}].pressure: {e}") from None
         try:
             mask = pin_mask(spec, b.positions)
         except ValueError as e:  # the message starts with the key: body[i].pin: ...
@@ -230,9 +235,10 @@ def load_scene(name_or_path):
 def _material_keys(world, recorded: PhysicsSettings) -> dict:
     """``[physics]``'s material keys for the world as it is now."""
     m = world.material
+    behaviours = _behaviour_keys(m)
     if m is not None and m.is_fem:
         return dict(material=m.model, youngs_modulus=m.youngs_modulus, poisson_ratio=m.poisson_ratio,
-                    density=m.density, material_damping=m.damping)
+                    density=m.density, material_damping=m.damping, **behaviours)
     # A springs world: finite-element keys in [physics] are defaults for bodies that choose a
     # finite-element model. The world does not hold them, so keep the scene's while some body
     # is made of elements (a file must not hold defaults that no body uses: load refuses it).
@@ -241,7 +247,14 @@ def _material_keys(world, recorded: PhysicsSettings) -> dict:
                 youngs_modulus=recorded.youngs_modulus if keep else None,
                 poisson_ratio=recorded.poisson_ratio if keep else None,
                 density=recorded.density if keep else None,
-                material_damping=recorded.material_damping if keep else 0.0)
+                material_damping=recorded.material_damping if keep else 0.0, **behaviours)
+
+
+def _behaviour_keys(material) -> dict:
+    """The behaviour keys (tear_strain, ...) of ``material`` (None: the seed's plain springs)."""
+    if material is None:
+        return dict(tear_strain=None, yield_strain=None, plastic_rate=1.0, max_stretch=None)
+    return {k: getattr(material, k) for k in BEHAVIOUR_KEYS}
 
 
 def _expected_material(physics: PhysicsSettings, spec):
@@ -258,11 +271,13 @@ def _expected_material(physics: PhysicsSettings, spec):
 
 def _body_material_keys(material) -> dict:
     """A body spec's material keys that give it exactly ``material`` whatever [physics] says."""
+    behaviours = _behaviour_keys(material)
     if not material.is_fem:
         return dict(material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
-                    material_damping=None)
+                    material_damping=None, **behaviours)
     return dict(material=material.model, youngs_modulus=material.youngs_modulus,
-                poisson_ratio=material.poisson_ratio, density=material.density, material_damping=material.damping)
+                poisson_ratio=material.poisson_ratio, density=material.density, material_damping=material.damping,
+                **behaviours)
 
 
 def _pin_keys(spec, body) -> dict:
@@ -289,7 +304,7 @@ def scene_of(world) -> Scene:
     the starting positions: a scene describes a setup, not a moment of a run.
 
     Materials: the world's material goes to ``[physics]``; a body whose material differs from
-    what its spec and ``[physics]`` give it gets all five material keys of its own (so a body
+    what its spec and ``[physics]`` give it gets all nine material keys of its own (so a body
     whose own material equals the world's is written as following the world). A
     finite-element body has no spring mass, stiffness or damping to write. Pins: the spec's
     ``pin`` box is kept while the body's pinned vertices are exactly those inside it;
@@ -335,7 +350,7 @@ def scene_of(world) -> Scene:
             actual = float(getattr(b, name))
             if actual != expected:
                 overrides[name] = actual
-        for name in ("collide", "self_collision"):
+        for name in ("collide", "self_collision", "pressure"):
             if getattr(b, name) != getattr(spec, name):
                 overrides[name] = getattr(b, name)
         spec = replace(spec, **overrides) if overrides else spec

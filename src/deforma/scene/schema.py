@@ -33,8 +33,9 @@ A file looks like::
     size = [8.0, 0.4]
 
 Materials: ``[physics] material`` (with ``youngs_modulus``, ``poisson_ratio``, ``density``,
-``material_damping``) is the world's default; the same five keys on a ``[[body]]`` give it
-its own material, each key it leaves out taken from ``[physics]``. :func:`material_settings`
+``material_damping`` and the behaviours ``tear_strain``, ``yield_strain``, ``plastic_rate``,
+``max_stretch``) is the world's default; the same nine keys on a ``[[body]]`` give it its
+own material, each key it leaves out taken from ``[physics]``. :func:`material_settings`
 says what a table means and refuses the combinations that mean nothing (finite-element
 parameters on springs, spring mass on finite elements, a finite-element model without E).
 """
@@ -61,8 +62,12 @@ __all__ = [
 #: Material models a scene may name (``deforma.Material``'s; kept here so that reading a file
 #: needs no physics import).
 MATERIAL_MODELS = ("springs", "corotated", "neo-hookean")
+#: The behaviour keys of a material (``deforma.Material``'s keywords of the same names), for
+#: every model; ``plastic_rate`` matters only with ``yield_strain``.
+BEHAVIOUR_KEYS = ("tear_strain", "yield_strain", "plastic_rate", "max_stretch")
+_BEHAVIOUR_DEFAULT = {"tear_strain": None, "yield_strain": None, "plastic_rate": 1.0, "max_stretch": None}
 #: The keys that describe a material, on ``[physics]`` and on a ``[[body]]``.
-MATERIAL_KEYS = ("material", "youngs_modulus", "poisson_ratio", "density", "material_damping")
+MATERIAL_KEYS = ("material", "youngs_modulus", "poisson_ratio", "density", "material_damping") + BEHAVIOUR_KEYS
 # the finite-element keys and the Material keyword each one sets
 _FEM_KEYWORD = {"youngs_modulus": "youngs_modulus", "poisson_ratio": "poisson_ratio", "density": "density",
                 "material_damping": "damping"}
@@ -174,6 +179,19 @@ class PhysicsSettings:
     material_damping: float = spec("float", 0.0, lo=0.0, hi=1e6, unit="s",
                                    doc="Viscous damping of finite-element bodies: a vibration of angular frequency "
                                        "w gets damping ratio material_damping * w / 2.")
+    tear_strain: float | None = spec("float", None, lo=0.0, hi=100.0, lo_open=True,
+                                     doc="Tearing (any material): where a body is stretched by more than this strain "
+                                         "(0.5 = 50% longer) across a mesh edge, the mesh splits there. Omit: never "
+                                         "tears.")
+    yield_strain: float | None = spec("float", None, lo=0.0, hi=100.0, lo_open=True,
+                                      doc="Plasticity (any material): strain beyond this moves the rest shape, so "
+                                          "dents stay. Omit: elastic.")
+    plastic_rate: float = spec("float", 1.0, lo=0.0, hi=1.0, lo_open=True,
+                               doc="Share of the strain beyond yield_strain made permanent per step; 1 is perfectly "
+                                   "plastic, smaller values creep.")
+    max_stretch: float | None = spec("float", None, lo=1.0, hi=100.0, lo_open=True,
+                                     doc="Strain limit (any material): no spring or element ends a step longer than "
+                                         "this ratio of its rest length (1.05 = 5% longer). Omit: no limit.")
 
 
 @dataclass(frozen=True)
@@ -202,8 +220,8 @@ class BodyPhysics:
     stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
     damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
     material: str | None = spec("str", None, choices=MATERIAL_MODELS,
-                                doc="Overrides physics.material: any of these five keys gives the body its own "
-                                    "material, the others taken from [physics].")
+                                doc="Overrides physics.material: any of the nine material keys (material to "
+                                    "max_stretch) gives the body its own material, the others taken from [physics].")
     youngs_modulus: float | None = spec("float", None, lo=0.0, hi=1e15, lo_open=True, unit="Pa",
                                         doc="Overrides physics.youngs_modulus.")
     poisson_ratio: float | None = spec("float", None, lo=-1.0, hi=0.5, lo_open=True, hi_open=True,
@@ -212,6 +230,17 @@ class BodyPhysics:
                                  doc="Overrides physics.density.")
     material_damping: float | None = spec("float", None, lo=0.0, hi=1e6, unit="s",
                                           doc="Overrides physics.material_damping.")
+    tear_strain: float | None = spec("float", None, lo=0.0, hi=100.0, lo_open=True,
+                                     doc="Overrides physics.tear_strain.")
+    yield_strain: float | None = spec("float", None, lo=0.0, hi=100.0, lo_open=True,
+                                      doc="Overrides physics.yield_strain.")
+    plastic_rate: float | None = spec("float", None, lo=0.0, hi=1.0, lo_open=True,
+                                      doc="Overrides physics.plastic_rate.")
+    max_stretch: float | None = spec("float", None, lo=1.0, hi=100.0, lo_open=True,
+                                     doc="Overrides physics.max_stretch.")
+    pressure: float | None = spec("float", None, lo=0.0, hi=1e12, unit="N/m",
+                                  doc="Gas inside the body's outer outline pushing it out with pressure * A0 / A (A0 "
+                                      "its rest area), like a balloon. A tear lets the gas out.")
     collide: bool = spec("bool", True, doc="Touch other bodies (both must have it on).")
     self_collision: bool = spec("bool", True, doc="Touch itself: its outline cannot fold through itself.")
     friction: float | None = spec("float", None, lo=0.0,
@@ -529,8 +558,9 @@ class MaterialKeyError(ValueError):
 
 
 def with_springs(scene: "Scene") -> "Scene":
-    """The same scene with every body made of the original's springs (its material keys
-    dropped; ``[physics]``'s stiffness, damping and mass, or the body's own, apply).
+    """The same scene with every body made of the original's springs (its model and
+    finite-element keys dropped; ``[physics]``'s stiffness, damping and mass, or the body's
+    own, apply; tearing, plasticity and the stretch limit stay, as springs have them too).
 
     The switch behind ``deforma run --springs`` and ``deforma view --springs``.
 
@@ -545,7 +575,9 @@ def with_springs(scene: "Scene") -> "Scene":
 
     physics = replace(scene.physics, material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
                       material_damping=0.0)
-    bodies = tuple(replace(b, **dict.fromkeys(MATERIAL_KEYS)) for b in scene.body)
+    # the behaviours (tearing, plasticity, stretch limit) work for springs too: they stay
+    model_keys = [k for k in MATERIAL_KEYS if k not in BEHAVIOUR_KEYS]
+    bodies = tuple(replace(b, **dict.fromkeys(model_keys)) for b in scene.body)
     return replace(scene, physics=physics, body=bodies)
 
 
@@ -562,7 +594,8 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
     -------
     dict or None
         ``{"model": ...}`` plus ``youngs_modulus``, ``poisson_ratio``, ``density`` and
-        ``damping`` for the finite-element models; ``Material(**settings)`` builds it.
+        ``damping`` for the finite-element models, plus each of :data:`BEHAVIOUR_KEYS` that
+        is set (not its default), for every model; ``Material(**settings)`` builds it.
 
     Raises
     ------
@@ -580,6 +613,8 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
     100000.0
     >>> material_settings(p, BoxBody()) is None
     True
+    >>> material_settings(p, BoxBody(tear_strain=0.4))
+    {'model': 'springs', 'tear_strain': 0.4}
     """
     if body is None:
         model, own = physics.material, {}
@@ -600,7 +635,7 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
             raise MaterialKeyError(fem[0], f"the 'springs' material takes no {fem[0]} (its springs use mass, "
                                            f"stiffness and damping): set material = \"corotated\" or "
                                            f"\"neo-hookean\" too, or remove {fem[0]}")
-        return {"model": "springs"}
+        return {"model": "springs", **_behaviour_settings(physics, own)}
     values = {k: own.get(k, getattr(physics, k)) for k in _FEM_KEYWORD}
     missing = [k for k in _FEM_NEEDS if values[k] is None]
     if missing:
@@ -609,6 +644,17 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
                                      f"density in kg/m^2): set {'it' if len(missing) == 1 else 'them'} {where}")
     out = {"model": model}
     out.update((_FEM_KEYWORD[k], float(v)) for k, v in values.items())
+    out.update(_behaviour_settings(physics, own))
+    return out
+
+
+def _behaviour_settings(physics: PhysicsSettings, own: dict) -> dict:
+    """The behaviour keywords that are set (the body's, else ``[physics]``'s), defaults left out."""
+    out = {}
+    for k in BEHAVIOUR_KEYS:
+        v = own.get(k, getattr(physics, k))
+        if v is not None and v != _BEHAVIOUR_DEFAULT[k]:
+            out[k] = float(v)
     return out
 
 
