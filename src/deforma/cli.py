@@ -162,7 +162,17 @@ def _save_states(path: str, world, scene, times, frames) -> None:
 
     arrays = {"time": np.asarray(times), "fps": np.float64(scene.run.fps), "dt": np.float64(world.dt)}
     for i, b in enumerate(world.bodies):
-        arrays[f"body{i}_positions"] = np.stack([f[i] for f in frames])
+        counts = [len(f[i]) for f in frames]
+        if min(counts) == max(counts):
+            arrays[f"body{i}_positions"] = np.stack([f[i] for f in frames])
+        else:
+            # a body that tore: a tear keeps the vertex numbers and appends the copies, so every
+            # frame is a prefix of the final numbering; vertices not made yet are NaN
+            pos = np.full((len(frames), max(counts), 2), np.nan)
+            for k, f in enumerate(frames):
+                pos[k, :counts[k]] = f[i]
+            arrays[f"body{i}_positions"] = pos
+            arrays[f"body{i}_vertex_count"] = np.asarray(counts)
         arrays[f"body{i}_triangles"] = np.asarray(b.triangles)
         arrays[f"body{i}_springs"] = np.asarray(b.springs)
         arrays[f"body{i}_rest"] = np.asarray(b.topology.rest_positions)
@@ -219,7 +229,7 @@ def cmd_run(a) -> int:
         if a.wireframe:
             view.wireframe = True
 
-    events = sorted(scene.event, key=lambda e: e.time)
+    script = scenes.Script(scene, world)  # its [[event]] explosions and [[pull]] grabs
     times, frames = [], []
     label = Path(a.scene).stem if a.scene.endswith(".toml") else a.scene
     bar = _progress(n_frames, not a.quiet, label)
@@ -230,12 +240,7 @@ def cmd_run(a) -> int:
             writer = open_writer(a.output, fps=fps)
         for k in range(n_frames):
             t_frame = k / fps
-            # step until the world's clock reaches this frame (dt need not divide 1/fps)
-            while world.time < t_frame - 0.5 * world.dt:
-                while events and events[0].time <= world.time + 0.5 * world.dt:
-                    e = events.pop(0)
-                    world.explode(e.strength if e.strength is not None else scene.interaction.explosive_force)
-                world.step()
+            script.advance(t_frame)  # step until the world's clock reaches this frame
             if writer is not None:
                 writer.write(view.draw())
             if a.states:

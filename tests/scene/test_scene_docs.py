@@ -29,7 +29,7 @@ SECTIONS = {
     schema.PhysicsSettings: "### `[physics]`", schema.InteractionSettings: "### `[interaction]`",
     schema.BoxBody: '### `[[body]]` with `shape = "box"`', schema.ImageBody: '### `[[body]]` with `shape = "image"`',
     schema.MeshBody: '### `[[body]]` with `shape = "mesh"`', schema.ColliderSpec: "### `[[collider]]`",
-    schema.Event: "### `[[event]]`",
+    schema.Event: "### `[[event]]`", schema.Pull: "### `[[pull]]`",
 }
 
 

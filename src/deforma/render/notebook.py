@@ -328,6 +328,7 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None) -> A
     camera = _camera(world, scene)
     picture = _picture_size(width, height, camera)
 
+    from ..scene.script import Script
     from .renderer import Renderer
     from .video import open_writer
     from .world_view import WorldView
@@ -335,19 +336,14 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None) -> A
     renderer = Renderer.headless(picture, samples=4)
     try:
         view = WorldView(renderer, world, replace(scene, camera=camera))
-        # the scene's events (explosions) that are still ahead of the world's clock
-        events = sorted((e for e in scene.event if e.time >= world.time - 0.5 * world.dt), key=lambda e: e.time)
+        # the scene's explosions and pulls that are still ahead of the world's clock
+        script = Script(scene, world)
         start = world.time
         with tempfile.TemporaryDirectory(prefix="deforma-show-") as tmp:
             path = Path(tmp) / f"animation.{format}"
             with open_writer(path, fps=fps) as writer:
                 for k in range(n_frames):
-                    # step until the world's clock reaches this frame (dt need not divide 1/fps)
-                    while world.time < start + k / fps - 0.5 * world.dt:
-                        while events and events[0].time <= world.time + 0.5 * world.dt:
-                            e = events.pop(0)
-                            world.explode(e.strength if e.strength is not None else scene.interaction.explosive_force)
-                        world.step()
+                    script.advance(start + k / fps)  # step until the world's clock reaches this frame
                     frame = view.draw()
                     writer.write(frame)
             data = path.read_bytes()

@@ -16,11 +16,12 @@ True
 from .assets import builtin_scenes, builtin_textures, load_texture
 from .build import body_specs, build, load, load_scene, make_mesh, save_scene, scene_of
 from .schema import (BoxBody, CameraSettings, ColliderSpec, Event, ImageBody, InteractionSettings, MeshBody,
-                     PhysicsSettings, RunSettings, Scene, SceneError, SceneInfo, parse_scene, with_springs)
+                     PhysicsSettings, Pull, RunSettings, Scene, SceneError, SceneInfo, parse_scene, with_springs)
+from .script import Script
 
 __all__ = [
     "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
-    "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "body_specs", "build",
+    "PhysicsSettings", "Pull", "RunSettings", "Scene", "SceneError", "SceneInfo", "Script", "body_specs", "build",
     "builtin_scenes", "builtin_textures", "load", "load_scene", "load_texture", "make_mesh", "parse_scene",
     "save_scene", "scene_of", "with_springs",
 ]

@@ -54,7 +54,7 @@ from ..mesh.image import BACKGROUND_NAMES, check_background
 
 __all__ = [
     "BodyPhysics", "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
-    "MaterialKeyError", "PhysicsSettings", "RunSettings", "Scene", "SceneError", "SceneInfo", "material_settings",
+    "MaterialKeyError", "PhysicsSettings", "Pull", "RunSettings", "Scene", "SceneError", "SceneInfo", "material_settings",
     "parse_scene",
     "scene_to_dict",
 ]
@@ -335,6 +335,29 @@ class Event:
 
 
 @dataclass(frozen=True)
+class Pull:
+    """``[[pull]]``: the mouse, scripted for a headless run: grab a body at a point, move the pull
+    target in a straight line, let go."""
+
+    at: tuple | None = spec("vec2", None, unit="m",
+                            doc="Where the body is grabbed (required): the vertices of the triangle under this "
+                                "point, as a mouse press picks them, plus those within radius.")
+    to: tuple | None = spec("vec2", None, unit="m",
+                            doc="Where the pull target ends up; omit to hold the grab where it started.")
+    start: float = spec("float", 0.0, lo=0.0, unit="s", doc="When the grab happens, in simulated seconds.")
+    end: float | None = spec("float", None, lo=0.0, unit="s",
+                             doc="When the target reaches `to`, moving at constant speed from `at` from start on; "
+                                 "omit (or = start) to put it there at once.")
+    release: float | None = spec("float", None, lo=0.0, unit="s",
+                                 doc="When the grab lets go (>= end); omit to hold it to the end of the run.")
+    radius: float | None = spec("float", None, lo=0.0, lo_open=True, unit="m",
+                                doc="Also hold every vertex of the grabbed body within this distance of `at`.")
+    strength: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N/m",
+                                  doc="Pull per held vertex toward the target; by default "
+                                      "interaction.mouse_strength.")
+
+
+@dataclass(frozen=True)
 class Scene:
     """A whole scene file. Build the world with :meth:`build`.
 
@@ -350,6 +373,7 @@ class Scene:
     body: tuple = ()
     collider: tuple = ()
     event: tuple = ()
+    pull: tuple = ()
     path: str | None = field(default=None, compare=False)
 
     def build(self):
@@ -361,7 +385,7 @@ class Scene:
 
 SECTIONS = {"scene": SceneInfo, "run": RunSettings, "camera": CameraSettings, "physics": PhysicsSettings,
             "interaction": InteractionSettings}
-ARRAYS = {"body": None, "collider": ColliderSpec, "event": Event}
+ARRAYS = {"body": None, "collider": ColliderSpec, "event": Event, "pull": Pull}
 
 
 # -- validation --------------------------------------------------------------------------------
@@ -681,6 +705,20 @@ def _check_materials(values: dict) -> None:
                                                    "here or on a body, or remove it")
 
 
+def _check_pull(pull: Pull, path: str) -> None:
+    """A pull's keys that only mean something together: where it grabs, and times in order."""
+    if pull.at is None:
+        raise _Problem(f"{path}.at", "missing: where the pull grabs the body, [x, y] in metres")
+    end = pull.start if pull.end is None else pull.end
+    if end < pull.start:
+        raise _Problem(f"{path}.end", f"must be >= start ({pull.start:g} s), got {end:g}")
+    if pull.end is not None and pull.end > pull.start and pull.to is None:
+        raise _Problem(f"{path}.to", "missing: where the target moves by end, [x, y] in metres (or remove end)")
+    if pull.release is not None and pull.release < end:
+        raise _Problem(f"{path}.release", f"must be >= {'end' if pull.end is not None else 'start'} ({end:g} s), "
+                                          f"got {pull.release:g}")
+
+
 def _check_integrator(name: str, path: str) -> None:
     # the registry, not a fixed list: an integrator registered by the user is allowed too
     from ..physics.integrators import available_integrators
@@ -752,6 +790,8 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
                 for i, item in enumerate(items):
                     p = f"{name}[{i}]"
                     out.append(_body(item, p, ctx) if name == "body" else _table(cls, item, p, ctx))
+                    if name == "pull":
+                        _check_pull(out[-1], p)
                 values[name] = tuple(out)
         _check_materials(values)
     except _Problem as e:
