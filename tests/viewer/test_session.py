@@ -302,3 +302,20 @@ def test_a_mesh_change_keeps_a_pin_box_that_still_holds_vertices_and_clears_vert
     s.toggle_pin(b.center_of_mass)
     s.set_param("detail", 3)
     assert not s.world.bodies[0].pinned.any() and "pins cleared" in s.note
+
+
+def test_objects_are_the_builtin_textures_and_box():
+    from deforma.mesh.image import builtin_textures
+
+    assert set(OBJECTS) == set(builtin_textures()) | {"box"} and OBJECTS[-1] == "box"
+
+
+def test_rebuilding_an_image_body_keeps_its_background_and_threshold():
+    scene = deforma.scene.Scene(body=(ImageBody(source="donut", resolution=16, edge_step=8, scale=0.004,
+                                                background="auto", threshold=0.2, position=(0.0, 2.0)),))
+    s = Session(scene)
+    s.set_param("resolution", 12)
+    spec = s.body_spec
+    assert spec.resolution == 12 and (spec.background, spec.threshold) == ("auto", 0.2)
+    s.select_object("bunny")  # another picture: its own default cut
+    assert (s.body_spec.background, s.body_spec.threshold) == ("black", None)

@@ -30,6 +30,16 @@ from ..scene.assets import builtin_textures
 from ..scene.build import pin_mask
 from ..scene.schema import MATERIAL_MODELS, BodyPhysics
 
+def _builtin_texture_names() -> tuple:
+    """The built-in textures the Selected menu offers, in the original's order where it has them
+    (bunny, donut, armadillo), any others after them."""
+    from ..mesh.image import builtin_textures as textures
+
+    names = list(textures())
+    first = [n for n in ("bunny", "donut", "armadillo") if n in names]
+    return tuple(first + sorted(n for n in names if n not in first))
+
+
 __all__ = ["MATERIAL_DEFAULTS", "MATERIAL_MODELS", "MESH_LIMITS", "OBJECTS", "MeshSettings", "Session"]
 
 #: What a finite-element model starts with when the scene gives no value: a soft gel of
@@ -43,7 +53,7 @@ _MATERIAL_KEYWORD = {"youngs_modulus": "youngs_modulus", "poisson_ratio": "poiss
                      "material_damping": "damping"}
 
 #: The original's "Selected" choices, in the order of the number keys 1-4.
-OBJECTS = ("bunny", "donut", "armadillo", "box")
+OBJECTS = (*_builtin_texture_names(), "box")
 
 #: Ranges the inspector accepts for mesh values. Tighter than the scene schema on purpose:
 #: a live window must rebuild in a fraction of a second and still run at 60 frames/s, and
@@ -428,9 +438,12 @@ class Session:
             if isinstance(spec, ImageBody) and MeshSettings.from_spec(spec).selected == new.selected:
                 source = spec.source  # an image file given by path keeps its path
             keep = isinstance(spec, ImageBody) and source == spec.source
+            # the same picture keeps how its shape is cut from its background
+            cut = dict(background=spec.background, threshold=spec.threshold) if keep else {}
             body = ImageBody(source=source, resolution=new.resolution, detect_edges=new.detect_edges,
                              edge_step=new.edge_step, scale=new.scale,
-                             color=spec.color if keep else None, texture=spec.texture if keep else None, **common)
+                             color=spec.color if keep else None, texture=spec.texture if keep else None, **cut,
+                             **common)
         kept = False
         if spec.pin is not None:
             from ..scene import make_mesh
