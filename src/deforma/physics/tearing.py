@@ -83,6 +83,10 @@ class TearTopology:
         Rest areas (m^2).
     normal : (I, 2) float64
         Unit normal of each interior edge in the rest shape.
+    keys : (E,) int64
+        ``low * N + high`` of each edge (sorted: the lookup of :meth:`edge`).
+    vertex_ptr, vertex_tris : (N + 1,), (3M,) int64
+        The triangles around vertex ``v``: ``vertex_tris[vertex_ptr[v]:vertex_ptr[v + 1]]``.
     """
 
     triangles: np.ndarray
@@ -93,6 +97,9 @@ class TearTopology:
     b: np.ndarray
     area: np.ndarray
     normal: np.ndarray
+    keys: np.ndarray
+    vertex_ptr: np.ndarray
+    vertex_tris: np.ndarray
 
     @classmethod
     def of(cls, rest, tris) -> "TearTopology":
@@ -120,13 +127,18 @@ class TearTopology:
         d = rest[pairs[inner, 1]] - rest[pairs[inner, 0]]
         normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]
         b, area = rest_geometry(rest, t)
-        return cls(t, pairs, tri_pair, inner, boundary, b, area, np.ascontiguousarray(normal))
+        # the triangles around each vertex (CSR)
+        corner = t.ravel()
+        order = np.argsort(corner, kind="stable")
+        ptr = np.zeros(n + 1, np.int64)
+        np.cumsum(np.bincount(corner, minlength=n), out=ptr[1:])
+        return cls(t, pairs, tri_pair, inner, boundary, b, area, np.ascontiguousarray(normal),
+                   pairs[:, 0] * n + pairs[:, 1], ptr, order // 3)
 
     def edge(self, a: int, b: int) -> int:
         """Index of edge ``(a, b)`` in ``pairs``."""
         n = len(self.boundary)
-        keys = self.pairs[:, 0] * n + self.pairs[:, 1]
-        return int(np.searchsorted(keys, min(a, b) * n + max(a, b)))
+        return int(np.searchsorted(self.keys, min(a, b) * n + max(a, b)))
 
 
 @njit(cache=True)
@@ -252,7 +264,7 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None):
 def _fans(topo: TearTopology, v: int, is_cut) -> list[list[int]]:
     """The triangles around vertex ``v`` grouped into fans joined across uncut edges."""
     t = topo.triangles
-    fan = [int(f) for f in np.flatnonzero((t == v).any(axis=1))]
+    fan = [int(f) for f in topo.vertex_tris[topo.vertex_ptr[v]:topo.vertex_ptr[v + 1]]]
     parent = {f: f for f in fan}
 
     def find(f):

@@ -170,7 +170,7 @@ class Body:
         tri = cut.triangles
         share = (np.full(t.n_vertices, 1.0 / t.n_vertices) if t.mass_share is None else t.mass_share)[src]
         share = share * cut.mass_share
-        edges = np.unique(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1), axis=0)
+        edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])  # from_arrays dedups
         self.topology = BodyTopology.from_arrays(rest, edges, tri, mass_share=share)
         uv = getattr(self.mesh, "uv", None)
         if uv is not None and len(uv) == t.n_vertices:
@@ -853,7 +853,12 @@ class World:
         c = self._model.contact
         self._inputs.contact_scratch = _contacts.make_scratch(len(c.cv_vertex), len(c.ce_a), len(self._bodies))
         n_outline = int(c.body_interior[0])
-        self._inputs.contacts = _contacts.make_buffer(n_outline + 64, 4 * n_outline + 64)
+        # keep what an earlier step grew the buffer to (a torn body rebuilds the Model while
+        # its contacts go on; a small buffer would make the next step run twice)
+        old = getattr(self._inputs, "contacts", None)
+        grown = (len(old.vertex), len(old.pair_vertex)) if old is not None else (0, 0)
+        self._inputs.contacts = _contacts.make_buffer(max(n_outline + 64, grown[0]),
+                                                      max(4 * n_outline + 64, grown[1]))
         self._inputs.hits = make_hits(self._model.n_vertices)
 
     def _contact_parameters(self, body) -> dict:
