@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import Row  # noqa: E402
+from common import Row, interleaved_medians  # noqa: E402
 
 import deforma  # noqa: E402
 
@@ -39,19 +39,6 @@ def sheet_world(detail: int, integrator: str, **behaviours):
     right = np.flatnonzero(x[:, 0] > 2.0 - 1e-9)
     body.pin(np.concatenate([np.flatnonzero(x[:, 0] < 1e-9), right]))
     return w, body, right
-
-
-def _interleaved(candidates: dict, repeat: int) -> dict:
-    """Median seconds per call of each candidate, timed in turns after one warm-up call."""
-    for f in candidates.values():
-        f()
-    times = {k: [] for k in candidates}
-    for _ in range(repeat):
-        for k, f in candidates.items():
-            t0 = time.perf_counter()
-            f()
-            times[k].append(time.perf_counter() - t0)
-    return {k: statistics.median(v) for k, v in times.items()}
 
 
 def tearing_steps(detail: int, integrator: str, steps: int):
@@ -78,7 +65,7 @@ def run(quick: bool) -> list[Row]:
         off, _, _ = sheet_world(detail, integrator)
         on, _, _ = sheet_world(detail, integrator, tear_strain=50.0, yield_strain=50.0, max_stretch=50.0)
         n = off.bodies[0].n_vertices
-        t = _interleaved({"off": off.step, "on": on.step}, 7 if quick else 21)
+        t = interleaved_medians({"off": off.step, "on": on.step}, 7 if quick else 21)
         rows.append(Row("behaviours", f"{integrator} step, {n}-vertex corotated sheet, no behaviour",
                         t["off"] * 1e3, "ms"))
         rows.append(Row("behaviours", "  same, tearing + plasticity + stretch limit on, never reached",

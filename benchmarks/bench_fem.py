@@ -15,15 +15,13 @@ the step is elements + integration + the floor, as in the peers.
 
 from __future__ import annotations
 
-import statistics
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import Row  # noqa: E402
+from common import Row, interleaved_medians  # noqa: E402
 from fem_peers import MODELS, grid_body, make_taichi_stepper, make_warp_stepper  # noqa: E402
 
 import deforma  # noqa: E402
@@ -50,20 +48,6 @@ def deforma_world(body: dict, model: str | None):
     return w
 
 
-def _interleaved(candidates: dict, repeat: int) -> dict:
-    """Median seconds per call of each candidate, timed in turns (a shared machine's load
-    then weighs on all alike); one untimed warm-up call each first."""
-    for f in candidates.values():
-        f()
-    times = {k: [] for k in candidates}
-    for _ in range(repeat):
-        for k, f in candidates.items():
-            t0 = time.perf_counter()
-            f()
-            times[k].append(time.perf_counter() - t0)
-    return {k: statistics.median(v) for k, v in times.items()}
-
-
 def run(quick: bool) -> list[Row]:
     side = 100 if quick else 316
     repeat = 5 if quick else 11
@@ -84,7 +68,7 @@ def run(quick: bool) -> list[Row]:
         fem = deforma_world(body, model)
         candidates = {"fem": fem.step, "springs": springs.step}
         candidates.update({peer: f for (peer, m), f in peers.items() if m == model})
-        t = _interleaved(candidates, repeat)
+        t = interleaved_medians(candidates, repeat)
         rows.append(Row("fem", f"deforma {model} world.step(), {case}", t["fem"] * 1e3, "ms"))
         rows.append(Row("fem", f"  deforma springs world.step(), same mesh", t["springs"] * 1e3, "ms",
                         ratio=f"FEM {t['fem'] / t['springs']:.2f}x its time", goal="FEM <= 2x",

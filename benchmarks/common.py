@@ -52,3 +52,17 @@ def format_table(rows: list[Row]) -> str:
         met = "" if r.met is None else ("yes" if r.met else "**no**")
         lines.append(f"| {r.topic} | {r.case} | {r.value:.4g} {r.unit} | {r.ratio} | {r.goal} | {met} |")
     return "\n".join(lines)
+
+
+def interleaved_medians(candidates: dict, repeat: int) -> dict:
+    """Median seconds per call of each candidate, timed in turns (a shared machine's load
+    then weighs on all alike); one untimed warm-up call each first."""
+    for f in candidates.values():
+        f()
+    times = {k: [] for k in candidates}
+    for _ in range(repeat):
+        for k, f in candidates.items():
+            t0 = time.perf_counter()
+            f()
+            times[k].append(time.perf_counter() - t0)
+    return {k: statistics.median(v) for k, v in times.items()}
