@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import deforma
@@ -120,6 +120,9 @@ def test_moving_a_collider_onto_a_body_pushes_it_out():
 
 
 @settings(max_examples=15, deadline=None)
+# found by this test: a vertex resting on the thin plank's face beside its corner, which the
+# corner pass nudged 3e-8 m into it
+@example(angles=[0.0, 0.0, 29.0], offsets=[0.0, -0.27300858830208874, 0.25], vx=0.0, drop=0.7479226887941499)
 @given(angles=st.lists(st.floats(-60, 60), min_size=3, max_size=3),
        offsets=st.lists(st.floats(-0.4, 0.4), min_size=3, max_size=3),
        vx=st.floats(-3, 3), drop=st.floats(0.2, 1.0))
