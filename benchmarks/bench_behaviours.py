@@ -42,10 +42,9 @@ def sheet_world(detail: int, integrator: str, **behaviours):
 
 
 def tearing_steps(detail: int, integrator: str, steps: int):
-    """Median seconds of the steps that tore and of those that did not, the number of each,
-    and the pieces at the end."""
+    """Step times (s) and which steps tore, and the pieces at the end."""
     w, body, right = sheet_world(detail, integrator, tear_strain=0.2)
-    torn, plain = [], []
+    times, tore = [], []
     for k in range(steps):
         x = body.positions
         x[right, 0] += 0.5 / 600 * (1 + k / 100)  # the clamp speeds up: 0.5 m/s, then faster
@@ -53,9 +52,9 @@ def tearing_steps(detail: int, integrator: str, steps: int):
         n = body.n_vertices
         t0 = time.perf_counter()
         w.step()
-        (torn if body.n_vertices != n else plain).append(time.perf_counter() - t0)
-    return (statistics.median(torn) if torn else float("nan"), statistics.median(plain[5:]), len(torn), len(plain),
-            int(body.pieces.max()) + 1)
+        times.append(time.perf_counter() - t0)
+        tore.append(body.n_vertices != n)
+    return np.array(times), np.array(tore), int(body.pieces.max()) + 1
 
 
 def run(quick: bool) -> list[Row]:
@@ -72,10 +71,17 @@ def run(quick: bool) -> list[Row]:
                         t["on"] * 1e3, "ms", ratio=f"{t['on'] / t['off']:.2f}x (the checks)"))
         if integrator != "implicit-euler":
             continue  # XPBD at one substep is too soft for this clamp: the strain piles up at it
-        tear, plain, nt, npl, pieces = tearing_steps(detail, integrator, 300 if quick else 400)
-        rows.append(Row("behaviours", f"  {integrator}: a step that tears ({nt} of {nt + npl} steps tore; "
+        times, tore, pieces = tearing_steps(detail, integrator, 300 if quick else 400)
+        first, last = np.flatnonzero(tore)[[0, -1]]
+        plain = statistics.median(times[5:][~tore[5:]])
+        tear = statistics.median(times[tore])
+        during = float(times[first:last + 1].mean())
+        rows.append(Row("behaviours", f"  {integrator}: a step that tears ({tore.sum()} of {len(tore)} steps tore; "
                         f"{pieces} pieces)", tear * 1e3, "ms", ratio=f"{tear / plain:.2f}x a step that does not",
                         goal="<= 2x", met=tear <= 2 * plain))
+        rows.append(Row("behaviours", f"  {integrator}: mean step while it tears (steps {first}-{last})", during * 1e3,
+                        "ms", ratio=f"{during / plain:.2f}x a step that does not", goal="<= 2x",
+                        met=during <= 2 * plain))
     return rows
 
 

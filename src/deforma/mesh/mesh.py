@@ -109,6 +109,18 @@ class Mesh:
                 )
         self.texture = texture
 
+    @classmethod
+    def _trusted(cls, vertices, triangles, uv, texture) -> "Mesh":
+        """A mesh from arrays known to be valid (counter-clockwise, non-degenerate triangles,
+        edges in at most two, uv in [0, 1]): a torn body's mesh, rebuilt every time it tears,
+        skips the checks that cost more than the rest of the tear."""
+        m = cls.__new__(cls)
+        m.vertices = np.asarray(vertices, dtype=np.float64)
+        m.triangles = np.asarray(triangles, dtype=np.int32)
+        m.uv = np.asarray(uv, dtype=np.float64)
+        m.texture = texture
+        return m
+
     # ---- topology -------------------------------------------------------------------------
 
     @cached_property

@@ -174,7 +174,7 @@ class Body:
         self.topology = BodyTopology.from_arrays(rest, edges, tri, mass_share=share)
         uv = getattr(self.mesh, "uv", None)
         if uv is not None and len(uv) == t.n_vertices:
-            self.mesh = Mesh(rest, tri, uv=np.asarray(uv)[src], texture=getattr(self.mesh, "texture", None))
+            self.mesh = Mesh._trusted(rest, tri, np.asarray(uv)[src], getattr(self.mesh, "texture", None))
         self._pinned = self._pinned[src]
         self._tear_source = src
         self._overrides["pressure"] = None  # the gas escapes through the tear
