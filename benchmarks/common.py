@@ -3,6 +3,8 @@
 Every ``benchmarks/bench_*.py`` module exposes ``run(quick: bool) -> list[Row]``;
 ``python benchmarks/run.py`` calls them all and prints one table. Peers are always
 measured in the same run as deforma, so ratios compare like with like on a noisy machine.
+A full run takes minutes, so run.py also prints each row the moment a module makes it
+(``row_listeners``): a Row is made when its case has been measured.
 """
 
 from __future__ import annotations
@@ -12,6 +14,9 @@ import statistics
 import time
 from dataclasses import dataclass
 from typing import Callable
+
+# Called with each Row as it is made (run.py prints it); the bench modules need not know.
+row_listeners: list[Callable[["Row"], None]] = []
 
 
 @dataclass
@@ -30,6 +35,10 @@ class Row:
     goal: str = ""
     met: bool | None = None
 
+    def __post_init__(self) -> None:
+        for listener in row_listeners:
+            listener(self)
+
 
 def median_seconds(fn: Callable[[], object], *, repeat: int = 5, warmup: int = 1) -> float:
     """Median wall time of ``fn()`` in seconds over ``repeat`` runs after ``warmup`` runs."""
@@ -44,14 +53,16 @@ def median_seconds(fn: Callable[[], object], *, repeat: int = 5, warmup: int = 1
     return statistics.median(times)
 
 
+def format_row(r: Row) -> str:
+    """One row as a line of the Markdown table that ``format_table`` renders."""
+    met = "" if r.met is None else ("yes" if r.met else "**no**")
+    return f"| {r.topic} | {r.case} | {r.value:.4g} {r.unit} | {r.ratio} | {r.goal} | {met} |"
+
+
 def format_table(rows: list[Row]) -> str:
     """Render rows as a GitHub-flavoured Markdown table."""
     head = "| topic | case | median | ratio | goal | met |\n| --- | --- | ---: | --- | --- | --- |"
-    lines = [head]
-    for r in rows:
-        met = "" if r.met is None else ("yes" if r.met else "**no**")
-        lines.append(f"| {r.topic} | {r.case} | {r.value:.4g} {r.unit} | {r.ratio} | {r.goal} | {met} |")
-    return "\n".join(lines)
+    return "\n".join([head] + [format_row(r) for r in rows])
 
 
 def interleaved_medians(candidates: dict, repeat: int) -> dict:
