@@ -211,6 +211,11 @@ def test_mesh_picture_of_a_box(tmp_path, capsys):
     im = np.asarray(Image.open(out).convert("RGB"))
     assert im.shape[1] == 300
     assert sorted(os.listdir(tmp_path)) == ["box.png"]
+    # side points are the default (as in mesh.box and scene files); --no-edges is the original's
+    code, stdout, err = run(capsys, "mesh", "box", "--detail", "3", "-o", str(out), "--width", "300")
+    assert code == 0 and "25 points, 32 triangles" in stdout, err
+    code, stdout, err = run(capsys, "mesh", "box", "--detail", "3", "--no-edges", "-o", str(out), "--width", "300")
+    assert code == 0 and "13 points" in stdout, err
 
 
 def test_mesh_rejects_bad_output(tmp_path, capsys):

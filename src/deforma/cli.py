@@ -97,8 +97,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="image: how far from the background a pixel must be to be the shape, 0 <= T < 1 of full "
                         "scale in the channel that differs most (default 0.06; for alpha 0.5)")
     m.add_argument("--detail", type=int, default=8, help="box: n*n interior points (default 8)")
-    m.add_argument("--edges", action=argparse.BooleanOptionalAction, default=False,
-                   help="box: points on the sides too (default off, as in the original)")
+    m.add_argument("--edges", action=argparse.BooleanOptionalAction, default=True,
+                   help="box: points on the sides too (default on, as in mesh.box and scene files; "
+                        "--no-edges gives the original's thin side triangles)")
     m.add_argument("--width", type=_positive(int, hi=8000), default=800, help="picture width in pixels (default 800)")
     m.add_argument("-o", "--output", required=True, metavar="OUT.png", help="the picture to write")
 

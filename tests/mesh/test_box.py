@@ -37,7 +37,7 @@ def test_point_count_area_and_topology(n, edges):
 
 
 def test_interior_points_are_bilinear_grid():
-    m = box(RECT, detail=3)
+    m = box(RECT, detail=3, edges=False)
     assert np.allclose(m.vertices[:4], RECT)
     xs = np.unique(m.vertices[4:, 0].round(12))
     ys = np.unique(m.vertices[4:, 1].round(12))
@@ -57,7 +57,7 @@ def test_edges_put_points_on_sides_at_grid_spacing():
 
 
 def test_edges_give_better_triangles_than_bare_sides():
-    bare = box(RECT, detail=8)
+    bare = box(RECT, detail=8, edges=False)
     sided = box(RECT, detail=8, edges=True)
     assert sided.min_angle > 4 * bare.min_angle
     assert sided.max_aspect_ratio < bare.max_aspect_ratio
@@ -216,3 +216,19 @@ def test_odd_cell_count_has_no_preferred_shear_direction():
     rising = np.sign(v[diagonal, 0] * v[diagonal, 1])
     assert abs(rising.sum()) / 2 <= 9  # each diagonal appears twice (once per triangle); one way: 81
     check_delaunay(x, t)
+
+
+def test_edges_default_is_the_same_in_the_api_the_cli_and_scene_files():
+    # issue 18: one default (on), so a box looks the same however it is asked for
+    import inspect
+    from dataclasses import fields
+
+    from deforma.cli import _parser
+    from deforma.scene import schema
+
+    api = inspect.signature(box).parameters["edges"].default
+    scene = next(f.default for f in fields(schema.BoxBody) if f.name == "edges")
+    cli = _parser().parse_args(["mesh", "box", "-o", "m.png"]).edges
+    assert api is scene is cli is True
+    m = box(RECT, detail=3)
+    assert len(m.vertices) == 3 * 3 + 4 + 4 * 3

@@ -14,7 +14,7 @@ from .mesh import Mesh
 MAX_DETAIL = 1000
 
 
-def box(corners, *, detail=8, edges=False) -> Mesh:
+def box(corners, *, detail=8, edges=True) -> Mesh:
     """A quadrilateral ("box") mesh filled evenly with points, as in the original's Square.
 
     Parameters
@@ -31,8 +31,9 @@ def box(corners, *, detail=8, edges=False) -> Mesh:
     edges : bool, keyword-only
         Also put ``n`` points on each of the four sides at the same parameters, so the points
         form a full ``(n+2) x (n+2)`` grid and the triangles along the sides are as good as
-        those inside. Without it the sides are single long edges and the outermost triangles
-        are thin (minimum angle about ``atan(1/(n+1))``), as in the original.
+        those inside. On by default (as in scene files, ``deforma mesh box`` and the viewer):
+        without it the sides are single long edges and the outermost triangles are thin
+        (minimum angle about ``atan(1/(n+1))``), the original's point set.
 
     Returns
     -------

@@ -264,7 +264,8 @@ class BoxBody(BodyPhysics):
     corners: tuple = spec("quad", ((-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)), unit="m",
                           doc="Four corners in order around a convex quadrilateral.")
     detail: int = spec("int", 8, lo=0, hi=1000, doc="n: n*n points inside, spread evenly.")
-    edges: bool = spec("bool", True, doc="Also put n points on each side.")
+    edges: bool = spec("bool", True, doc="Also put n points on each side (on by default, as in mesh.box: "
+                                         "without them the triangles along the sides are thin).")
     position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
     color: str | None = spec("color", None, doc=_BODY_COMMON_DOC["color"])
     texture: str | None = spec("file", None, doc=_BODY_COMMON_DOC["texture"])
