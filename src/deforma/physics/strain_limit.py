@@ -85,6 +85,17 @@ def limit_springs(x, v, inv_mass, spring_i, spring_j, rest, max_stretch, toleran
     return sweeps, worst if worst > tolerance else 0.0
 
 
+@njit(cache=True, inline="always")
+def _along(a, i, j, k, wi, wj, wk, g, step):
+    """``a += step * W g`` over a triangle's three vertices (``g`` their 6 gradient entries)."""
+    a[i, 0] += wi * g[0] * step
+    a[i, 1] += wi * g[1] * step
+    a[j, 0] += wj * g[2] * step
+    a[j, 1] += wj * g[3] * step
+    a[k, 0] += wk * g[4] * step
+    a[k, 1] += wk * g[5] * step
+
+
 @njit(cache=True)
 def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, move=True, stop=True):
     """Bring every principal stretch of the triangles ``elem`` down to ``max_stretch``
@@ -138,23 +149,11 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
                 if move and cons > 0.0:
                     if cons > worst:
                         worst = cons
-                    dl = -cons / norm
-                    x[i, 0] += wi * g[0] * dl
-                    x[i, 1] += wi * g[1] * dl
-                    x[j, 0] += wj * g[2] * dl
-                    x[j, 1] += wj * g[3] * dl
-                    x[k, 0] += wk * g[4] * dl
-                    x[k, 1] += wk * g[5] * dl
+                    _along(x, i, j, k, wi, wj, wk, g, -cons / norm)
                 rate = g[0] * v[i, 0] + g[1] * v[i, 1] + g[2] * v[j, 0] + g[3] * v[j, 1] + g[4] * v[k, 0] \
                     + g[5] * v[k, 1]
                 if stop and rate > 0.0:  # still stretching: remove that velocity (an inelastic impulse)
-                    dv = -rate / norm
-                    v[i, 0] += wi * g[0] * dv
-                    v[i, 1] += wi * g[1] * dv
-                    v[j, 0] += wj * g[2] * dv
-                    v[j, 1] += wj * g[3] * dv
-                    v[k, 0] += wk * g[4] * dv
-                    v[k, 1] += wk * g[5] * dv
+                    _along(v, i, j, k, wi, wj, wk, g, -rate / norm)
         if worst <= tolerance:
             break
     return sweeps, worst if worst > tolerance else 0.0
