@@ -19,9 +19,10 @@ def test_every_original_inspector_value_is_a_parameter():
             "collider_y", "collider_width", "collider_height", "collider_angle", "mouse_strength"} <= names
     assert {"youngs_modulus", "poisson_ratio", "density", "material_damping"} <= names
     assert [g for g, _ in GROUPS] == ["Square", "Texture", "Physics", "Material", "Contact", "Collision", "Mouse"]
+    assert {"tear_strain", "yield_strain", "plastic_rate", "max_stretch", "pressure"} <= names
     s = Session("demo")
-    for name in names:  # every parameter reads back from a live session
-        assert s.get_param(name) is not None
+    for name in names:  # every parameter reads back from a live session (None: a value that is off)
+        assert s.get_param(name) is not None or PARAMS[name].optional
 
 
 def test_physics_values_apply_to_the_running_world():
@@ -46,7 +47,10 @@ def test_physics_values_apply_to_the_running_world():
                                          ("explosive_force", -1.0), ("air_drag", -1.0),
                                          ("contact_thickness", 1.0), ("youngs_modulus", 0.0),
                                          ("poisson_ratio", 0.5), ("density", -1.0), ("material_damping", -0.1),
-                                         ("youngs_modulus", "stiff")])
+                                         ("youngs_modulus", "stiff"), ("tear_strain", 0.0),
+                                         ("yield_strain", -0.1), ("plastic_rate", 0.0), ("plastic_rate", None),
+                                         ("max_stretch", 1.0), ("max_stretch", "long"), ("tear_strain", True),
+                                         ("pressure", -5.0), ("pressure", float("inf"))])
 def test_invalid_values_are_refused_and_change_nothing(name, value):
     s = Session("demo")
     before = s.scene
@@ -319,3 +323,87 @@ def test_rebuilding_an_image_body_keeps_its_background_and_threshold():
     assert spec.resolution == 12 and (spec.background, spec.threshold) == ("auto", 0.2)
     s.select_object("bunny")  # another picture: its own default cut
     assert (s.body_spec.background, s.body_spec.threshold) == ("black", None)
+
+
+# -- material behaviours and gas pressure ----------------------------------------------------------
+
+BEHAVIOUR_VALUES = {"tear_strain": 0.4, "yield_strain": 0.05, "plastic_rate": 0.5, "max_stretch": 1.1}
+
+
+def test_behaviours_and_pressure_apply_to_the_running_world_and_are_saved(tmp_path):
+    s = Session("balloon")
+    world, b = s.world, s.world.bodies[0]
+    assert [s.get_param(n) for n in (*BEHAVIOUR_VALUES, "pressure")] == [None, None, 1.0, None, 400.0]
+    for name, value in BEHAVIOUR_VALUES.items():
+        s.set_param(name, value)
+    s.set_param("pressure", 250.0)
+    assert s.world is world and world.bodies[0] is b  # no rebuild, the state kept
+    assert world.material == deforma.Material("springs", **BEHAVIOUR_VALUES) and b.pressure == 250.0
+    assert [s.get_param(n) for n in (*BEHAVIOUR_VALUES, "pressure")] == [*BEHAVIOUR_VALUES.values(), 250.0]
+    scene = deforma.scene.load(s.save(tmp_path / "behaviours.toml"))  # what Ctrl+S writes
+    assert {k: getattr(scene.physics, k) for k in BEHAVIOUR_VALUES} == BEHAVIOUR_VALUES
+    assert scene.body[0].pressure == 250.0
+    again = Session(tmp_path / "behaviours.toml")
+    assert [again.get_param(n) for n in (*BEHAVIOUR_VALUES, "pressure")] == [*BEHAVIOUR_VALUES.values(), 250.0]
+    s.select_object("donut")  # a mesh change rebuilds from the scene and keeps them
+    assert s.world.material == deforma.Material("springs", **BEHAVIOUR_VALUES)
+    assert s.world.bodies[0].pressure == 250.0
+
+
+def test_none_turns_a_behaviour_and_the_gas_off():
+    s = Session("tear")
+    assert s.get_param("tear_strain") == 0.3
+    s.set_param("tear_strain", None)
+    assert s.world.material is None and s.get_param("tear_strain") is None  # the seed's plain springs again
+    s.set_param("pressure", 100.0)
+    s.set_param("pressure", None)
+    assert s.world.bodies[0].pressure is None and s.get_param("pressure") is None
+    assert parse_value(PARAMS["max_stretch"], " ") is None and parse_value(PARAMS["pressure"], "Off") is None
+    with pytest.raises(ValueError, match="Plastic rate must be a number"):
+        parse_value(PARAMS["plastic_rate"], "")  # not optional: it always has a value
+
+
+def test_refused_behaviour_shows_the_materials_own_message():
+    s = Session("dent")
+    before = s.world.material
+    with pytest.raises(ValueError, match=r"max_stretch must be a stretch ratio in \(1, 100\]"):
+        s.set_param("max_stretch", 0.9)
+    with pytest.raises(ValueError, match=r"yield_strain must be a strain in \(0, 100\]"):
+        s.set_param("yield_strain", 200.0)
+    assert s.world.material is before
+
+
+def test_model_and_elastic_values_keep_the_behaviours():
+    s = Session("dent")
+    s.set_integrator("xpbd")
+    assert s.world.material.model == "corotated" and s.world.material.yield_strain == 0.03
+    s.set_param("youngs_modulus", 2e4)
+    assert (s.world.material.youngs_modulus, s.world.material.yield_strain) == (2e4, 0.03)
+    s.set_material("springs")
+    assert s.world.material == deforma.Material("springs", yield_strain=0.03)
+    s.set_material("neo-hookean")
+    assert (s.world.material.model, s.world.material.yield_strain) == ("neo-hookean", 0.03)
+
+
+def test_a_body_with_its_own_material_gets_the_behaviour_itself(tmp_path):
+    scene = seed("sample")
+    scene = dataclasses.replace(scene, body=(dataclasses.replace(scene.body[0], material="springs", tear_strain=0.5),
+                                             *scene.body[1:]))
+    s = Session(scene)
+    assert s.world.material is None and s.get_param("tear_strain") == 0.5
+    s.set_param("tear_strain", 0.8)
+    assert s.world.material is None and s.world.bodies[0].material.tear_strain == 0.8
+    assert deforma.scene.load(s.save(tmp_path / "own.toml")).body[0].tear_strain == 0.8
+
+
+def test_pressure_on_an_open_outline_is_refused_and_changes_nothing():
+    s = Session(seed("sample"))
+    chain = type("Chain", (), {"vertices": np.array([[5.0, 5.0], [6.0, 5.0], [7.0, 5.0]]),
+                               "edges": np.array([[0, 1], [1, 2]])})()
+    s.world.add_body(chain)
+    s.select_body(len(s.world.bodies) - 1)
+    before = s.scene
+    with pytest.raises(ValueError) as e:
+        s.set_param("pressure", 100.0)
+    assert "\n" not in str(e.value) and "outline" in str(e.value)
+    assert s.get_param("pressure") is None and s.scene == before

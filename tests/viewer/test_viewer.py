@@ -10,6 +10,7 @@ import pytest
 from PIL import Image
 
 import deforma
+from deforma.viewer.params import PARAMS
 from seed_scenes import seed
 
 
@@ -456,3 +457,102 @@ def test_shift_click_pins_instead_of_grabbing(demo):
     finally:
         pygame.key.set_mods(0)
     assert not body(demo).pinned.any()
+
+
+def type_into(v, name, text):
+    entry = v.inspector.rows[name].entry
+    entry.set_text(text)
+    post(pygame_gui_event("UI_TEXT_ENTRY_FINISHED"), ui_element=entry, text=text)
+    run(v, 1)
+    return entry
+
+
+def test_behaviour_and_pressure_boxes_set_empty_turns_off_and_refusals_show(demo):
+    ins, s = demo.inspector, demo.session
+    entry = ins.rows["tear_strain"].entry
+    assert entry.get_text() == "" and entry.placeholder_text == "off"  # off: an empty box says so in grey
+    type_into(demo, "tear_strain", "0.5")
+    assert s.world.material.tear_strain == 0.5 and entry.get_text() == "0.5"
+    type_into(demo, "tear_strain", "0")
+    assert ins.message_is_error and "tear_strain must be a strain in (0, 100]" in ins.message
+    assert s.world.material.tear_strain == 0.5 and entry.get_text() == "0.5"
+    type_into(demo, "tear_strain", "")
+    assert s.world.material is None and entry.get_text() == "" and not ins.message_is_error
+    type_into(demo, "pressure", "150")
+    assert body(demo).pressure == 150.0
+    type_into(demo, "pressure", "off")
+    assert body(demo).pressure is None
+    ins.rows["max_stretch"].slider.set_current_value(0.5)  # the slider turns an off value on
+    run(demo, 1)
+    assert s.world.material.max_stretch == pytest.approx(PARAMS["max_stretch"].from_slider(0.5))
+    w = s.world
+    chain = type("Chain", (), {"vertices": np.array([[30.0, 30.0], [31.0, 30.0]]), "edges": np.array([[0, 1]])})()
+    b = w.add_body(chain)
+    s.select_body(len(w.bodies) - 1)
+    assert not ins.apply("pressure", 100.0)  # no closed outline to hold a gas: said in red, no crash
+    assert ins.message_is_error and "outline" in ins.message and b.pressure is None
+    w.remove_body(b)
+    s.select_body(0)
+    run(demo, 2)
+    assert not demo.paused
+
+
+def test_a_torn_body_keeps_drawing_and_stays_grabbable(viewer):
+    """The built-in tear scene, torn by the mouse as a person would, then drawn and grabbed again."""
+    viewer.load("tear")
+    viewer.panel_visible = True
+    pygame.event.clear()
+    run(viewer, 1)
+    b = body(viewer)
+    n0 = b.n_vertices
+    x = b.positions
+    press = vertex_pixel_of(viewer, x[np.argmin(np.linalg.norm(x - (0.0, 0.85), axis=1))])
+    post(pygame.MOUSEBUTTONDOWN, pos=press, button=1)
+    run(viewer, 1)
+    assert viewer.grab is not None
+    for k in range(240):  # pull the bottom edge down until the sheet tears
+        post(pygame.MOUSEMOTION, pos=(press[0], press[1] + min(300, 5 * k)), rel=(0, 5), buttons=(1, 0, 0))
+        run(viewer, 1)
+        if body(viewer).pieces.max() >= 1:
+            break
+    b = body(viewer)
+    assert b.pieces.max() >= 1 and b.n_vertices > n0, "the sheet did not tear"
+    post(pygame.MOUSEBUTTONUP, pos=press, button=1)
+    run(viewer, 10)
+    assert viewer.unstable is None and np.isfinite(b.positions).all()
+    assert viewer.view._topologies[0] is b.topology  # the view follows the new mesh
+    img = viewer.screenshot().astype(float)
+
+    def sheet(p):  # the sheet's #3d7ea6 as the renderer shades it: darker than the sky and blue
+        return p.mean() < 180 and p[2] - p[0] > 40
+
+    assert not sheet(img[5, 5])  # the sky
+    for piece in range(int(b.pieces.max()) + 1):  # every piece is drawn
+        c = vertex_pixel_of(viewer, largest_triangle_centre(b, piece))
+        assert sheet(img[c[1], c[0]]), (piece, img[c[1], c[0]])
+    # grab the largest piece again and pull it up: it follows
+    press = vertex_pixel_of(viewer, largest_triangle_centre(b, np.bincount(b.pieces).argmax()))
+    post(pygame.MOUSEBUTTONDOWN, pos=press, button=1)
+    run(viewer, 1)
+    assert viewer.grab is not None and viewer.grab.body is b
+    held = list(viewer.grab.vertices)
+    y0 = b.positions[held, 1].mean()
+    post(pygame.MOUSEMOTION, pos=(press[0], press[1] - 60), rel=(0, -60), buttons=(1, 0, 0))
+    run(viewer, 20)
+    assert body(viewer).positions[held, 1].mean() > y0 + 0.1
+    post(pygame.MOUSEBUTTONUP, pos=press, button=1)
+    run(viewer, 1)
+    assert viewer.grab is None and np.isfinite(body(viewer).positions).all()
+
+
+def largest_triangle_centre(b, piece):
+    """The centre of the largest triangle of ``piece`` of body ``b`` (metres)."""
+    t = b.triangles[b.pieces[b.triangles[:, 0]] == piece]
+    p, q, r = (b.positions[t[:, k]] for k in range(3))
+    area = np.abs((q[:, 0] - p[:, 0]) * (r[:, 1] - p[:, 1]) - (q[:, 1] - p[:, 1]) * (r[:, 0] - p[:, 0]))
+    return (p + q + r)[np.argmax(area)] / 3
+
+
+def vertex_pixel_of(v, point):
+    px = v.to_pixel(point)
+    return int(round(px[0])), int(round(px[1]))

@@ -1,10 +1,14 @@
 """The inspector panel: pygame_gui widgets drawn to a surface that the window shows as a texture.
 
 Rows follow the original Unity inspector's groups (Square, Texture, Physics, Collision,
-Mouse), plus Material (the world's model and its finite-element parameters) and Contact.
+Mouse), plus Material (the world's model and its finite-element parameters, the selected
+body's behaviours and gas pressure) and Contact.
 Each number has a slider (a comfortable range, log-scaled where values span decades) and a
-text box (any value the session accepts; Enter applies it). A refused value leaves
-everything as it was and shows the reason in red at the bottom of the panel.
+text box (any value the session accepts; Enter applies it). A value that may be off (a
+material behaviour, a body's gas pressure) shows "off" in its otherwise empty box: emptying
+the box (or typing ``off``) turns it off, typing a number or moving the slider turns it on.
+A refused value leaves everything as it was and shows the reason in red at the bottom of
+the panel.
 
 The panel has its own :class:`pygame_gui.UIManager` sized to the panel, so mouse events are
 translated into panel coordinates and the mouse position comes from the events (which also
@@ -191,7 +195,8 @@ class Inspector:
         else:
             row.slider = UIHorizontalSlider(pygame.Rect(124, y + 3, 112, 18), 0.0, (0.0, 1.0), m, container=c,
                                             click_increment=0.02)
-            row.entry = UITextEntryLine(pygame.Rect(240, y, 72, 24), m, container=c)
+            row.entry = UITextEntryLine(pygame.Rect(240, y, 72, 24), m, container=c,
+                                        placeholder_text="off" if p.optional else None)
         return row
 
     def _make_menu(self) -> None:
@@ -386,7 +391,8 @@ class Inspector:
                 row.slider_value = v
                 value = row.param.from_slider(v)
                 current = self.session.get_param(name)
-                if current is not None and value != current:
+                # an optional value that is off (None) is turned on by its slider
+                if (current is not None or row.param.optional) and value != current:
                     self.apply(name, value)
 
     def refresh(self, *, force: bool = False) -> None:
@@ -404,10 +410,12 @@ class Inspector:
                 continue
             if row.entry is not None and not row.entry.is_focused:
                 row.entry.set_text(format_value(row.param, value))
-            if row.slider is not None and value is not None:
+            if row.slider is not None and (value is not None or row.param.optional):
                 dragging = row.slider.sliding_button is not None and row.slider.sliding_button.held
                 if not dragging:
-                    row.slider.set_current_value(row.param.to_slider(value), warn=False)
+                    # an optional value that is off rests at the slider's left end
+                    t = 0.0 if value is None else row.param.to_slider(value)
+                    row.slider.set_current_value(t, warn=False)
                 row.slider_value = row.slider.get_current_value()
         n = len(s.world.colliders)
         text = "none" if s.collider_index is None else f"{s.collider_index + 1} of {n}"

@@ -21,6 +21,8 @@ class Param:
     ``kind`` is ``float``, ``int`` or ``bool``; ``lo``/``hi`` the slider's range and ``log``
     whether it moves in equal ratios (stiffness from 10 to 100000 N/m needs that).
     ``rebuild`` marks values that rebuild the body (the original's mesh settings).
+    ``optional`` marks values that may be off (``None``: a material behaviour that is not
+    used, a body without gas): an empty text box shows and sets "off".
     """
 
     name: str
@@ -32,6 +34,7 @@ class Param:
     unit: str = ""
     rebuild: bool = False
     tip: str = ""
+    optional: bool = False
 
     def to_slider(self, value: float) -> float:
         """Slider position in [0, 1] for ``value`` (clamped)."""
@@ -85,6 +88,17 @@ GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
         Param("density", "Density", "float", 0.1, 1e4, log=True, unit="kg/m²", tip="mass per area"),
         Param("material_damping", "Damping", "float", 0.0, 0.1, unit="s",
               tip="viscous damping of the elements (stiffens the explicit step limit)"),
+        # the behaviours of the selected body's material (any model); empty = off
+        Param("tear_strain", "Tear strain", "float", 0.02, 2.0, log=True, optional=True,
+              tip="the mesh splits where stretched beyond this strain (0.3 = 30%); empty: never tears"),
+        Param("yield_strain", "Yield strain", "float", 0.005, 1.0, log=True, optional=True,
+              tip="strain beyond this moves the rest shape, so dents stay; empty: elastic"),
+        Param("plastic_rate", "Plastic rate", "float", 0.01, 1.0,
+              tip="share of the strain beyond yield made permanent per step (1: perfectly plastic)"),
+        Param("max_stretch", "Max stretch", "float", 1.01, 3.0, log=True, optional=True,
+              tip="no spring or element ends a step longer than this ratio (1.05 = 5%); empty: no limit"),
+        Param("pressure", "Pressure", "float", 1.0, 1e4, log=True, unit="N/m", optional=True,
+              tip="gas in the selected body's outline (needs a closed outline); empty: no gas"),
     )),
     ("Contact", (
         Param("contact_thickness", "Thickness", "float", 1e-4, 0.05, log=True, unit="m",
@@ -118,7 +132,8 @@ def format_value(param: Param, value) -> str:
 
 
 def parse_value(param: Param, text: str):
-    """The number typed in a value box.
+    """The number typed in a value box; for an optional parameter, ``None`` (off) when the box
+    is empty or says ``off`` or ``none``.
 
     Raises
     ------
@@ -133,8 +148,12 @@ def parse_value(param: Param, text: str):
     Traceback (most recent call last):
     ...
     ValueError: Detail must be a whole number, got '7.5'
+    >>> parse_value(PARAMS["tear_strain"], "") is None
+    True
     """
     s = text.strip().replace(",", ".")
+    if param.optional and s.lower() in ("", "off", "none"):
+        return None
     try:
         v = float(s)
     except ValueError:

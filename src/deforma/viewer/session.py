@@ -9,6 +9,8 @@ A :class:`Session` owns the live :class:`deforma.World` and knows how it was mad
   their starting positions, every other setting is kept;
 - the world's material (springs or finite elements, with E, nu, density, damping) is
   switched on the running world, raising substeps where the explicit integrator needs it;
+- the selected body's material behaviours (tearing, plasticity, stretch limit) and its gas
+  pressure are set on the running world;
 - vertices are pinned and unpinned where the pointer is;
 - colliders are added, removed and edited in place;
 - :meth:`Session.save` writes a scene file that ``deforma run`` renders the same way.
@@ -40,7 +42,7 @@ def _builtin_texture_names() -> tuple:
     return tuple(first + sorted(n for n in names if n not in first))
 
 
-__all__ = ["MATERIAL_DEFAULTS", "MATERIAL_MODELS", "MESH_LIMITS", "OBJECTS", "MeshSettings", "Session"]
+__all__ = ["BEHAVIOURS", "MATERIAL_DEFAULTS", "MATERIAL_MODELS", "MESH_LIMITS", "OBJECTS", "MeshSettings", "Session"]
 
 #: What a finite-element model starts with when the scene gives no value: a soft gel of
 #: 1 kg/m^2 (a 1.5 m box weighs 2.25 kg), undamped: stiffness-proportional damping shrinks
@@ -51,6 +53,10 @@ MATERIAL_DEFAULTS = {"youngs_modulus": 1e4, "poisson_ratio": 0.3, "density": 1.0
 # the inspector's material names and the Material keywords they set
 _MATERIAL_KEYWORD = {"youngs_modulus": "youngs_modulus", "poisson_ratio": "poisson_ratio", "density": "density",
                      "material_damping": "damping"}
+#: The material behaviours the inspector edits (``deforma.Material`` keywords of the same
+#: names; every model has them). None of the three strains means "off".
+BEHAVIOURS = ("tear_strain", "yield_strain", "plastic_rate", "max_stretch")
+_SPRINGS = Material("springs")  # what a world without a material (None) is made of
 
 #: The original's "Selected" choices, in the order of the number keys 1-4.
 OBJECTS = (*_builtin_texture_names(), "box")
@@ -205,6 +211,11 @@ class Session:
             return self.explosive_force
         if name in _MATERIAL_KEYWORD:
             return self.material_values[name]
+        if name in BEHAVIOURS:
+            m = w.bodies[self.body_index].material if w.bodies else (w.material or _SPRINGS)
+            return getattr(m, name)
+        if name == "pressure":
+            return w.bodies[self.body_index].pressure if w.bodies else None
         if name == "mouse_strength":
             return w.grab_strength
         if name in ("detail", "edges", "resolution", "detect_edges", "edge_step", "scale"):
@@ -250,6 +261,15 @@ class Session:
             w.grab_strength = value
         elif name in _MATERIAL_KEYWORD:
             self._set_material_value(name, value)
+        elif name in BEHAVIOURS:
+            self._set_behaviour(name, value)
+        elif name == "pressure":
+            if not w.bodies:
+                raise ValueError("the scene has no body to fill with gas")
+            if isinstance(value, bool):
+                raise ValueError(f"pressure must be a number in N/m or None, got {value!r}")
+            # the body checks it (>= 0, finite, a closed outline) and changes nothing if not
+            w.bodies[self.body_index].pressure = value
         elif name in ("detail", "resolution", "edge_step"):
             self._set_mesh(**{name: _check_int(value, name)})
         elif name in ("edges", "detect_edges"):
@@ -272,8 +292,16 @@ class Session:
         m = self.world.material
         return "springs" if m is None else m.model
 
-    def _material(self, model: str, values: dict) -> Material:
-        return Material(model, **{kw: values[name] for name, kw in _MATERIAL_KEYWORD.items()})
+    def _material(self, model: str, values: dict) -> Material | None:
+        # a new model or elastic value keeps the world's behaviours (tearing, ...)
+        if model == "springs":
+            material = Material("springs", **self._world_behaviours())
+            return None if material == _SPRINGS else material  # the seed's plain springs
+        return Material(model, **{kw: values[name] for name, kw in _MATERIAL_KEYWORD.items()},
+                        **self._world_behaviours())
+
+    def _world_behaviours(self) -> dict:
+        return {k: getattr(self.world.material or _SPRINGS, k) for k in BEHAVIOURS}
 
     def set_material(self, model: str) -> None:
         """Make the world's bodies (those without a material of their own) ``model``.
@@ -292,7 +320,7 @@ class Session:
         if model not in MATERIAL_MODELS:
             raise ValueError(f"material model must be one of {', '.join(MATERIAL_MODELS)}, got {model!r}")
         self.note, self.note_is_warning = "", False
-        material = None if model == "springs" else self._material(model, self.material_values)
+        material = self._material(model, self.material_values)
         self.world.material = material  # refuses (changing nothing) a body without triangles
         self._keep_stable(f"the {model} material")
 
@@ -313,6 +341,29 @@ class Session:
             self.world.material = material
             self._keep_stable(f"the {model} material")
         self.material_values = values
+
+    def _follows_world(self, body) -> bool:
+        """True if ``body`` has no material of its own (it is made of the world's)."""
+        m, wm = body.material, self.world.material
+        # a body following a world without a material gets a fresh Material("springs")
+        return m is wm if wm is not None else m == _SPRINGS
+
+    def _set_behaviour(self, name: str, value) -> None:
+        """Set tear_strain, yield_strain, plastic_rate or max_stretch of the selected body's
+        material: the world's when the body follows it (then every body following the world
+        gets it), else the body's own; state is kept."""
+        if isinstance(value, bool):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        w = self.world
+        body = w.bodies[self.body_index] if w.bodies else None
+        if body is not None and not self._follows_world(body):
+            body.material = replace(body.material, **{name: value})  # the Material checks it
+            return
+        new = replace(w.material or _SPRINGS, **{name: value})  # refuses a bad value, changing nothing
+        w.material = None if new == _SPRINGS else new
+        if body is not None and getattr(body.material, name) != getattr(new, name):
+            # a body whose own material equals the world's plain springs: it is what was meant
+            body.material = replace(body.material, **{name: value})
 
     # -- pins ---------------------------------------------------------------------------------
     def vertex_at(self, point, *, radius: float = 0.0) -> tuple[int, int] | None:
