@@ -3,10 +3,13 @@ degenerate ones (grids, cocircular and collinear sets, duplicates, extreme scale
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scipy.spatial import ConvexHull
 from scipy.spatial import Delaunay as ScipyDelaunay
 
 import deforma
@@ -115,12 +118,18 @@ def test_deterministic():
         ([[0, 0], [1, 0], [np.inf, 1]], "finite"),
         ([[0, 0, 0], [1, 0, 0], [0, 1, 0]], r"\(N, 2\)"),
         ([0, 1, 2], r"\(N, 2\)"),
-        ([["a", "b"], ["c", "d"], ["e", "f"]], "numbers"),
+        ([["a", "b"], ["c", "d"], ["e", "f"]], "real numbers"),
+        ([[0, 0], [1, 0], [0, 1j]], "complex"),
+        (np.array([[0, 0], [1, 0], [0, 1]], complex), "complex"),
+        ([[0, 0], [1, 0], [0, 10**400]], "real numbers"),
+        ([[0, 0], [1, 0], [0, 2**1024]], "real numbers"),  # an int beyond the largest double
     ],
 )
 def test_bad_input_raises_one_line_value_error(points, message):
-    with pytest.raises(ValueError, match=message) as info:
-        deforma.delaunay(points)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no ComplexWarning or overflow warning on the way
+        with pytest.raises(ValueError, match=message) as info:
+            deforma.delaunay(points)
     assert "\n" not in str(info.value)
 
 
@@ -136,7 +145,12 @@ def _exactly_degenerate(pts: np.ndarray) -> bool:
     u = np.unique(pts, axis=0)
     if len(u) < 3:
         return True
-    far = max(range(1, len(u)), key=lambda i: abs(u[i] - u[0]).sum())
+    from fractions import Fraction
+
+    def dist(i):  # exact: float differences of huge coordinates overflow
+        return sum(abs(Fraction(float(u[i][k])) - Fraction(float(u[0][k]))) for k in range(2))
+
+    far = max(range(1, len(u)), key=dist)
     return all(orient_exact(u[0], u[far], q) == 0 for q in u)
 
 coords = st.integers(min_value=-6, max_value=6)
@@ -196,3 +210,69 @@ def test_nearly_collinear_after_rounding_is_triangulated():
     pts = raw * 3.0e7 + 29.777640542740528
     assert not _exactly_degenerate(pts)
     check_delaunay(pts, deforma.delaunay(pts))
+
+
+# -- magnitudes mixed in one set: the whole double range -----------------------------------
+
+
+def _check_covers_hull(pts: np.ndarray, tris: np.ndarray) -> None:
+    """Every distinct point a vertex, exact Delaunay (check_delaunay), and the triangles'
+    area equal to SciPy's hull area on a copy scaled to magnitude 1 (when that hull exists)."""
+    check_delaunay(pts, tris, brute_force=len(pts) <= 40)
+    used = set(np.unique(tris).tolist())
+    assert len(used) == len(np.unique(pts, axis=0))
+    unit = pts / np.abs(pts).max()  # small points may flush to 0 here: area unaffected
+    try:
+        hull = ConvexHull(unit)
+    except Exception:  # all large points on one line in the scaled copy: nothing to compare
+        return
+    a, b, c = unit[tris[:, 0]], unit[tris[:, 1]], unit[tris[:, 2]]
+    area = 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])).sum()
+    assert area == pytest.approx(hull.volume, rel=1e-9, abs=1e-300)
+
+
+@pytest.mark.parametrize("big, small", [(1e300, 1e-300), (2.0**1000, 2.0**-1000), (1.7e308, 5e-324), (1.0, 1e-310)])
+def test_magnitudes_mixed_in_one_set_keep_every_point(big, small):
+    # issue 17: half the distinct points were dropped (the tiny ones flushed to 0 when the
+    # set was scaled down) and the triangles no longer covered the hull
+    rng = np.random.default_rng(17)
+    pts = np.vstack([(rng.random((20, 2)) - 0.5) * big, (rng.random((20, 2)) - 0.5) * small])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tris = deforma.delaunay(pts)
+    _check_covers_hull(pts, tris)
+
+
+@pytest.mark.parametrize("scale", [5e-324, 1e-320, 5.6e-309, 2.0**-1060])
+def test_subnormal_coordinates_are_points_not_coincident(scale):
+    # issue 17: below ~5.6e-309 the scaling factor overflowed and every point "coincided"
+    grid = np.stack(np.meshgrid(np.arange(5.0), np.arange(4.0)), -1).reshape(-1, 2)
+    pts = grid * scale
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tris = deforma.delaunay(pts)
+    _check_covers_hull(pts, tris)
+    assert len(tris) == 2 * 4 * 3
+
+
+magnitude = st.sampled_from([5e-324, 2.0**-1074 * 3, 1e-310, 2.0**-1000, 1e-300, 1e-150, 1.0, 3.0e7, 1e150,
+                             1e300, 2.0**1000, 2.0**1020])
+
+
+@HYP
+@given(
+    st.lists(
+        st.tuples(st.integers(-4, 4), st.integers(-4, 4), magnitude, st.floats(-1, 1)),
+        min_size=3,
+        max_size=25,
+    )
+)
+def test_property_sets_mixing_magnitudes(raw):
+    """Small lattices (collinear runs, cocircular quads) and random points, each at its own
+    magnitude from the smallest subnormal to 2**1022, in one set."""
+    pts = np.array([(x * m, y * m) if abs(r) < 0.5 else (x * m * r, y * m * (1 - r)) for x, y, m, r in raw])
+    if _exactly_degenerate(pts):
+        with pytest.raises(ValueError):
+            deforma.delaunay(pts)
+        return
+    _check_covers_hull(pts, deforma.delaunay(pts))

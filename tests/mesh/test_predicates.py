@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -105,3 +106,78 @@ def test_signs_survive_products_below_the_smallest_double():
     want = incircle_fraction(p, q, r, d)
     assert want != 0
     assert sign(incircle_exact(*p, *q, *r, *d, W)) == sign(incircle(*p, *q, *r, *d, W)) == want
+
+
+# every finite double: subnormals, normals and values near the largest double, with either sign
+any_double = st.one_of(
+    st.floats(allow_nan=False, allow_infinity=False),
+    st.floats(min_value=-(2.0**-1000), max_value=2.0**-1000, allow_nan=False),
+    st.integers(-(2**52), 2**52).map(lambda m: m * 2.0**-1074),  # subnormals, exactly
+    st.sampled_from([0.0, 1.0, -1.0, 2.0**1023, -(2.0**1023), 1.7976931348623157e308, 5e-324]),
+)
+any_point = st.tuples(any_double, any_double)
+
+
+@settings(max_examples=150, deadline=None)
+@given(any_point, any_point, any_point, st.sampled_from(["free", "repeat", "mirror"]))
+def test_orient_exact_over_the_whole_double_range(a, b, c, kind):
+    if kind == "repeat":  # collinear or nearly: a coordinate shared, the sign rests on the rest
+        c = (a[0], c[1])
+    elif kind == "mirror":
+        c = (-a[0], -a[1])
+    want = orient_fraction(a, b, c)
+    assert sign(orient2d(*a, *b, *c, W)) == want
+    assert sign(orient2d_exact(*a, *b, *c, W)) == want
+
+
+@settings(max_examples=150, deadline=None)
+@given(any_point, any_point, any_point, any_point)
+def test_incircle_exact_over_the_whole_double_range(a, b, c, d):
+    o = orient_fraction(a, b, c)
+    if o == 0:
+        return
+    if o < 0:
+        b, c = c, b
+    want = incircle_fraction(a, b, c, d)
+    assert sign(incircle(*a, *b, *c, *d, W)) == want
+    assert sign(incircle_exact(*a, *b, *c, *d, W)) == want
+
+
+@pytest.mark.parametrize("big, small", [(1e300, 1e-300), (2.0**1000, 2.0**-1000), (1.7e308, 5e-324)])
+def test_signs_with_magnitudes_mixed_in_one_call(big, small):
+    # the large terms cancel exactly; the sign rests on products of the small ones, far
+    # below the smallest double (and the large products far above the largest)
+    a, b, c = (big, big), (2 * small, small), (small, 0.0)
+    assert orient_fraction(a, b, c) != 0
+    assert sign(orient2d(*a, *b, *c, W)) == orient_fraction(a, b, c)
+    for p, q, r, d in [
+        ((-big, 0.0), (big, 0.0), (0.0, big), (0.0, -big + small)),  # just inside
+        ((-big, 0.0), (big, 0.0), (0.0, big), (small, -big)),  # on the circle, by a hair off
+        ((0.0, 0.0), (small, 0.0), (0.0, small), (big, big)),  # tiny circle, far point
+        ((small, small), (big, -big), (big, big), (2 * small, 0.0)),
+    ]:
+        if orient_fraction(p, q, r) == 0:
+            continue
+        if orient_fraction(p, q, r) < 0:
+            q, r = r, q
+        assert sign(incircle(*p, *q, *r, *d, W)) == incircle_fraction(p, q, r, d)
+
+
+def test_filters_do_not_trust_products_below_the_smallest_normal_double():
+    # Differences around 1e-160: products fall to subnormals, where rounding is absolute,
+    # not relative. The points are nearly collinear / cocircular at that scale.
+    s = 1e-160
+    rng = np.random.default_rng(8)
+    for _ in range(200):
+        a = tuple(rng.integers(-50, 50, 2) * s)
+        b = tuple(rng.integers(-50, 50, 2) * s)
+        t = rng.random()
+        c = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
+        assert sign(orient2d(*a, *b, *c, W)) == orient_fraction(a, b, c)
+        ang = rng.random(4) * 2 * np.pi
+        p = [(s * 40 * np.cos(u), s * 40 * np.sin(u)) for u in ang]
+        if orient_fraction(p[0], p[1], p[2]) == 0:
+            continue
+        if orient_fraction(p[0], p[1], p[2]) < 0:
+            p[1], p[2] = p[2], p[1]
+        assert sign(incircle(*p[0], *p[1], *p[2], *p[3], W)) == incircle_fraction(*p)

@@ -20,8 +20,11 @@ robust and fast:
   triangles; the cavity grows over triangle adjacency and its slots are reused. All of it
   is one Numba-compiled loop: no Python runs per point.
 
-Coordinates are first scaled by a power of two (an exact operation) so that the exact
-stages never overflow, whatever the magnitude of the input.
+The predicates are exact for every finite double, so any finite coordinates work, tiny
+and huge mixed in one set included. Coordinates are first scaled by a power of two when
+that is exact for every one of them (no coordinate underflows), which keeps typical sets
+in the range where the float filter decides; a set that spans too many magnitudes for
+that is triangulated as given, with more calls reaching the exact stages.
 """
 
 from __future__ import annotations
@@ -265,19 +268,51 @@ def _bowyer_watson(P, index):
 
 
 @njit(cache=True)
-def _gather_scaled(points, order, scale):
+def _gather(points, order):
     out = np.empty((order.shape[0], 2))
     for i in range(order.shape[0]):
-        out[i, 0] = points[order[i], 0] * scale
-        out[i, 1] = points[order[i], 1] * scale
+        out[i, 0] = points[order[i], 0]
+        out[i, 1] = points[order[i], 1]
     return out
 
 
+def _exact_power_of_two_scale(pts: np.ndarray) -> np.ndarray:
+    """``pts`` times the power of two that brings the largest magnitude to [0.5, 1), or the
+    nearest power that is still exact for every coordinate, or ``pts`` itself.
+
+    Scaling by 2**k is exact unless a coordinate underflows (loses low bits below 2**-1074)
+    or overflows; a set mixing 1e300 with 1e-300 has no exact scaling to [0.5, 1), and
+    scaling it anyway turned its small points into duplicates of 0.
+    """
+    mags = np.abs(pts[pts != 0.0])
+    if mags.size == 0:
+        return pts
+    top = int(np.frexp(mags.max())[1])
+    bottom = int(np.frexp(mags.min())[1])
+    # the lowest set bit of a coordinate is at least 2**(frexp exponent - 53)
+    k = max(-top, -1074 - (bottom - 53))
+    k = min(k, 1023 - top)
+    scaled = np.ldexp(pts, k)
+    if np.isfinite(scaled).all() and np.array_equal(np.ldexp(scaled, -k), pts):
+        return scaled
+    return pts
+
+
 def _as_points(points) -> np.ndarray:
+    raw = points if isinstance(points, np.ndarray) else None
+    if raw is None:
+        try:
+            raw = np.asarray(points)
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"points must be an (N, 2) array of real numbers: {err}") from None
+    if raw.dtype.kind == "c" or (raw.dtype == object and any(isinstance(v, complex) for v in raw.ravel())):
+        raise ValueError("points must be real numbers: got complex values")
+    if raw.dtype.kind not in "biufO":
+        raise ValueError(f"points must be an (N, 2) array of real numbers, got dtype {raw.dtype}")
     try:
-        pts = np.ascontiguousarray(points, dtype=np.float64)
-    except (TypeError, ValueError) as err:
-        raise ValueError(f"points must be an (N, 2) array of numbers: {err}") from None
+        pts = np.ascontiguousarray(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as err:
+        raise ValueError(f"points must be an (N, 2) array of real numbers: {err}") from None
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"points must be an (N, 2) array, got shape {pts.shape}")
     if pts.shape[0] < 3:
@@ -285,7 +320,10 @@ def _as_points(points) -> np.ndarray:
     if pts.shape[0] >= 2**30:
         raise ValueError(f"at most 2**30 points can be triangulated, got {pts.shape[0]}")
     if not np.isfinite(pts).all():
-        raise ValueError("points must be finite: found NaN or inf")
+        bad = pts[~np.isfinite(pts)][0]
+        raise ValueError(
+            f"points must be finite doubles (magnitude at most {np.finfo(np.float64).max:.6g}): found {bad}"
+        )
     return pts
 
 
@@ -294,8 +332,10 @@ def delaunay(points) -> np.ndarray:
 
     Parameters
     ----------
-    points : (N, 2) array_like of float
-        Point coordinates, any units; N >= 3, finite.
+    points : (N, 2) array_like of real numbers
+        Point coordinates, any units; N >= 3. Converted to float64; every finite double
+        works, from subnormals (5e-324) to 1.8e308, mixed in one set: the predicates are
+        exact over the whole range.
 
     Returns
     -------
@@ -309,8 +349,9 @@ def delaunay(points) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``points`` is not an (N, 2) array of finite numbers, or has fewer than three
-        distinct points, or all its points are collinear.
+        If ``points`` is not an (N, 2) array of finite real numbers (complex values,
+        strings, NaN, inf or a value beyond the largest double are refused), or has fewer
+        than three distinct points, or all its points are collinear.
 
     Notes
     -----
@@ -327,12 +368,10 @@ def delaunay(points) -> np.ndarray:
     (4, 3)
     """
     pts = _as_points(points)
-    # scale by a power of two: exact, and keeps the exact stages far from overflow
-    big = float(np.abs(pts).max())
-    scale = 2.0 ** -np.frexp(big)[1] if big > 0.0 else 1.0
-    order = brio_order(pts)
+    scaled = _exact_power_of_two_scale(pts)
+    order = brio_order(scaled)
     # renumber the points in insertion order: neighbours in space become neighbours in memory
-    tris, status = _bowyer_watson(_gather_scaled(pts, order, scale), order)
+    tris, status = _bowyer_watson(_gather(scaled, order), order)
     if status == _TOO_FEW_DISTINCT:
         raise ValueError("need at least 3 distinct points to triangulate; all points coincide")
     if status == _ALL_COLLINEAR:

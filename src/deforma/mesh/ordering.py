@@ -66,11 +66,20 @@ def hilbert_keys(points, keys, levels):
         xmax = max(xmax, points[i, 0])
         ymin = min(ymin, points[i, 1])
         ymax = max(ymax, points[i, 1])
-    side = max(xmax - xmin, ymax - ymin)
-    scale = ((1 << levels) - 1) / side if side > 0.0 else 0.0
+    # halves: the extent of coordinates near +-1.8e308 would overflow
+    half = max(xmax * 0.5 - xmin * 0.5, ymax * 0.5 - ymin * 0.5)
+    top = (1 << levels) - 1
+    scale = top / half if half > 0.0 else 0.0
+    divide = scale > 1e300  # a subnormal extent: top / half overflows, divide instead
     for i in range(n):
-        cx = np.int64((points[i, 0] - xmin) * scale)
-        cy = np.int64((points[i, 1] - ymin) * scale)
+        if divide:
+            fx = top * ((points[i, 0] * 0.5 - xmin * 0.5) / half)
+            fy = top * ((points[i, 1] * 0.5 - ymin * 0.5) / half)
+        else:
+            fx = (points[i, 0] * 0.5 - xmin * 0.5) * scale
+            fy = (points[i, 1] * 0.5 - ymin * 0.5) * scale
+        cx = np.int64(min(max(fx, 0.0), top))
+        cy = np.int64(min(max(fy, 0.0), top))
         d = np.int64(0)
         state = 0
         for level in range(levels - 1, -1, -1):

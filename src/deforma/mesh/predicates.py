@@ -7,16 +7,25 @@ Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust Geometri
 Predicates" (1997):
 
 1. a plain float evaluation with a forward error bound: its sign is returned when the
-   value clears the bound (almost every call on random input);
-2. the same evaluation with every rounding checked by an error-free transformation: when no
-   operation rounded, the float value is the exact value (integer grids and most
-   coordinates with few significant bits end here, at a few dozen flops);
-3. the determinant expanded into a sum of products of the coordinates' exact differences,
-   each product formed without rounding (two-product, scale-expansion) and summed into a
-   nonoverlapping expansion, whose largest component carries the exact sign.
+   value clears the bound (almost every call on random input). The bound has an absolute
+   term for products that fall below the smallest normal double (where the relative bound
+   does not hold), and an overflow makes the value or the bound inf or NaN, which never
+   clears it;
+2. the same evaluation, on inputs scaled by a power of two into a safe exponent range,
+   with every rounding checked by an error-free transformation: when no operation rounded,
+   the float value is the exact value (integer grids and most coordinates with few
+   significant bits end here, at a few dozen flops). Skipped when the inputs' magnitudes
+   span more than that range holds (no single power of two then avoids both overflow and
+   underflow);
+3. the determinant expanded into monomials of the raw coordinates, each a product of
+   doubles ``m * 2**e`` (``m`` a 53-bit integer), summed exactly as a fixed-point integer
+   of 16-bit limbs wide enough for every finite double (about 8,700 bits for the in-circle
+   test). Its sign is the exact sign.
 
-The inputs must not overflow when squared twice: callers scale coordinates by a power of
-two first (exact), as :func:`deforma.delaunay` does.
+So the signs are exact for every finite double input: no range to respect, no scaling by
+the caller. A few thousand integer operations make stage 3 slower than a float
+evaluation, and it is rare: only inputs within a few ulps of degenerate, or whose
+magnitudes span more than about 2**400, reach it.
 
 All functions are Numba ``njit`` kernels; stage 3 works in a caller-supplied scratch
 array so that no call allocates (see :data:`SCRATCH_SIZE`).
@@ -25,18 +34,46 @@ array so that no call allocates (see :data:`SCRATCH_SIZE`).
 from __future__ import annotations
 
 import math
+from itertools import permutations
 
 import numpy as np
 from numba import njit
 
 _EPS = 2.0**-53  # half an ulp of 1.0: the unit roundoff of float64
 _SPLITTER = 134217729.0  # 2**27 + 1, splits a double into two 26-bit halves
-ORIENT_ERRBOUND = (3.0 + 16.0 * _EPS) * _EPS
-INCIRCLE_ERRBOUND = (10.0 + 96.0 * _EPS) * _EPS
+# Shewchuk's bounds with a doubled second-order term: room for the absolute underflow
+# term below when adding it rounds (see _UNDERFLOW)
+ORIENT_ERRBOUND = (3.0 + 32.0 * _EPS) * _EPS
+INCIRCLE_ERRBOUND = (10.0 + 192.0 * _EPS) * _EPS
+# A product below 2**-1022 (subnormal) has an absolute error up to 2**-1075 instead of a
+# relative one. The filters add this much (times the size of what multiplies such an
+# error) to their bound: 2**13 times the worst such error, so it holds after rounding.
+_UNDERFLOW = 2.0**-1060
 
-#: Length of the scratch array the exact stages need: ``w[0:16]`` for one product,
-#: ``w[16:-16]`` for the running sum, ``w[-16:]`` for the coordinate differences.
+#: Length of the float64 scratch array the exact stage needs (it is used as int64 limbs).
 SCRATCH_SIZE = 4096
+
+# -- stage 3: exact fixed-point integer sums of products of doubles -----------------------
+_LIMB_BITS = 16
+_LIMB_MASK = 0xFFFF
+# A nonzero double is m * 2**e with 2**52 <= m < 2**53 and e >= -1126 (2**-1074 = 2**52 *
+# 2**-1126), so a product of four is an integer multiple of 2**(4 * -1126): bit 0 of the
+# accumulator. The largest, four times 2**1024, ends below bit 4 * (1024 + 1126) = 8600.
+_ACC_EXP0 = 4 * -1126
+_ACC_LIMBS = 560  # 8960 bits: the largest product, its 212 mantissa bits and the carries
+_PROD = _ACC_LIMBS  # iw[_PROD:_PROD + 20]: the mantissa product being formed
+_TMP = _ACC_LIMBS + 20  # iw[_TMP:_TMP + 20]: the factor before it
+_TWO53 = 9007199254740992.0
+
+# The in-circle determinant | x y x^2+y^2 1 | over the rows a, b, c, d as 24 signed
+# permutations (row for x, row for y, row for the lift); the 1 takes the remaining row.
+_PERMS = np.array(
+    [
+        (p[0], p[1], p[2], (-1) ** sum(p[i] > p[j] for i in range(4) for j in range(i + 1, 4)))
+        for p in permutations(range(4))
+    ],
+    np.int64,
+)
 
 
 @njit(inline="always")
@@ -73,152 +110,140 @@ def _two_product(a, b):
     return x, alo * blo - err
 
 
-@njit(inline="always")
-def _grow(e, elen, b):
-    """Add the double ``b`` to the expansion ``e[:elen]`` in place; return the new length.
 
-    In place is safe: component ``h`` is written at an index never past the one just read.
+@njit(inline="always")
+def _acc_add(iw, negative, x1, x2, x3, x4):
+    """Add the exact product ``x1 x2 x3 x4`` (negated if ``negative``) to the accumulator.
+
+    ``iw`` is the scratch array viewed as int64: ``iw[:_ACC_LIMBS]`` holds the sum as
+    16-bit limbs that may run over or go negative until :func:`_acc_sign` carries them. A
+    factor of exactly 1.0 is left out, so a product of two is ``x1, x2, 1.0, 1.0``.
     """
-    q = b
-    h = 0
-    for i in range(elen):
-        q, t = _two_sum(q, e[i])
-        if t != 0.0:
-            e[h] = t
-            h += 1
-    if q != 0.0 or h == 0:
-        e[h] = q
-        h += 1
-    return h
-
-
-@njit(inline="always")
-def _scale(e, elen, b, h, off):
-    """Write ``e[:elen] * b`` exactly into ``h[off:]``; return the new length (no zeros)."""
-    n = 0
-    q, t = _two_product(e[0], b)
-    if t != 0.0:
-        h[off + n] = t
-        n += 1
-    for i in range(1, elen):
-        p1, p0 = _two_product(e[i], b)
-        s, t = _two_sum(q, p0)
-        if t != 0.0:
-            h[off + n] = t
-            n += 1
-        q, t = _two_sum(p1, s)
-        if t != 0.0:
-            h[off + n] = t
-            n += 1
-    if q != 0.0 or n == 0:
-        h[off + n] = q
-        n += 1
-    return n
-
-
-@njit(inline="always")
-def _add_product(w, acc_len, a, b, c, d):
-    """Add the exact product ``a*b*c*d`` to the expansion held in ``w[16:16+acc_len]``.
-
-    ``w[0:16]`` is the working space for the product's own expansion (at most 8 terms).
-    Returns the new accumulator length.
-    """
-    if a == 0.0 or b == 0.0 or c == 0.0 or d == 0.0:
-        return acc_len
-    # largest factors first: ((a b) c) d then never passes below the smallest double on the
-    # way to a product that is in range (two tiny factors first would underflow)
-    if abs(a) < abs(b):
-        a, b = b, a
-    if abs(c) < abs(d):
-        c, d = d, c
-    if abs(a) < abs(c):
-        a, c = c, a
-    if abs(b) < abs(d):
-        b, d = d, b
-    if abs(b) < abs(c):
-        b, c = c, b
-    x, y = _two_product(a, b)
-    if y != 0.0:
-        w[0] = y
-        w[1] = x
-        n = 2
-    else:
-        w[0] = x
-        n = 1
-    n = _scale(w, n, c, w, 8)  # reads w[0:2], writes at most w[8:12]
-    n = _scale(w[8:], n, d, w, 0)  # reads w[8:12], writes at most w[0:8]
-    acc = w[16:]
+    if x1 == 0.0 or x2 == 0.0 or x3 == 0.0 or x4 == 0.0:
+        return
+    prod = iw[_PROD : _PROD + 20]
+    tmp = iw[_TMP : _TMP + 20]
+    prod[0] = 1
+    n = 1
+    e = 0  # the product is prod * 2**e
+    for k in range(4):
+        x = x1 if k == 0 else (x2 if k == 1 else (x3 if k == 2 else x4))
+        if x < 0.0:
+            negative = not negative
+            x = -x
+        if x == 1.0:
+            continue
+        f, ex = math.frexp(x)
+        m = np.int64(f * _TWO53)  # exact: f has at most 53 significant bits
+        e += ex - 53
+        m0 = m & _LIMB_MASK
+        m1 = (m >> 16) & _LIMB_MASK
+        m2 = (m >> 32) & _LIMB_MASK
+        m3 = m >> 48
+        for i in range(n + 4):
+            tmp[i] = 0
+        for i in range(n):  # limb products < 2**32, at most four per limb: no overflow
+            p = prod[i]
+            tmp[i] += p * m0
+            tmp[i + 1] += p * m1
+            tmp[i + 2] += p * m2
+            tmp[i + 3] += p * m3
+        carry = 0
+        for i in range(n + 4):
+            v = tmp[i] + carry
+            prod[i] = v & _LIMB_MASK
+            carry = v >> _LIMB_BITS
+        n += 4
+    s = e - _ACC_EXP0  # >= 0: bit position of prod's lowest bit in the accumulator
+    q = s >> 4
+    r = s & 15
     for i in range(n):
-        acc_len = _grow(acc, acc_len, w[i])
-    return acc_len
+        v = prod[i] << r
+        if negative:
+            iw[q + i] -= v & _LIMB_MASK
+            iw[q + i + 1] -= v >> _LIMB_BITS
+        else:
+            iw[q + i] += v & _LIMB_MASK
+            iw[q + i + 1] += v >> _LIMB_BITS
 
 
 @njit(inline="always")
-def _add_product2(w, acc_len, a, b):
-    """Add the exact product ``a*b`` to the accumulator ``w[16:16+acc_len]``."""
-    x, y = _two_product(a, b)
-    acc = w[16:]
-    if y != 0.0:
-        acc_len = _grow(acc, acc_len, y)
-    return _grow(acc, acc_len, x)
-
-
-@njit(inline="always")
-def _sign_of(w, acc_len):
-    if acc_len == 0:
-        return 0.0
-    top = w[16 + acc_len - 1]
-    return 1.0 if top > 0.0 else (-1.0 if top < 0.0 else 0.0)
-
-
-@njit(inline="always")
-def _upscale(m, target):
-    """A power of two that brings the largest input magnitude ``m`` up to about ``2**target``.
-
-    Expansion arithmetic is exact only while no product underflows: with inputs of
-    magnitude 1 and 1e-260 (a lattice point nudged by a tiny offset), the product of two
-    tiny ones is below the smallest double, and a determinant whose large terms cancel
-    exactly came out 0 instead of its true, tiny sign. Multiplying every input by the same
-    power of two is exact and keeps the sign; bringing the largest to ``2**target`` (500 for
-    the degree-2 orientation, 250 for the degree-4 in-circle test) keeps the largest
-    products below overflow and lifts the smallest into range. Only upward: the callers
-    scale their points to magnitude <= 1 first (see :func:`deforma.delaunay`).
-    """
-    if m == 0.0:
+def _acc_sign(iw):
+    """Sign (+1, -1, 0) of the accumulated sum; carries the limbs from the lowest up."""
+    carry = 0
+    nonzero = False
+    for i in range(_ACC_LIMBS):
+        v = iw[i] + carry
+        if (v & _LIMB_MASK) != 0:
+            nonzero = True
+        carry = v >> _LIMB_BITS  # arithmetic shift: floor division, also when negative
+    # sum = (limbs in [0, 2**16) below) + carry * 2**(16 * _ACC_LIMBS)
+    if carry < 0:
+        return -1.0
+    if carry > 0 or nonzero:
         return 1.0
-    e = math.frexp(m)[1]
-    return math.ldexp(1.0, target - e) if e < target else 1.0
+    return 0.0
+
+
+@njit(inline="always")
+def _min_nonzero(m, v):
+    v = abs(v)
+    return v if v != 0.0 and v < m else m
+
+
+@njit(inline="always")
+def _safe_shift(hi, lo, target, floor):
+    """The power of two ``k`` that puts magnitudes ``hi`` (largest) and ``lo`` (smallest
+    nonzero) in the range where stage 2 neither overflows nor underflows: the largest to
+    about ``2**target``, and the lowest set bit of the smallest, at least
+    ``2**(frexp(lo)[1] - 53)``, to at least ``2**floor``. Returns 4096 when the inputs span
+    more than that range.
+    """
+    k = target - math.frexp(hi)[1]
+    if math.frexp(lo)[1] - 53 + k < floor:
+        return 4096
+    return k
 
 
 @njit(cache=True)
 def orient2d_exact(ax, ay, bx, by, cx, cy, w):
     """Sign (+1, -1, 0) of the orientation determinant, always exact (stages 2 and 3)."""
-    k = _upscale(max(max(abs(ax), abs(ay)), max(max(abs(bx), abs(by)), max(abs(cx), abs(cy)))), 500)
-    ax, ay, bx, by, cx, cy = ax * k, ay * k, bx * k, by * k, cx * k, cy * k
-    acx, e1 = _two_diff(ax, cx)
-    bcx, e2 = _two_diff(bx, cx)
-    acy, e3 = _two_diff(ay, cy)
-    bcy, e4 = _two_diff(by, cy)
-    if e1 == 0.0 and e2 == 0.0 and e3 == 0.0 and e4 == 0.0:
-        left, el = _two_product(acx, bcy)
-        right, er = _two_product(acy, bcx)
-        det, es = _two_diff(left, right)
-        if el == 0.0 and er == 0.0 and es == 0.0:
-            return 1.0 if det > 0.0 else (-1.0 if det < 0.0 else 0.0)
-    # det = ax*by - ax*cy - ay*bx + ay*cx + bx*cy - by*cx, six exact products
-    n = 0
-    n = _add_product2(w, n, ax, by)
-    n = _add_product2(w, n, -ax, cy)
-    n = _add_product2(w, n, -ay, bx)
-    n = _add_product2(w, n, ay, cx)
-    n = _add_product2(w, n, bx, cy)
-    n = _add_product2(w, n, -by, cx)
-    return _sign_of(w, n)
+    hi = max(max(abs(ax), abs(ay)), max(max(abs(bx), abs(by)), max(abs(cx), abs(cy))))
+    if hi == 0.0:
+        return 0.0
+    lo = _min_nonzero(_min_nonzero(_min_nonzero(hi, ax), ay), bx)
+    lo = _min_nonzero(_min_nonzero(_min_nonzero(lo, by), cx), cy)
+    # differences below 2**481, products below 2**962; products of the lowest bits >= 2**-1022
+    k = _safe_shift(hi, lo, 480, -511)
+    if k != 4096:
+        sx, sy = math.ldexp(ax, k), math.ldexp(ay, k)  # exact: no overflow, no underflow
+        tx, ty = math.ldexp(bx, k), math.ldexp(by, k)
+        ux, uy = math.ldexp(cx, k), math.ldexp(cy, k)
+        acx, e1 = _two_diff(sx, ux)
+        bcx, e2 = _two_diff(tx, ux)
+        acy, e3 = _two_diff(sy, uy)
+        bcy, e4 = _two_diff(ty, uy)
+        if e1 == 0.0 and e2 == 0.0 and e3 == 0.0 and e4 == 0.0:
+            left, el = _two_product(acx, bcy)
+            right, er = _two_product(acy, bcx)
+            det, es = _two_diff(left, right)
+            if el == 0.0 and er == 0.0 and es == 0.0:
+                return 1.0 if det > 0.0 else (-1.0 if det < 0.0 else 0.0)
+    # stage 3: det = ax*by - ax*cy - ay*bx + ay*cx + bx*cy - by*cx, on the raw inputs
+    iw = w.view(np.int64)
+    iw[:_ACC_LIMBS] = 0
+    _acc_add(iw, False, ax, by, 1.0, 1.0)
+    _acc_add(iw, True, ax, cy, 1.0, 1.0)
+    _acc_add(iw, True, ay, bx, 1.0, 1.0)
+    _acc_add(iw, False, ay, cx, 1.0, 1.0)
+    _acc_add(iw, False, bx, cy, 1.0, 1.0)
+    _acc_add(iw, True, by, cx, 1.0, 1.0)
+    return _acc_sign(iw)
 
 
 @njit(inline="always")
 def orient2d(ax, ay, bx, by, cx, cy, w):
-    """Orientation of the triangle (a, b, c), exact in sign.
+    """Orientation of the triangle (a, b, c), exact in sign for any finite doubles.
 
     Returns a value that is positive when a, b, c turn counter-clockwise, negative when
     clockwise and zero when collinear (only the sign is meaningful). ``w`` is a float64
@@ -227,7 +252,7 @@ def orient2d(ax, ay, bx, by, cx, cy, w):
     detleft = (ax - cx) * (by - cy)
     detright = (ay - cy) * (bx - cx)
     det = detleft - detright
-    bound = ORIENT_ERRBOUND * (abs(detleft) + abs(detright))
+    bound = ORIENT_ERRBOUND * (abs(detleft) + abs(detright)) + _UNDERFLOW
     if det > bound or -det > bound:
         return det
     return orient2d_exact(ax, ay, bx, by, cx, cy, w)
@@ -270,61 +295,49 @@ def _ops_exact_incircle(adx, ady, bdx, bdy, cdx, cdy):
 @njit(cache=True)
 def incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, w):
     """Sign (+1, -1, 0) of the in-circle determinant, always exact (stages 2 and 3)."""
-    k = _upscale(max(max(max(abs(ax), abs(ay)), max(abs(bx), abs(by))),
-                     max(max(abs(cx), abs(cy)), max(abs(dx), abs(dy)))), 250)
-    ax, ay, bx, by, cx, cy, dx, dy = ax * k, ay * k, bx * k, by * k, cx * k, cy * k, dx * k, dy * k
-    adx, adxt = _two_diff(ax, dx)
-    ady, adyt = _two_diff(ay, dy)
-    bdx, bdxt = _two_diff(bx, dx)
-    bdy, bdyt = _two_diff(by, dy)
-    cdx, cdxt = _two_diff(cx, dx)
-    cdy, cdyt = _two_diff(cy, dy)
-    if adxt == 0.0 and adyt == 0.0 and bdxt == 0.0 and bdyt == 0.0 and cdxt == 0.0 and cdyt == 0.0:
-        det, exact = _ops_exact_incircle(adx, ady, bdx, bdy, cdx, cdy)
-        if exact:
-            return 1.0 if det > 0.0 else (-1.0 if det < 0.0 else 0.0)
-    # Stage 3. Each difference is exactly hi + lo; the determinant
-    #   |a|^2 (b x c) + |b|^2 (c x a) + |c|^2 (a x b)   (vectors relative to d)
-    # is a sum of products of four such components, each added exactly.
-    # comp[2*row + 0] is the high part of a difference, comp[2*row + 1] its rounding error;
-    # rows: adx ady bdx bdy cdx cdy.
-    comp = w[w.shape[0] - 16 : w.shape[0] - 4]
-    comp[0] = adx
-    comp[1] = adxt
-    comp[2] = ady
-    comp[3] = adyt
-    comp[4] = bdx
-    comp[5] = bdxt
-    comp[6] = bdy
-    comp[7] = bdyt
-    comp[8] = cdx
-    comp[9] = cdxt
-    comp[10] = cdy
-    comp[11] = cdyt
-    n = 0
-    for k in range(3):
-        # the lift of point k times the cross product of the next two, in cyclic order
-        px = 2 * k  # row of point k's x difference; +1 is its y
-        qx = 2 * ((k + 1) % 3)
-        rx = 2 * ((k + 2) % 3)
-        for axis in range(2):  # x^2, then y^2 of the lifted point
-            row = px + axis
-            for i in range(2):
-                u = comp[2 * row + i]
-                for j in range(2):
-                    v = comp[2 * row + j]
-                    for s in range(2):
-                        for t in range(2):
-                            # + q_x r_y
-                            n = _add_product(w, n, u, v, comp[2 * qx + s], comp[2 * (rx + 1) + t])
-                            # - r_x q_y
-                            n = _add_product(w, n, -u, v, comp[2 * rx + s], comp[2 * (qx + 1) + t])
-    return _sign_of(w, n)
+    hi = max(max(max(abs(ax), abs(ay)), max(abs(bx), abs(by))),
+             max(max(abs(cx), abs(cy)), max(abs(dx), abs(dy))))
+    if hi == 0.0:
+        return 0.0
+    lo = _min_nonzero(_min_nonzero(_min_nonzero(_min_nonzero(hi, ax), ay), bx), by)
+    lo = _min_nonzero(_min_nonzero(_min_nonzero(_min_nonzero(lo, cx), cy), dx), dy)
+    # differences below 2**241, lifts below 2**483, products below 2**966; products of
+    # four lowest bits >= 2**-1020
+    k = _safe_shift(hi, lo, 240, -255)
+    if k != 4096:
+        sx, sy = math.ldexp(ax, k), math.ldexp(ay, k)
+        tx, ty = math.ldexp(bx, k), math.ldexp(by, k)
+        ux, uy = math.ldexp(cx, k), math.ldexp(cy, k)
+        vx, vy = math.ldexp(dx, k), math.ldexp(dy, k)
+        adx, adxt = _two_diff(sx, vx)
+        ady, adyt = _two_diff(sy, vy)
+        bdx, bdxt = _two_diff(tx, vx)
+        bdy, bdyt = _two_diff(ty, vy)
+        cdx, cdxt = _two_diff(ux, vx)
+        cdy, cdyt = _two_diff(uy, vy)
+        if adxt == 0.0 and adyt == 0.0 and bdxt == 0.0 and bdyt == 0.0 and cdxt == 0.0 and cdyt == 0.0:
+            det, exact = _ops_exact_incircle(adx, ady, bdx, bdy, cdx, cdy)
+            if exact:
+                return 1.0 if det > 0.0 else (-1.0 if det < 0.0 else 0.0)
+    # stage 3: | x y x^2+y^2 1 | over the rows a, b, c, d, expanded into 48 monomials of
+    # the raw inputs (positive when d is inside the circle through counter-clockwise a, b, c)
+    xs = (ax, bx, cx, dx)
+    ys = (ay, by, cy, dy)
+    iw = w.view(np.int64)
+    iw[:_ACC_LIMBS] = 0
+    for i in range(_PERMS.shape[0]):
+        px = xs[_PERMS[i, 0]]
+        qy = ys[_PERMS[i, 1]]
+        r = _PERMS[i, 2]
+        negative = _PERMS[i, 3] < 0
+        _acc_add(iw, negative, px, qy, xs[r], xs[r])
+        _acc_add(iw, negative, px, qy, ys[r], ys[r])
+    return _acc_sign(iw)
 
 
 @njit(inline="always")
 def incircle(ax, ay, bx, by, cx, cy, dx, dy, w):
-    """In-circle test, exact in sign.
+    """In-circle test, exact in sign for any finite doubles.
 
     Positive when d lies strictly inside the circle through a, b, c (given counter-
     clockwise), negative when strictly outside, zero when the four points are cocircular.
@@ -345,13 +358,18 @@ def incircle(ax, ay, bx, by, cx, cy, dx, dy, w):
     adxbdy = adx * bdy
     bdxady = bdx * ady
     clift = cdx * cdx + cdy * cdy
-    det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) + clift * (adxbdy - bdxady)
+    bc = bdxcdy - cdxbdy
+    ca = cdxady - adxcdy
+    ab = adxbdy - bdxady
+    det = alift * bc + blift * ca + clift * ab
     permanent = (
         (abs(bdxcdy) + abs(cdxbdy)) * alift
         + (abs(cdxady) + abs(adxcdy)) * blift
         + (abs(adxbdy) + abs(bdxady)) * clift
     )
-    bound = INCIRCLE_ERRBOUND * permanent
+    # an underflowed product's absolute error is multiplied by a lift or a cross term
+    tiny = _UNDERFLOW * (1.0 + alift + blift + clift + abs(bc) + abs(ca) + abs(ab))
+    bound = INCIRCLE_ERRBOUND * permanent + tiny
     if det > bound or -det > bound:
         return det
     return incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, w)
