@@ -197,6 +197,24 @@ def _progress(total: int, enabled: bool, label: str):
 
 
 def cmd_run(a) -> int:
+    from .startup import COMPILE_MESSAGE, CompileWatch, warn
+
+    shown = {}  # the progress bar once drawn: the message must not cut through it
+
+    def say_compiling():
+        # even with --quiet: a silent 20 s on the first run looks like a hang (issue 18)
+        bar = shown.get("bar")
+        if bar is not None and not bar.disable:
+            bar.write(COMPILE_MESSAGE, file=sys.stderr)
+        else:
+            warn(COMPILE_MESSAGE)
+
+    with CompileWatch(on_first=say_compiling) as watch:
+        return _run_scene(a, watch, shown)
+
+
+def _run_scene(a, watch, shown: dict) -> int:
+    """``deforma run``'s work; ``watch`` counts Numba compiling, ``shown["bar"]`` is the bar."""
     from dataclasses import replace
 
     from . import scene as scenes
@@ -233,8 +251,9 @@ def cmd_run(a) -> int:
     script = scenes.Script(scene, world)  # its [[event]] explosions and [[pull]] grabs
     times, frames = [], []
     label = Path(a.scene).stem if a.scene.endswith(".toml") else a.scene
-    bar = _progress(n_frames, not a.quiet, label)
+    bar = shown["bar"] = _progress(n_frames, not a.quiet, label)
     t_wall = time.perf_counter()
+    compile_before = watch.seconds
     try:
         if a.output:
             # inside the try: from here on an interrupt removes the temporary file
@@ -263,11 +282,18 @@ def cmd_run(a) -> int:
             writer.abort()  # no-op after close(); discards the temporary file otherwise
         if view is not None:
             view.renderer.release()
-    wall = time.perf_counter() - t_wall
+    # honest figures: the whole command's wall time, start-up and compiling included, and the
+    # real-time factor of the frames alone (a first run's compiling is not the simulation's speed)
+    total = time.perf_counter() - a.started
+    frames_wall = time.perf_counter() - t_wall - (watch.seconds - compile_before)
+    compiling = watch.seconds if watch.compiled else 0.0  # else a helper without cache: start-up
+    startup = max(0.0, total - frames_wall - compiling)
     outputs = [o for o in (a.output, a.states) if o]
     sim = world.time
-    print(f"{label}: {n_frames} frames, {sim:.2f} s simulated in {wall:.2f} s wall "
-          f"({sim / wall if wall > 0 else float('inf'):.2f}x real time)"
+    print(f"{label}: {n_frames} frames, {sim:.2f} s simulated in {total:.2f} s wall ("
+          + (f"{compiling:.2f} s compiling kernels, first run only; " if watch.compiled else "")
+          + f"{startup:.2f} s start-up; frames {frames_wall:.2f} s, "
+          f"{sim / frames_wall if frames_wall > 0 else float('inf'):.2f}x real time)"
           + (f" -> {', '.join(outputs)}" if outputs else
              f"; nothing written: add -o {label}.mp4 (or .gif, or a folder/ for PNGs) for a video, "
              f"--states {label}.npz for the positions"))
@@ -411,8 +437,14 @@ def cmd_view(a) -> int:
 
 def main(argv=None) -> int:
     """Entry point of the ``deforma`` command; returns the exit code."""
+    from .startup import seconds_since_process_start
+
+    # the command's wall time starts with the process (imports included); called from Python
+    # (tests, scripts), with this call
+    started = time.perf_counter() - (seconds_since_process_start() if argv is None else 0.0)
     parser = _parser()
     a = parser.parse_args(argv)
+    a.started = started
     commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view}
     try:
         return commands[a.command](a)
