@@ -35,6 +35,10 @@ How it works (the reasons are in ``docs/mesh.md``):
 5. **Without an outline** (``detect_edges=False``, the original's behaviour made safe): the
    grid points are triangulated and every triangle that covers a background pixel centre
    is dropped, so the mesh is a slightly shrunken, stair-stepped version of the shape.
+6. **Manifold.** Where dropped triangles leave two parts touching at one vertex only (a
+   pinch: a thin ring or crossing lines cut there), the vertex is split, one copy per fan
+   of triangles (:func:`deforma.mesh.mesh.split_pinches`): every vertex has one fan and
+   every boundary vertex one boundary edge in and one out.
 
 Coordinates: pixel ``(row, col)`` covers ``[col, col+1] x [row, row+1]`` in image units;
 ``x = (col + 0.5 - cx) * scale`` and ``y = (cy - row - 0.5) * scale`` with ``(cx, cy)`` the
@@ -57,7 +61,7 @@ from scipy import ndimage
 
 from . import quality
 from .delaunay import delaunay
-from .mesh import Mesh
+from .mesh import Mesh, split_pinches
 
 #: File types a built-in texture may be stored as (what Pillow reads).
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
@@ -202,8 +206,9 @@ def from_image(
 
     pic = _load(source, background, threshold)
     field, level, by_alpha = pic.field, pic.level, pic.by_alpha
-    mask = _clean(field > level)
-    _check_foreground(pic, mask)
+    raw = field > level
+    mask = _clean(raw)
+    _check_foreground(pic, mask, raw)
     h, w = mask.shape
     off = r // 2
     grid = np.zeros_like(mask)
@@ -261,6 +266,10 @@ def from_image(
             f"no triangle fits inside the foreground with resolution={r}; use a smaller "
             "resolution or detect_edges=True"
         )
+    # pieces that touch only at a vertex (a thin line cut where a triangle was dropped, two
+    # parts meeting corner to corner) are separated there: every vertex gets one fan
+    tris, source = split_pinches(tris, len(points))
+    points = points[source]
     used = np.unique(tris)
     remap = np.full(len(points), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
@@ -483,11 +492,21 @@ def _describe(pic):
     return f"{pic.background!r} ({_hex(pic.rgb)})" if isinstance(pic.background, str) else _hex(pic.rgb)
 
 
-def _check_foreground(pic, mask):
-    """Refuse a mask that is empty or full: the picture is not on that background."""
+def _check_foreground(pic, mask, raw=None):
+    """Refuse a mask that is empty or full: the picture is not on that background.
+
+    ``raw`` is the mask before specks were dropped: a picture whose foreground is nothing
+    but specks (a tiny picture, a thin diagonal line) is told so, not that it has none.
+    """
     t = f"{pic.level / 255:.3g}"
     choose = ('choose the background the shape is on ("black", "white", "auto" for the border\'s colour, '
               '"#rrggbb" or (r, g, b))')
+    if not mask.any() and raw is not None and raw.any():
+        h, w = raw.shape
+        raise ValueError(f"the picture's foreground is only specks: {int(raw.sum())} of its {h}x{w} pixels are "
+                         f"foreground, in pieces smaller than {_MIN_PIECE} pixels joined side to side, which are "
+                         f"dropped as noise; need a shape of at least {_MIN_PIECE} such pixels (a larger or "
+                         "thicker shape)")
     if not mask.any():
         if pic.by_alpha:
             raise ValueError(f"the picture has no foreground: every pixel's alpha is at or below threshold {t} "
@@ -579,10 +598,36 @@ def _from_pil(im, label):
     if w == 0 or h == 0:
         raise ValueError(f"image {label!r} is empty ({w}x{h}); it needs at least one pixel")
     try:
+        if im.mode in _WIDE_GREY_MODES:
+            return _from_array(_wide_grey_to_8bit(np.asarray(im), im.mode, label))
         rgba = np.asarray(im.convert("RGBA"), dtype=np.uint8)
     except OSError as exc:  # truncated or corrupt data surfaces when pixels are decoded
         raise ValueError(f"cannot read image {label!r} ({exc}); a PNG or JPEG file is needed") from None
     return np.ascontiguousarray(rgba)
+
+
+# Pillow's convert("RGBA") clips these to 0..255, so a 16-bit disc (say 60000 on 20000)
+# became white on white: the whole square was meshed, or nothing, without a word
+_WIDE_GREY_MODES = ("I;16", "I;16L", "I;16B", "I;16N", "I", "F")
+
+
+def _wide_grey_to_8bit(a, mode, label):
+    """A 16-bit ("I;16*", "I") or float ("F") greyscale picture as 8-bit grey.
+
+    16-bit values map 0..65535 to 0..255 (65535 is white, as in PNG); "I" holds 32-bit
+    integers, which must be in 0..65535 (what Pillow reads 16-bit files as); "F" floats
+    must be in [0, 1]. Anything else has no agreed brightness and is refused.
+    """
+    if mode == "F":
+        if not (np.isfinite(a).all() and a.min() >= 0.0 and a.max() <= 1.0):
+            raise ValueError(f"image {label!r} is 32-bit float greyscale (mode F) with values outside [0, 1]; "
+                             "need 8-bit or 16-bit pictures, or floats in [0, 1]")
+        return a.astype(np.float64)
+    a = a.astype(np.int64)
+    if a.min() < 0 or a.max() > 65535:
+        raise ValueError(f"image {label!r} is 32-bit integer greyscale (mode {mode}) with values in "
+                         f"[{a.min()}, {a.max()}]; need 8-bit pictures or 16-bit values in 0..65535")
+    return ((a * 255 + 32767) // 65535).astype(np.uint8)
 
 
 def _from_array(source):
