@@ -40,6 +40,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
+from ..checks import coefficient as _coefficient
+from ..checks import pair as _pair
 from .friction import coulomb
 
 # Columns of the packed collider array read by the kernels.
@@ -67,27 +69,6 @@ def make_hits(n_vertices: int) -> ColliderHits:
 # Pushing a point out of one rectangle can push it into a touching one; a few passes settle
 # every sane arrangement, and a point still trapped falls back to its previous position.
 MAX_PASSES = 4
-
-
-def _as_pair(value, name: str, *, positive: bool = False) -> tuple[float, float]:
-    try:
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a pair of numbers, got {value!r}") from None
-    if a.shape != (2,) or not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} must be a pair of finite numbers, got {value!r}")
-    if positive and np.any(a <= 0):
-        raise ValueError(f"{name} must be positive in both directions, got {value!r}")
-    return float(a[0]), float(a[1])
-
-
-def _check_coefficient(value, name: str):
-    if value is None:
-        return None
-    v = float(value)
-    if not math.isfinite(v) or v < 0:
-        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -125,11 +106,11 @@ class Rect:
         a = float(angle)
         if not math.isfinite(a):
             raise ValueError(f"angle must be a finite number of degrees, got {angle!r}")
-        object.__setattr__(self, "center", _as_pair(center, "center"))
-        object.__setattr__(self, "size", _as_pair(size, "size", positive=True))
+        object.__setattr__(self, "center", _pair(center, "center"))
+        object.__setattr__(self, "size", _pair(size, "size", positive=True))
         object.__setattr__(self, "angle", a)
-        object.__setattr__(self, "friction", _check_coefficient(friction, "friction"))
-        object.__setattr__(self, "static_friction", _check_coefficient(static_friction, "static_friction"))
+        object.__setattr__(self, "friction", _coefficient(friction, "friction"))
+        object.__setattr__(self, "static_friction", _coefficient(static_friction, "static_friction"))
 
     @property
     def axes(self) -> np.ndarray:

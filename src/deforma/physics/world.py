@@ -15,11 +15,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import MAX_GRAVITY, MAX_SUBSTEPS, MIN_SUBSTEP
+from ..checks import non_negative as _non_negative
+from ..checks import number as _finite
+from ..checks import pair as _pair
+from ..checks import positive as _positive
+from ..checks import switch as _switch
 from . import behaviours as _behaviours
 from . import contacts as _contacts
 from . import tearing as _tearing
 from .colliders import Rect, make_hits, pack_rects
-from .elements import element_energy, gradient_row_sums, max_stiffness
+from .elements import element_energy, gradient_row_sums, max_stiffness, signed_areas
 from .integrators import make_integrator
 from .material import Material
 from .model import BodyTopology, Model, element_geometry
@@ -28,6 +34,11 @@ from .state import State
 
 # Automatic contact thickness: this fraction of a body's median boundary edge (see World).
 AUTO_THICKNESS = 0.05
+# A body has lost its shape when a spring is this many times its rest length, or its area
+# falls below this share of its rest area; checked every SHAPE_CHECK_EVERY steps.
+LOST_STRETCH = 10.0
+LOST_AREA = 0.1
+SHAPE_CHECK_EVERY = 16
 
 
 class SimulationUnstable(RuntimeError):
@@ -67,36 +78,6 @@ class Energy:
         return self.kinetic + self.spring + self.gravitational + self.elastic
 
 
-def _finite(value, name: str) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
-
-
-def _positive(value, name: str, unit: str) -> float:
-    v = _finite(value, name)
-    if v <= 0:
-        raise ValueError(f"{name} must be > 0 {unit}, got {value!r}")
-    return v
-
-
-def _non_negative(value, name: str, unit: str) -> float:
-    v = _finite(value, name)
-    if v < 0:
-        raise ValueError(f"{name} must be >= 0 {unit}, got {value!r}")
-    return v
-
-
-def _switch(value, name: str) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be True or False, got {value!r}")
-    return bool(value)
-
-
 def _material(value):
     if value is None or isinstance(value, Material):
         return value
@@ -115,20 +96,8 @@ def _pressure(value, topology) -> float | None:
     if value is None:
         return None
     p = _non_negative(value, "pressure", "N/m")
-    if p > 1e12:
-        raise ValueError(f"pressure must be in [0, 1e12] N/m, got {value!r}")
     outline_loops(topology.rest_positions, topology.boundary_edges, topology.springs, topology.triangles)
     return p
-
-
-def _pair(value, name: str) -> tuple[float, float]:
-    try:
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a pair of numbers (x, y), got {value!r}") from None
-    if a.shape != (2,) or not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} must be a pair of finite numbers (x, y), got {value!r}")
-    return float(a[0]), float(a[1])
 
 
 class Body:
@@ -539,6 +508,7 @@ class World:
         self._packed_colliders: list | None = None
         self._grabs: list[Grab] = []
         self._grabs_dirty = True
+        self._lost_shape = {}  # id(body) -> checks in a row at which it had lost its shape
         self._model = Model([], masses=[], stiffness=[], damping=[])
         self._state = State.empty()
         self._contact_thickness = None
@@ -569,7 +539,7 @@ class World:
 
     @gravity.setter
     def gravity(self, value):
-        self._inputs.gravity = _pair(value, "gravity")
+        self._inputs.gravity = _pair(value, "gravity", limit=MAX_GRAVITY)
 
     @property
     def dt(self) -> float:
@@ -578,7 +548,9 @@ class World:
 
     @dt.setter
     def dt(self, value):
-        self._dt = _positive(value, "dt", "s")
+        dt = _positive(value, "dt", "s")
+        self._check_substep(dt, getattr(self, "_substeps", 1))
+        self._dt = dt
 
     @property
     def substeps(self) -> int:
@@ -587,9 +559,17 @@ class World:
 
     @substeps.setter
     def substeps(self, value):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise ValueError(f"substeps must be an integer >= 1, got {value!r}")
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SUBSTEPS:
+            raise ValueError(f"substeps must be an integer in [1, {MAX_SUBSTEPS}] (one step must stay short "
+                             f"enough to interrupt), got {value!r}")
+        self._check_substep(self._dt, int(value))
         self._substeps = int(value)
+
+    @staticmethod
+    def _check_substep(dt, substeps):
+        if dt / substeps < MIN_SUBSTEP:
+            raise ValueError(f"dt / substeps must be >= {MIN_SUBSTEP:g} s, got {dt:g} / {substeps} = "
+                             f"{dt / substeps:.3g} s")
 
     def _world_param(name, unit, check):  # noqa: N805 - a property factory used in the class body
         def get(self):
@@ -630,8 +610,8 @@ class World:
             v = float(value)
         except (TypeError, ValueError):
             raise ValueError(f"max_speed must be a number of m/s, got {value!r}") from None
-        if not v > 0:
-            raise ValueError(f"max_speed must be > 0 m/s (inf allowed), got {value!r}")
+        if v != math.inf:  # inf: no speed check; else a number whose square is finite
+            v = _positive(value, "max_speed", "m/s (or inf)")
         self._inputs.max_speed = v
 
     @property
@@ -1114,6 +1094,8 @@ class World:
                 self._check_not_trapped()
             _behaviours.limit_and_yield(self._model, self._state, self._dt)
             self._tear()
+            if self.step_count % SHAPE_CHECK_EVERY == 0:
+                self._check_shape()
         self.time += self._dt
         self.step_count += 1
 
@@ -1147,6 +1129,46 @@ class World:
             for body in self._bodies:
                 body._tear_source = slice(None)
 
+    def _check_shape(self) -> None:
+        """Refuse a state in which a body has lost its shape: a spring or triangle stretched
+        ``LOST_STRETCH`` times its rest size, or a finite-element body's triangles turned inside
+        out over most of it (its area below ``LOST_AREA`` of its rest area), at two checks in a row (an
+        impact may crush a body for a moment). No stable step keeps either; a run that did is
+        garbage however finite its numbers (a step too long for the stiffness, a body started
+        inside a collider)."""
+        m, x = self._model, self._state.x
+        for b, body in enumerate(self._bodies):
+            tear = body.material.tear_strain
+            limit = LOST_STRETCH if tear is None else max(LOST_STRETCH, 2.0 * (1.0 + tear))
+            s0, s1 = m.body_spring_offsets[b], m.body_spring_offsets[b + 1]
+            what = None
+            if s1 > s0:
+                d = x[m.spring_j[s0:s1]] - x[m.spring_i[s0:s1]]
+                ratio = float(np.max(np.hypot(d[:, 0], d[:, 1]) / m.spring_rest_length[s0:s1]))
+                if ratio > limit:
+                    what = f"a spring is {ratio:.3g} times its rest length"
+            t = body.topology.triangles
+            # (a springs body folded flat keeps every spring's length: a state of the model,
+            # which has no area to keep, so only finite elements are held to their area)
+            if what is None and len(t) and body.is_fem:
+                v0 = int(m.body_vertex_offsets[b])
+                area = signed_areas(x, t + v0)
+                rest = signed_areas(body.topology.rest_positions, t)
+                if area.sum() < LOST_AREA * rest.sum():
+                    what = (f"its area fell to {area.sum() / rest.sum():.0%} of its rest area "
+                            f"({np.mean(area < 0):.0%} of its triangles inside out)")
+            # a hard impact may crush a body for a moment (a springs body has no area to keep):
+            # only a shape still lost at the next check is garbage
+            seen = self._lost_shape.get(id(body), 0) + 1 if what is not None else 0
+            self._lost_shape[id(body)] = seen
+            if seen < 2:
+                continue
+            self._state.restore()
+            hint = ("shorten dt or raise substeps (or use implicit-euler), and start bodies outside colliders; "
+                    "a stiffer or denser body keeps its shape better")
+            raise SimulationUnstable(f"body {b} lost its shape at step {self.step_count}: {what}; {hint}",
+                                     body=body, step=self.step_count, hint=hint)
+
     def _check_not_trapped(self) -> None:
         """After colliders changed: refuse a step that left a vertex inside one.
 
@@ -1179,13 +1201,21 @@ class World:
         self._state.restore()
         h = self._dt / self._substeps
         stable = self.stable_dt()
-        if math.isinf(stable) and getattr(self._integrator, "unconditionally_stable", False):
+        given = float(np.max(np.hypot(self._state.v[:, 0], self._state.v[:, 1]), initial=0.0))
+        if given > self.max_speed:
+            hint = (f"a velocity given before the step is already {given:.3g} m/s, beyond max_speed "
+                    f"{self.max_speed:g} m/s (explode strength, body.velocities): give less, or raise max_speed")
+        elif math.isinf(stable) and getattr(self._integrator, "unconditionally_stable", False):
             hint = (f"the {self.integrator} integrator has no step limit, so a large force ran away "
                     f"(grab strength, explosion): lower it, or raise max_speed if such speeds are intended")
-        elif h > stable:
+        elif h > stable and self._dt / stable <= MAX_SUBSTEPS:
             need = math.ceil(self._dt / stable)
             hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s: "
                     f"lower dt or raise substeps to at least {need}")
+        elif h > stable:
+            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s by more than "
+                    f"{MAX_SUBSTEPS} substeps can make up: lower the stiffness or damping, raise the mass, "
+                    f"or use an unconditionally stable integrator (implicit-euler, xpbd)")
         else:
             hint = (f"dt/substeps {h:.3g} s is within the stable estimate {stable:.3g} s, so a large "
                     f"force ran away (grab strength, explosion, stiffness): lower it, raise damping "
@@ -1238,7 +1268,9 @@ class World:
         gamma = float(np.max(2 * kd * m.vertex_inv_mass))
         if w2 == 0:
             return math.inf if gamma == 0 else 2 / gamma
-        return (math.sqrt(gamma * gamma + 4 * w2) - gamma) / w2
+        # (sqrt(gamma^2 + 4 w2) - gamma) / w2, written without the difference of two close
+        # numbers (heavy damping made it 0, and a hint then divided by it)
+        return 4.0 / (math.hypot(gamma, 2.0 * math.sqrt(w2)) + gamma)
 
     def energy(self, body: Body | None = None) -> Energy:
         """Kinetic, spring, gravitational and elastic (finite-element) energy in joules, of one body or all.

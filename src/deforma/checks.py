@@ -1,0 +1,108 @@
+"""Checks at the boundary: every number a user gives is tested against the range in which
+the formulas that read it mean something, and refused in one line that names the value and
+the range.
+
+The ranges (``LIMITS``, SI units) are wide - no realistic scene comes near them - but finite,
+so that no product, square or sum downstream overflows, no step count runs away and every
+hint stays true. ``docs/cli.md`` lists them.
+
+Examples
+--------
+>>> positive(0.01, "dt", "s")
+0.01
+>>> positive(1e-300, "dt", "s")
+Traceback (most recent call last):
+...
+ValueError: dt must be in [1e-06, 0.1] s, got 1e-300
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: name -> (smallest, largest) allowed value; names not listed are only checked for sign.
+LIMITS = {
+    "dt": (1e-6, 0.1),                  # s: below, a second of simulation is 1e6 steps
+    "mass": (1e-9, 1e9),                # kg
+    "stiffness": (0.0, 1e12),           # N/m
+    "damping": (0.0, 1e9),              # N*s/m
+    "friction": (0.0, 100.0),           # Coulomb coefficients
+    "static_friction": (0.0, 100.0),
+    "grab_strength": (1e-9, 1e12),      # N/m per vertex
+    "strength": (1e-9, 1e12),           # a grab's strength, N/m
+    "radius": (1e-9, 1e6),              # m
+    "air_drag": (0.0, 1e4),             # 1/s
+    "contact_thickness": (1e-9, 1e3),   # m
+    "pressure": (0.0, 1e12),            # N/m
+    "max_speed": (1e-9, 1e100),         # m/s (inf allowed: no speed check)
+}
+#: Largest coordinate or size of anything placed in a world (m), and of gravity (m/s^2).
+MAX_COORDINATE = 1e9
+MAX_GRAVITY = 1e7
+#: Largest number of substeps in one step: a step must stay short enough to interrupt.
+MAX_SUBSTEPS = 1000
+#: Smallest substep (s): dt / substeps below this is refused.
+MIN_SUBSTEP = 1e-7
+
+
+def number(value, name: str) -> float:
+    """``value`` as a finite float, or one ValueError line."""
+    if isinstance(value, (bool, np.bool_)) or isinstance(value, complex):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def _limited(v: float, value, name: str, unit: str, lo: float, lo_open: bool) -> float:
+    if v < lo or (lo_open and v == lo):  # the sign first: the usual mistake, said as before
+        raise ValueError(f"{name} must be {'>' if lo_open else '>='} {lo:g} {unit}, got {value!r}")
+    low, high = LIMITS.get(name, (lo, math.inf))
+    if v < low or v > high:
+        raise ValueError(f"{name} must be in [{low:g}, {high:g}] {unit}, got {value!r}")
+    return v
+
+
+def positive(value, name: str, unit: str) -> float:
+    """A finite number > 0 within ``LIMITS[name]`` (when listed)."""
+    return _limited(number(value, name), value, name, unit, 0.0, True)
+
+
+def non_negative(value, name: str, unit: str) -> float:
+    """A finite number >= 0 within ``LIMITS[name]`` (when listed)."""
+    return _limited(number(value, name), value, name, unit, 0.0, False)
+
+
+def pair(value, name: str, *, positive: bool = False, limit: float = MAX_COORDINATE) -> tuple[float, float]:
+    """A pair of finite numbers of magnitude at most ``limit`` (both > 0 with ``positive``)."""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a pair of numbers, got {value!r}") from None
+    if a.shape != (2,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be a pair of finite numbers, got {value!r}")
+    if positive and np.any(a <= 0):
+        raise ValueError(f"{name} must be positive in both directions, got {value!r}")
+    if np.any(np.abs(a) > limit):
+        raise ValueError(f"{name} must lie within +-{limit:g}, got {value!r}")
+    return float(a[0]), float(a[1])
+
+
+def switch(value, name: str) -> bool:
+    """``True`` or ``False`` (numpy's too), nothing else."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def coefficient(value, name: str):
+    """A friction coefficient override: ``None``, or a number in ``LIMITS[name]``."""
+    if value is None:
+        return None
+    return non_negative(value, name, "(dimensionless)")
