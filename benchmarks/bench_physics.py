@@ -33,7 +33,6 @@ from common import Row  # noqa: E402
 
 import deforma  # noqa: E402
 from deforma.physics.colliders import pack_rects  # noqa: E402
-from deforma.physics.forces import gather_spring_force, spring_forces_parallel  # noqa: E402
 
 GRAVITY = (0.0, -9.81)
 
@@ -95,14 +94,6 @@ def bare_spring_forces_tuned(x, v, si, sj, rest, ks, kd, f):
         f[i, 1] += s * ny
         f[j, 0] -= s * nx
         f[j, 1] -= s * ny
-
-
-@njit(cache=True, parallel=True)
-def _gather_all(fe, adj_ptr, adj_spring, adj_sign, f):
-    for i in prange(f.shape[0]):
-        fx, fy = gather_spring_force(fe, adj_ptr, adj_spring, adj_sign, i)
-        f[i, 0] = fx
-        f[i, 1] = fy
 
 
 def numpy_step(x, v, m, si, sj, rest, ks, kd, rects, h):
@@ -284,7 +275,6 @@ def run(quick: bool) -> list[Row]:
         m, s = w._model, w._state
         x, v = s.x.copy(), s.v.copy()
         f = np.zeros_like(x)
-        fe = np.zeros((m.n_springs, 2))
         args = (m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness, m.spring_damping)
         rects = pack_rects(w.colliders, friction=w.friction, static_friction=w.static_friction)
         xn, vn = x.copy(), v.copy()
@@ -294,8 +284,6 @@ def run(quick: bool) -> list[Row]:
             "parallel": worlds["parallel"].step,
             "bare": lambda: bare_spring_forces(x, v, *args, f),
             "tuned": lambda: bare_spring_forces_tuned(x, v, *args, f),
-            "bare2": lambda: (spring_forces_parallel(x, v, *args, fe),
-                              _gather_all(fe, m.adj_ptr, m.adj_spring, m.adj_sign, f)),
             "numpy": lambda: numpy_step(xn, vn, m.vertex_mass, *args, rects, w.dt),
         }
         taichi_cases.append((n, nv, (x.copy(), v.copy(), m.vertex_mass, *args, rects), w.dt))
@@ -312,8 +300,6 @@ def run(quick: bool) -> list[Row]:
         rows.append(Row("physics", f"  bare Numba spring forces, serial, tuned like deforma's ({nv} v)",
                         1 / t["tuned"], "steps/s", ratio=f"full step {t['auto'] / t['tuned']:.2f}x its time",
                         goal="full step <= 1.5x", met=t["auto"] <= 1.5 * t["tuned"]))
-        rows.append(Row("physics", f"  bare Numba spring forces, two threads ({nv} v)", 1 / t["bare2"], "steps/s",
-                        ratio=f"full step {t['auto'] / t['bare2']:.2f}x its time"))
         rows.append(Row("physics", f"  NumPy full step ({nv} v)", 1 / t["numpy"], "steps/s",
                         ratio=f"deforma {t['numpy'] / t['auto']:.1f}x faster", goal=">= 10x faster",
                         met=t["numpy"] >= 10 * t["auto"]))

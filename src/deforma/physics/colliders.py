@@ -38,7 +38,7 @@ from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..checks import coefficient as _coefficient
 from ..checks import pair as _pair
@@ -610,25 +610,3 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
                     v[i, 1] -= vn * ny
             moved += 1
     return moved
-
-
-@njit(cache=True, parallel=True)
-def collide_points(x_prev, x, v, rects, h):
-    """Resolve every point in place: ``x``, ``v`` (N, 2) after a substep from ``x_prev``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> r = pack_rects([Rect((0, -1), (10, 2), 0.0)], friction=0.3, static_friction=0.5)
-    >>> x, v = np.array([[0.0, -0.01]]), np.array([[0.0, -1.0]])
-    >>> collide_points(np.zeros((1, 2)), x, v, r, 0.01)
-    >>> bool(x[0, 1] > 0), float(v[0, 1])
-    (True, 0.0)
-    """
-    for i in prange(x.shape[0]):
-        px, py, vx, vy, _, _, _, _ = collide_point(x_prev[i, 0], x_prev[i, 1], x[i, 0], x[i, 1], v[i, 0], v[i, 1],
-                                                   rects, h)
-        x[i, 0] = px
-        x[i, 1] = py
-        v[i, 0] = vx
-        v[i, 1] = vy

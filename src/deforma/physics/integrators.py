@@ -221,7 +221,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
                         fbuf[t, i, 0] = 0.0
                         fbuf[t, i, 1] = 0.0
             g = grab_slot[i]
-            if g >= 0:  # forces.grab_force
+            if g >= 0:  # the grab pull: strength * (target - x), summed over the grabs holding i
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
                 fy += grab_pull[g, 2] - grab_pull[g, 0] * y0
             if inv_mass[i] == 0.0:  # pinned: it stays (its buffers are re-zeroed above)

@@ -189,13 +189,6 @@ class Model:
         Spring constants ``ks`` in N/m.
     spring_damping : (E,) float64
         Damping constants ``kd`` in N*s/m (acting on the relative velocity along the spring).
-    adj_ptr : (N + 1,) int64
-        CSR row pointers: the springs at vertex ``i`` are ``adj_spring[adj_ptr[i]:adj_ptr[i+1]]``.
-    adj_spring : (2E,) int32
-        Spring index per adjacency entry.
-    adj_sign : (2E,) float64
-        +1 where the vertex is the spring's ``i`` end, -1 where it is the ``j`` end; lets a
-        per-vertex gather sum spring forces computed once per spring, without write races.
     body_vertex_offsets, body_spring_offsets, body_elem_offsets : (B + 1,) int64
         Where each body's vertices, springs and elements start. A body of a finite-element
         material has elements and no springs; a springs body has springs and no elements.
@@ -238,8 +231,8 @@ class Model:
     --------
     >>> t = BodyTopology.from_arrays([[0, 0], [1, 0], [0, 1]], [[0, 1], [1, 2], [0, 2]])
     >>> m = Model([t], masses=[3.0], stiffness=[100.0], damping=[0.0])
-    >>> m.vertex_mass.tolist(), m.adj_ptr.tolist()
-    ([1.0, 1.0, 1.0], [0, 2, 4, 6])
+    >>> m.vertex_mass.tolist(), m.spring_i.tolist(), m.spring_j.tolist()
+    ([1.0, 1.0, 1.0], [0, 0, 1], [1, 2, 2])
     """
 
     def __init__(self, topologies, *, masses, stiffness, damping, materials=None, pinned=None, contact=None,
@@ -304,16 +297,6 @@ class Model:
         self.elem_area0 = self.elem_area.copy()
         self.rest_version = 0
         self._pressure(pressure if pressure is not None else [None] * nb)
-
-        # CSR adjacency: each spring appears once under each of its two ends.
-        ends = np.concatenate([self.spring_i, self.spring_j])
-        ids = np.concatenate([np.arange(e, dtype=np.int32)] * 2)
-        signs = np.concatenate([np.ones(e), -np.ones(e)])
-        order = np.argsort(ends, kind="stable")
-        self.adj_ptr = np.zeros(n + 1, np.int64)
-        np.cumsum(np.bincount(ends, minlength=n), out=self.adj_ptr[1:])
-        self.adj_spring = np.ascontiguousarray(ids[order])
-        self.adj_sign = np.ascontiguousarray(signs[order])
 
         # The contact stage's view: the collision vertices are every body's outline vertices,
         # body by body, then the other vertices of each body with triangles, body by body.

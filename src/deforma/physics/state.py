@@ -26,7 +26,7 @@ class State:
     --------
     >>> import numpy as np
     >>> s = State(np.zeros((3, 2)), np.ones((3, 2)), [0, 1, 3])
-    >>> s.body_view(1)[1].shape
+    >>> s.x[s.body_offsets[1]:s.body_offsets[2]].shape
     (2, 2)
     """
 
@@ -42,21 +42,7 @@ class State:
         """A state with no vertices."""
         return cls(np.zeros((0, 2)), np.zeros((0, 2)), [0])
 
-    def body_view(self, body: int) -> tuple[np.ndarray, np.ndarray]:
-        """Views (not copies) of body ``body``'s positions and velocities."""
-        a, b = self.body_offsets[body], self.body_offsets[body + 1]
-        return self.x[a:b], self.v[a:b]
-
-    def save(self) -> None:
-        """Copy the current state into the backup (the step kernel does this itself)."""
-        self.x_start[...] = self.x
-        self.v_start[...] = self.v
-
     def restore(self) -> None:
         """Put back the state saved at the start of the last step."""
         self.x[...] = self.x_start
         self.v[...] = self.v_start
-
-    def rebuilt(self, positions, velocities, body_offsets) -> "State":
-        """A new state with different bodies (after adding or removing one)."""
-        return State(positions, velocities, body_offsets)
