@@ -301,16 +301,52 @@ def _run_scene(a, watch, shown: dict) -> int:
 
 
 # -- mesh ---------------------------------------------------------------------------------------------
+#: Largest picture ``deforma mesh`` draws: its height, like ``--width``, at most this many pixels.
+MESH_PICTURE_MAX_SIDE = 8000
+#: Largest drawing canvas (before the shrink that smooths the lines), in pixels: above it the
+#: picture is drawn at its final size, so memory stays near 1 GB whatever the options.
+MESH_CANVAS_MAX_PIXELS = 64_000_000
+
+
+def _mesh_picture_size(mesh, width: int) -> tuple[int, int]:
+    """The picture's (width, height) without the caption, from the mesh's aspect ratio.
+
+    A mesh much taller than wide would ask for a picture of millions of pixels in height; the
+    width is then narrowed so the height stays within :data:`MESH_PICTURE_MAX_SIDE`.
+    """
+    v = mesh.vertices
+    span = np.maximum(v.max(axis=0) - v.min(axis=0), 1e-12)
+    aspect = float(span[1] / span[0])
+    margin = 0.06
+    height = lambda w: w * (1 - 2 * margin) * aspect + 2 * margin * w  # noqa: E731
+    if height(width) > MESH_PICTURE_MAX_SIDE:
+        width = int(MESH_PICTURE_MAX_SIDE / height(1.0))
+        if width < 16:
+            raise CliError(f"the mesh is {aspect:.3g} times taller than wide: its picture would be over "
+                           f"{MESH_PICTURE_MAX_SIDE} px high even 16 px wide; at most {MESH_PICTURE_MAX_SIDE} px "
+                           f"per side")
+    return width, max(1, int(round(height(width))))
+
+
 def _mesh_picture(mesh, picture, width: int, caption: str):
-    """Triangles over the picture (or a plain background for a box), with a caption bar."""
+    """Triangles over the picture (or a plain background for a box), with a caption bar.
+
+    Every size here follows from ``width`` (at most 8000) and the mesh's aspect ratio (see
+    :func:`_mesh_picture_size`), never from the source picture: only the part of the picture
+    under the mesh's frame is scaled, so a 3-pixel shape on a large picture does not blow the
+    picture up to tens of thousands of pixels (issue 17).
+    """
     from PIL import Image, ImageDraw, ImageFont
 
+    width, _ = _mesh_picture_size(mesh, width)
     ss = 2  # draw at twice the size and shrink: smooth lines without an antialiasing library
     v = mesh.vertices
     lo, hi = v.min(axis=0), v.max(axis=0)
     span = np.maximum(hi - lo, 1e-12)
     margin = 0.06
     aspect = span[1] / span[0]
+    if (width * ss) * (width * ss) * max(aspect, 1.0) > MESH_CANVAS_MAX_PIXELS:
+        ss = 1
     W = width * ss
     inner_w = W * (1 - 2 * margin)
     inner_h = inner_w * aspect
@@ -330,12 +366,20 @@ def _mesh_picture(mesh, picture, width: int, caption: str):
         corners = np.array([[0, 1, 1], [1, 1, 1]]) @ coef  # uv (0,1) top-left, (1,1) top-right
         origin = np.array([0, 0, 1]) @ coef
         tl, tr, bl = to_px(corners[:1]), to_px(corners[1:]), to_px(origin[None])
-        pw, ph = int(round(tr[0, 0] - tl[0, 0])), int(round(bl[0, 1] - tl[0, 1]))
-        if pw > 0 and ph > 0:
-            pic = Image.fromarray(picture).convert("RGBA").resize((pw, ph), Image.LANCZOS)
+        x0, y0 = float(tl[0, 0]), float(tl[0, 1])
+        pw, ph = float(tr[0, 0]) - x0, float(bl[0, 1]) - y0
+        # only the part of the picture inside the canvas is resized, to the canvas's pixels
+        cx0, cy0 = max(0, int(np.floor(x0))), max(0, int(np.floor(y0)))
+        cx1, cy1 = min(W, int(np.ceil(x0 + pw))), min(H, int(np.ceil(y0 + ph)))
+        if pw > 0 and ph > 0 and cx1 > cx0 and cy1 > cy0:
+            src = Image.fromarray(picture).convert("RGBA")
+            sx, sy = src.width / pw, src.height / ph
+            box = (max(0.0, (cx0 - x0) * sx), max(0.0, (cy0 - y0) * sy),  # within the picture: Pillow
+                   min(src.width, (cx1 - x0) * sx), min(src.height, (cy1 - y0) * sy))  # wants that
+            pic = src.resize((cx1 - cx0, cy1 - cy0), Image.LANCZOS, box=box)
             faded = Image.new("RGBA", pic.size, (246, 244, 239, 255))
             faded.alpha_composite(pic)
-            img.paste(faded.convert("RGB"), (int(round(tl[0, 0])), int(round(tl[0, 1]))))
+            img.paste(faded.convert("RGB"), (cx0, cy0))
     draw = ImageDraw.Draw(img)
     px = to_px(v)
     line = (31, 58, 104)
