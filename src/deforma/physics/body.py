@@ -1,0 +1,385 @@
+"""Handles onto a world's bodies and grabs: what :meth:`World.add_body` and
+:meth:`World.grab` return.
+
+A :class:`Body` owns nothing but its topology, mesh and overrides; its ``positions`` and
+``velocities`` are views into the world's state, and its setters write through the world
+(which validates and updates the Model). A :class:`Grab` is the mouse: vertices of one body
+pulled toward a target while held.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..checks import non_negative as _non_negative
+from ..checks import positive as _positive
+from ..checks import switch as _switch
+from . import tearing as _tearing
+from .material import Material
+from .model import BodyTopology, element_geometry
+from .pressure import outline_loops
+
+if TYPE_CHECKING:  # the World imports this module
+    from .world import World
+
+
+def _material(value):
+    if value is None or isinstance(value, Material):
+        return value
+    raise ValueError(f"material must be a deforma.Material (or None for the world's / the seed's springs), "
+                     f"got {type(value).__name__}: e.g. deforma.Material('neo-hookean', youngs_modulus=1e5, "
+                     f"poisson_ratio=0.3, density=100.0)")
+
+
+def _fem_mesh_check(topology) -> None:
+    """Refuse a mesh that cannot be made of finite elements (before anything changes)."""
+    element_geometry(topology)  # raises with the reason
+
+
+def _pressure(value, topology) -> float | None:
+    """Validate a body's gas pressure (N/m) and that the body can hold a gas."""
+    if value is None:
+        return None
+    p = _non_negative(value, "pressure", "N/m")
+    outline_loops(topology.rest_positions, topology.boundary_edges, topology.springs, topology.triangles)
+    return p
+
+
+class Body:
+    """A soft body in a world: a handle onto its slice of the world's arrays.
+
+    Made by :meth:`World.add_body`, not directly. ``material``, the springs' ``mass`` (kg,
+    total), ``stiffness`` (N/m per spring) and ``damping`` (N*s/m per spring), and the
+    body-contact ``friction`` / ``static_friction`` can be set live; setting ``None`` makes
+    the body follow the world's value again. A body of a finite-element material takes its
+    mass from the material's density and has no springs to set. ``collide`` and
+    ``self_collision`` switch its contacts with other bodies and with itself; :meth:`pin`
+    holds vertices in place.
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World()
+    >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]), position=(0, 2))
+    >>> b.positions.shape, b.mass, b.n_springs
+    ((3, 2), 1.0, 3)
+    """
+
+    def __init__(self, world: "World", index: int, mesh, topology: BodyTopology, overrides: dict):
+        self._world = world
+        self._index = index
+        self.mesh = mesh
+        self.topology = topology
+        self._overrides = overrides
+        self._pinned = np.zeros(topology.n_vertices, bool)
+        self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
+        self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
+
+    def _apply_tear(self, cut) -> None:
+        """Take the torn mesh ``cut`` (a :class:`~deforma.physics.tearing.Tear`) as the body's."""
+        from ..mesh import Mesh
+
+        t, src = self.topology, cut.source
+        rest = t.rest_positions[src]
+        tri = cut.triangles
+        share = (np.full(t.n_vertices, 1.0 / t.n_vertices) if t.mass_share is None else t.mass_share)[src]
+        share = share * cut.mass_share
+        edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])  # from_arrays dedups
+        self.topology = BodyTopology.from_arrays(rest, edges, tri, mass_share=share)
+        uv = getattr(self.mesh, "uv", None)
+        if uv is not None and len(uv) == t.n_vertices:
+            self.mesh = Mesh._trusted(rest, tri, np.asarray(uv)[src], getattr(self.mesh, "texture", None))
+        self._pinned = self._pinned[src]
+        self._tear_source = src
+        self._overrides["pressure"] = None  # the gas escapes through the tear
+
+    def _check(self) -> "World":
+        if self._world is None:
+            raise ValueError("this body was removed from its world")
+        return self._world
+
+    @property
+    def world(self) -> "World":
+        """The world the body lives in."""
+        return self._check()
+
+    @property
+    def index(self) -> int:
+        """Position of the body in ``world.bodies``."""
+        self._check()
+        return self._index
+
+    @property
+    def vertex_slice(self) -> slice:
+        """Rows of the world's state arrays that belong to this body."""
+        off = self._check()._model.body_vertex_offsets
+        return slice(int(off[self._index]), int(off[self._index + 1]))
+
+    @property
+    def positions(self) -> np.ndarray:
+        """(N, 2) vertex positions in metres: a view into the world's state, writable."""
+        return self._check()._state.x[self.vertex_slice]
+
+    @positions.setter
+    def positions(self, value):
+        self.positions[...] = self._checked_array(value, "positions", shapes=((self.n_vertices, 2),))
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """(N, 2) vertex velocities in m/s: a view into the world's state, writable."""
+        return self._check()._state.v[self.vertex_slice]
+
+    @velocities.setter
+    def velocities(self, value):
+        # a single (vx, vy) sets every vertex: the usual way to launch a body
+        self.velocities[...] = self._checked_array(value, "velocities", shapes=((self.n_vertices, 2), (2,)))
+
+    def _checked_array(self, value, name, *, shapes):
+        try:
+            a = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be an array of numbers, got {type(value).__name__}") from None
+        if a.shape not in shapes or not np.all(np.isfinite(a)):
+            allowed = " or ".join(str(s) for s in shapes)
+            raise ValueError(f"{name} must be finite with shape {allowed}, got shape {a.shape}")
+        return a
+
+    @property
+    def n_vertices(self) -> int:
+        """Number of vertices (masses)."""
+        return self.topology.n_vertices
+
+    @property
+    def n_springs(self) -> int:
+        """Number of springs (unique mesh edges)."""
+        return self.topology.n_springs
+
+    @property
+    def triangles(self) -> np.ndarray:
+        """(M, 3) int32 triangles in body-local vertex indices (may be empty)."""
+        return self.topology.triangles
+
+    @property
+    def springs(self) -> np.ndarray:
+        """(E, 2) int32 spring vertex pairs in body-local indices."""
+        return self.topology.springs
+
+    @property
+    def vertex_masses(self) -> np.ndarray:
+        """(N,) mass of each vertex in kg (a copy): equal for springs, ``density`` times the
+        lumped area for finite elements."""
+        return self._check()._model.vertex_mass[self.vertex_slice].copy()
+
+    @property
+    def center_of_mass(self) -> np.ndarray:
+        """(2,) centre of mass in metres (vertices weighted by their masses)."""
+        m = self._check()._model.vertex_mass[self.vertex_slice]
+        return (m @ self.positions) / m.sum()
+
+    @property
+    def material(self) -> Material:
+        """The body's material (its own, or the world's; ``Material("springs")`` if neither is set).
+
+        Setting it (or ``None``: follow the world) switches the model live; the body keeps its
+        positions and velocities.
+        """
+        m = self._overrides["material"]
+        if m is None:
+            m = self._check().material
+        return Material("springs") if m is None else m
+
+    @material.setter
+    def material(self, value):
+        world = self._check()
+        value = _material(value)
+        if value is not None and value.is_fem:
+            _fem_mesh_check(self.topology)
+        self._overrides["material"] = value
+        world._material_changed()
+
+    @property
+    def is_fem(self) -> bool:
+        """True if the body is made of finite elements (its material is not ``"springs"``)."""
+        return self.material.is_fem
+
+    def _param(self, name):
+        v = self._overrides[name]
+        return getattr(self._check(), name) if v is None else v
+
+    def _set_param(self, name, value, check):
+        if value is not None and name in ("mass", "stiffness", "damping") and self.is_fem:
+            raise ValueError(f"body {self._index} is made of {self.material.model!r} elements, which have no "
+                             f"spring {name}: change its material (youngs_modulus, density, damping) instead")
+        self._overrides[name] = None if value is None else check(value)
+        self._check()._apply_body_parameters(self._index)
+
+    def _mass(self):
+        if self.is_fem:
+            return float(self._check()._model.vertex_mass[self.vertex_slice].sum())
+        return self._param("mass")
+
+    mass = property(_mass,
+                    lambda self, v: self._set_param("mass", v, lambda x: _positive(x, "mass", "kg")),
+                    doc="Total mass in kg: for springs spread evenly over the vertices (the original's "
+                        "mass / N); for finite elements ``density * area`` (read-only).")
+    stiffness = property(lambda self: self._param("stiffness"),
+                         lambda self, v: self._set_param("stiffness", v,
+                                                         lambda x: _non_negative(x, "stiffness", "N/m")),
+                         doc="Spring constant ks of every spring, N/m (springs bodies).")
+    damping = property(lambda self: self._param("damping"),
+                       lambda self, v: self._set_param("damping", v,
+                                                       lambda x: _non_negative(x, "damping", "N*s/m")),
+                       doc="Spring damping kd of every spring, N*s/m (springs bodies).")
+
+    @property
+    def pinned(self) -> np.ndarray:
+        """(N,) bool: which vertices are pinned (a copy; use :meth:`pin` / :meth:`unpin`)."""
+        self._check()
+        return self._pinned.copy()
+
+    def _indices(self, indices, name):
+        try:
+            a = np.asarray(indices)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be vertex indices (integers), got {indices!r}") from None
+        if a.dtype == bool and a.shape == (self.n_vertices,):
+            return np.flatnonzero(a)
+        a = a.reshape(-1)
+        if a.size and not np.issubdtype(a.dtype, np.integer):
+            raise ValueError(f"{name} must be integers (or a bool mask of {self.n_vertices}), got dtype {a.dtype}")
+        if a.size and (a.min() < 0 or a.max() >= self.n_vertices):
+            bad = int(a[(a < 0) | (a >= self.n_vertices)][0])
+            raise ValueError(f"{name}: vertex index {bad} is out of range; body {self._index} has vertices "
+                             f"0..{self.n_vertices - 1}")
+        return a.astype(np.int64)
+
+    def pin(self, indices) -> None:
+        """Hold vertices ``indices`` (body-local, or a bool mask) where they are: infinite mass,
+        zero velocity, under every integrator, until :meth:`unpin`.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]), position=(0, 2))
+        >>> b.pin([0, 1])
+        >>> for _ in range(60):
+        ...     w.step()
+        >>> b.pinned.tolist(), b.positions[0].tolist()
+        ([True, True, False], [-0.5, 1.5])
+        """
+        world = self._check()
+        idx = self._indices(indices, "pin indices")
+        self._pinned[idx] = True
+        self.velocities[idx] = 0.0
+        world._model.set_pinned(self._index, self._pinned)
+
+    def unpin(self, indices=None) -> None:
+        """Free vertices ``indices`` (default: all of them)."""
+        world = self._check()
+        if indices is None:
+            self._pinned[:] = False
+        else:
+            self._pinned[self._indices(indices, "unpin indices")] = False
+        world._model.set_pinned(self._index, self._pinned)
+    friction = property(lambda self: self._param("friction"),
+                        lambda self, v: self._set_param("friction", v,
+                                                        lambda x: _non_negative(x, "friction", "(dimensionless)")),
+                        doc="Dynamic Coulomb coefficient against other bodies and itself; two bodies "
+                            "mix theirs as sqrt(a * b). Colliders use their own.")
+    static_friction = property(lambda self: self._param("static_friction"),
+                               lambda self, v: self._set_param(
+                                   "static_friction", v, lambda x: _non_negative(x, "static_friction",
+                                                                                 "(dimensionless)")),
+                               doc="Static Coulomb coefficient against other bodies and itself, mixed "
+                                   "as sqrt(a * b).")
+
+    @property
+    def collide(self) -> bool:
+        """Whether the body touches other bodies (both must have it on)."""
+        return self._overrides["collide"]
+
+    @collide.setter
+    def collide(self, value):
+        self._set_switch("collide", value)
+
+    @property
+    def self_collision(self) -> bool:
+        """Whether the body touches itself (a fold of its outline against another part of it)."""
+        return self._overrides["self_collision"]
+
+    @self_collision.setter
+    def self_collision(self, value):
+        self._set_switch("self_collision", value)
+
+    def _set_switch(self, name, value):
+        value = _switch(value, name)
+        world = self._check()
+        if value and name == "collide":
+            world._check_no_overlap(self)
+        self._overrides[name] = value
+        world._apply_body_parameters(self._index)
+
+    @property
+    def contact_thickness(self) -> float:
+        """The contact thickness this body uses, metres (the world's, or its automatic value)."""
+        return self._check()._body_thickness(self)
+
+    @property
+    def pressure(self) -> float | None:
+        """Gas pressure at the rest area, N/m (``None``: no gas); settable. See
+        :mod:`deforma.physics.pressure`. A body that tears lets its gas out (``None``)."""
+        self._check()
+        return self._overrides["pressure"]
+
+    @pressure.setter
+    def pressure(self, value):
+        world = self._check()
+        self._overrides["pressure"] = _pressure(value, self.topology)
+        world._rebuild(world._state.x, world._state.v)
+
+    @property
+    def pieces(self) -> np.ndarray:
+        """(N,) int: the connected piece each vertex belongs to (all 0 until the body tears).
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2))
+        >>> int(b.pieces.max()) + 1
+        1
+        """
+        self._check()
+        t = self.topology
+        return _tearing.pieces(t.n_vertices, t.springs if not len(t.triangles) else [], t.triangles)
+
+    def __repr__(self) -> str:
+        if self._world is None:
+            return "Body(removed)"
+        if self.is_fem:
+            return (f"Body({self.n_vertices} vertices, {len(self.triangles)} {self.material.model} elements, "
+                    f"mass {self.mass:.4g} kg)")
+        return f"Body({self.n_vertices} vertices, {self.n_springs} springs, mass {self.mass} kg)"
+
+
+class Grab:
+    """A mouse grab: vertices of one body pulled toward ``target`` while held.
+
+    Made by :meth:`World.grab`. ``vertices`` are body-local indices (empty when the point
+    was off every body, then the grab does nothing).
+    """
+
+    def __init__(self, world, body, vertices, target, strength):
+        self._world = world
+        self.body = body
+        self.vertices = np.asarray(vertices, dtype=np.int64)
+        self.target = target
+        self.strength = strength
+        self.active = True
+
+    def __repr__(self) -> str:
+        state = "active" if self.active else "released"
+        return f"Grab({len(self.vertices)} vertices, target={self.target}, strength={self.strength} N/m, {state})"
