@@ -91,3 +91,180 @@ def test_a_decompression_bomb_as_texture_or_source_is_refused(tmp_path, capsys, 
     line = one_line_error(err)
     assert "bomb.png" in line and "40000000" in line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bomb.png", "s.toml"]
+
+
+# -- interrupted and failed output --------------------------------------------------------------------
+def _exe():
+    import os
+    import sys
+
+    return os.path.join(os.path.dirname(sys.executable), "deforma")
+
+
+def _dead_pid():
+    import subprocess
+    import sys
+
+    p = subprocess.Popen([sys.executable, "-c", "pass"])
+    p.wait()
+    return p.pid
+
+
+@pytest.mark.parametrize("signame, output", [("SIGTERM", "big.mp4"), ("SIGHUP", "big.mp4"), ("SIGTERM", "frames/")])
+def test_sigterm_and_sighup_clean_up_like_ctrl_c(tmp_path, signame, output):
+    import os
+    import signal
+    import subprocess
+    import time
+
+    from deforma.startup import COMPILE_MESSAGE
+
+    signum = getattr(signal, signame)
+    p = subprocess.Popen([_exe(), "run", "sample", "--seconds", "120", "--size", "64x48", "-o", output, "--quiet"],
+                         cwd=tmp_path, stderr=subprocess.PIPE, text=True, start_new_session=True)
+
+    def partials():
+        found = []
+        for root, dirs, files in os.walk(tmp_path):
+            found += [f for f in dirs + files if ".partial" in f]
+        return found
+
+    deadline = time.time() + 60
+    while time.time() < deadline and not partials():
+        time.sleep(0.05)
+    time.sleep(0.5)
+    os.kill(p.pid, signum)  # the process alone (a service manager's stop, a closed terminal's hang-up)
+    _, err = p.communicate(timeout=30)
+    assert p.returncode == 128 + signum, err
+    assert err.replace(COMPILE_MESSAGE + "\n", "", 1) == f"deforma: stopped by {signame}; no partial output was left\n"
+    assert os.listdir(tmp_path) == []
+
+
+def test_ctrl_c_in_a_png_folder_run_leaves_no_frames(tmp_path, capsys, monkeypatch):
+    import os
+
+    from deforma.cli import EXIT_INTERRUPTED
+    from deforma.render import world_view
+
+    calls = []
+    real = world_view.WorldView.draw
+
+    def draw(self, **kw):
+        calls.append(1)
+        if len(calls) == 6:
+            raise KeyboardInterrupt
+        return real(self, **kw)
+
+    monkeypatch.setattr(world_view.WorldView, "draw", draw)
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "frame_00000.png").write_bytes(b"earlier run")
+    for out in (tmp_path / "new", tmp_path / "old"):
+        calls.clear()
+        code, _, err = run(capsys, "run", "sample", "--seconds", "1", "--size", "64x48", "--quiet", "-o", f"{out}/")
+        assert code == EXIT_INTERRUPTED and "no partial output was left" in err
+    # the folder it made is gone; the existing one is as it was
+    assert sorted(os.listdir(tmp_path)) == ["old"]
+    assert os.listdir(tmp_path / "old") == ["frame_00000.png"]
+    assert (tmp_path / "old" / "frame_00000.png").read_bytes() == b"earlier run"
+
+
+def test_png_folder_run_publishes_every_frame(tmp_path, capsys):
+    import os
+
+    code, _, err = run(capsys, "run", "sample", "--seconds", "0.2", "--fps", "10", "--size", "64x48", "--quiet",
+                       "-o", f"{tmp_path / 'f'}/")
+    assert code == 0, err
+    assert sorted(os.listdir(tmp_path / "f")) == ["frame_00000.png", "frame_00001.png"]
+
+
+def test_the_temporary_files_of_killed_runs_are_removed_by_the_next_run(tmp_path, capsys):
+    import os
+    import time
+
+    pid = _dead_pid()
+    stale = [tmp_path / f".out.{pid}.abcd1234.partial.mp4", tmp_path / f".s.{pid}.x_y_z_12.partial.npz"]
+    for f in stale:
+        f.write_bytes(b"killed run")
+    staged = tmp_path / f".frames.{pid}.qwertyui.partial"
+    staged.mkdir()
+    (staged / "frame_00000.png").write_bytes(b"")
+    alive = tmp_path / f".out.{os.getppid()}.abcd1234.partial.mp4"  # a live process: kept
+    other = tmp_path / ".notes.partial.txt"  # not ours: kept
+    for f in (alive, other):
+        f.write_bytes(b"keep")
+    old = time.time() - 60
+    for f in (*stale, staged, alive, other):
+        os.utime(f, (old, old))
+    code, _, err = run(capsys, "run", "sample", "--seconds", "0.1", "--fps", "10", "--size", "64x48", "--quiet",
+                       "-o", tmp_path / "out.gif")
+    assert code == 0, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([alive.name, other.name, "out.gif"])
+
+
+def test_a_recent_temporary_file_of_a_dead_process_is_kept(tmp_path):
+    # last written after this run began: another machine's run may be writing it into a shared folder
+    import time
+
+    from deforma.render.video import remove_stale_partials
+
+    f = tmp_path / f".out.{_dead_pid()}.abcd1234.partial.mp4"
+    f.write_bytes(b"")
+    assert remove_stale_partials(tmp_path, before=time.time() - 60) == [] and f.exists()
+    assert remove_stale_partials(tmp_path, before=time.time() + 60) == [f] and not f.exists()
+
+
+@pytest.mark.parametrize("failure", ["enospc", "pipe"])
+def test_a_failing_ffmpeg_is_one_line_and_leaves_nothing(tmp_path, capsys, monkeypatch, failure):
+    import errno
+    import os
+
+    import imageio_ffmpeg
+
+    import deforma.render.video as video
+
+    def write_frames(path, *args, **kw):
+        open(path, "wb").close()
+        n = 0
+        while True:
+            yield
+            n += 1
+            if n == 3:
+                if failure == "enospc":
+                    raise OSError(errno.ENOSPC, "No space left on device")
+                raise OSError("[Errno 32] Broken pipe\n\nFFMPEG COMMAND:\n/usr/bin/ffmpeg -y -f rawvideo ...\n\n"
+                              "FFMPEG STDERR OUTPUT:\n")
+
+    monkeypatch.setattr(imageio_ffmpeg, "write_frames", write_frames)
+    if failure == "pipe":
+        monkeypatch.setattr(video.shutil, "disk_usage", lambda p: type("U", (), {"free": 10**12})())
+    code, _, err = run(capsys, "run", "sample", "--seconds", "1", "--size", "64x48", "--quiet",
+                       "-o", tmp_path / "big.mp4")
+    assert code == EXIT_ERROR
+    line = one_line_error(err)
+    assert "FFMPEG" not in line and "big.mp4" in line and "nothing was written" in line
+    assert ("no space left" in line) == (failure == "enospc")
+    assert os.listdir(tmp_path) == []
+
+
+def test_view_screenshot_into_an_unwritable_folder_is_refused(tmp_path, capsys, monkeypatch):
+    import os
+
+    monkeypatch.setattr(os, "access", lambda path, mode: False)  # root writes anywhere: simulated
+    code, out, err = run(capsys, "view", "sample", "--frames", "2", "--screenshot", tmp_path / "s.png")
+    assert code == EXIT_ERROR and out == ""
+    assert "is not writable" in one_line_error(err)
+    assert os.listdir(tmp_path) == []
+
+
+def test_view_screenshot_that_cannot_be_saved_fails(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "s.png").mkdir()  # saving onto a folder fails after the frames ran
+    env = dict(os.environ, SDL_VIDEODRIVER="offscreen")
+    r = subprocess.run([sys.executable, "-m", "deforma.cli", "view", "sample", "--frames", "2", "--size", "640x360",
+                        "--screenshot", "s.png"], capture_output=True, text=True, env=env, timeout=120, cwd=tmp_path)
+    assert r.returncode == EXIT_ERROR and r.stdout == ""
+    assert "cannot save the screenshot" in one_line_error(r.stderr)
+    assert os.listdir(tmp_path) == ["s.png"] and os.listdir(tmp_path / "s.png") == []

@@ -24,8 +24,39 @@ from . import __version__
 __all__ = ["main"]
 
 #: Exit codes: 1 a user error (scene, output, options), 3 the simulation became unstable,
-#: 4 rendering unavailable (no OpenGL), 130 interrupted (Ctrl-C).
+#: 4 rendering unavailable (no OpenGL), 130 interrupted (Ctrl-C); SIGTERM and SIGHUP give
+#: 128 + the signal's number (143, 129), as a shell reports a process they ended.
 EXIT_ERROR, EXIT_UNSTABLE, EXIT_NO_GL, EXIT_INTERRUPTED = 1, 3, 4, 130
+
+
+class Stopped(BaseException):
+    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C, so every writer discards its temporary file."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _stop_on_signals():
+    """Make SIGTERM and SIGHUP raise :class:`Stopped`; returns a function that restores the old handlers."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None  # only the main thread may set handlers (tests may call main() elsewhere)
+    signums = [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
+
+    def handler(signum, frame):
+        for n in signums:  # a second signal must not cut through the clean-up
+            signal.signal(n, signal.SIG_IGN)
+        raise Stopped(signum)
+
+    previous = {n: signal.signal(n, handler) for n in signums}
+
+    def restore():
+        for n, h in previous.items():
+            signal.signal(n, h)
+    return restore
 
 
 class CliError(Exception):
@@ -490,6 +521,7 @@ def main(argv=None) -> int:
     a = parser.parse_args(argv)
     a.started = started
     commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view}
+    restore_signals = _stop_on_signals()
     try:
         return commands[a.command](a)
     except KeyboardInterrupt:
@@ -497,6 +529,13 @@ def main(argv=None) -> int:
             raise
         print("deforma: interrupted; no partial output was left", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Stopped as e:
+        import signal
+
+        if a.debug:
+            raise
+        print(f"deforma: stopped by {signal.Signals(e.signum).name}; no partial output was left", file=sys.stderr)
+        return 128 + e.signum
     except CliError as e:
         if a.debug:
             raise
@@ -508,6 +547,8 @@ def main(argv=None) -> int:
             raise
         print(f"deforma: error: {e}", file=sys.stderr)
         return EXIT_ERROR
+    finally:
+        restore_signals()
 
 
 if __name__ == "__main__":  # pragma: no cover

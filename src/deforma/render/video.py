@@ -3,19 +3,30 @@
 Every writer puts its bytes in a temporary file beside the target and renames it into
 place only when the last frame is written, so an interrupted run (Ctrl-C, a crash, an
 unstable simulation) never leaves a broken video: either the old file or a complete one.
-PNG folders get the same guarantee per file.
+A PNG folder's frames are gathered in a hidden folder inside it and moved into place at the
+end, so an interrupted run adds no frames either.
+
+Temporary names carry the writing process's id (``.NAME.PID.RANDOM.partial.SUFFIX``). A run
+killed outright (SIGKILL, a power cut) cannot clean up, so the next run that writes into the
+same folder removes the temporary files whose process no longer exists and that were last
+written before it started (see :func:`remove_stale_partials`). A process id taken again by
+another program keeps its file until that id is free.
 """
 
 from __future__ import annotations
 
+import errno
 import os
+import re
+import shutil
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
 
 __all__ = ["FrameWriter", "GifWriter", "Mp4Writer", "PngFolderWriter", "check_output", "open_writer",
-           "output_kind", "publish"]
+           "output_kind", "publish", "remove_stale_partials"]
 
 VIDEO_SUFFIXES = {".mp4": "mp4", ".gif": "gif"}
 
@@ -84,10 +95,80 @@ def check_folder(path, folder: Path) -> None:
 
 
 def temp_beside(target: Path) -> Path:
-    """A fresh hidden file next to ``target`` with the same suffix (ffmpeg picks formats by it)."""
-    fd, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=f".partial{target.suffix}", dir=target.parent)
+    """A fresh hidden file next to ``target`` with the same suffix (ffmpeg picks formats by it).
+
+    Its name carries this process's id, so a later run can tell it is stale; the first call per
+    folder removes the stale ones of earlier, killed runs (:func:`remove_stale_partials`).
+    """
+    target = Path(target)
+    _sweep_once(target.parent)
+    fd, name = tempfile.mkstemp(prefix=f".{target.stem}.{os.getpid()}.", suffix=f".partial{target.suffix}",
+                                dir=target.parent)
     os.close(fd)
     return Path(name)
+
+
+def temp_folder_in(folder: Path) -> Path:
+    """A fresh hidden folder inside ``folder``, named like :func:`temp_beside`'s files."""
+    _sweep_once(folder)
+    return Path(tempfile.mkdtemp(prefix=f".frames.{os.getpid()}.", suffix=".partial", dir=folder))
+
+
+# .NAME.PID.RANDOM.partial[.SUFFIX]: RANDOM is mkstemp's 8 characters
+_PARTIAL_NAME = re.compile(r"^\..*\.(?P<pid>\d+)\.[A-Za-z0-9_]{8}\.partial(\.[A-Za-z0-9]+)?$")
+_swept: set[str] = set()
+_STARTED = time.time()  # about when this process began: later files belong to runs going on now
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError, OSError):
+        return True  # someone else's live process (or an id we cannot ask about): keep its file
+    return True
+
+
+def remove_stale_partials(folder, *, before: float | None = None) -> list[Path]:
+    """Remove the temporary outputs in ``folder`` left by runs that were killed; returns them.
+
+    A temporary file or folder (``.NAME.PID.RANDOM.partial[.SUFFIX]``) is stale when no process
+    of that id exists and it was last written before ``before`` (a time stamp; default: when
+    this process started). The time test keeps the files of a run on another machine that
+    writes into a shared folder now. Errors (a file removed meanwhile, no permission) are
+    ignored: cleaning up is a courtesy, never a reason to fail a run.
+    """
+    before = _STARTED if before is None else before
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for e in entries:
+        m = _PARTIAL_NAME.match(e.name)
+        if m is None or _pid_alive(int(m.group("pid"))):
+            continue
+        try:
+            if e.stat(follow_symlinks=False).st_mtime >= before:
+                continue
+            if e.is_dir(follow_symlinks=False):
+                shutil.rmtree(e.path)
+            else:
+                os.unlink(e.path)
+            removed.append(Path(e.path))
+        except OSError:
+            pass
+    return removed
+
+
+def _sweep_once(folder) -> None:
+    key = os.path.abspath(folder)
+    if key not in _swept:
+        _swept.add(key)
+        remove_stale_partials(folder)
 
 
 def publish(tmp, target) -> None:
@@ -201,7 +282,26 @@ class Mp4Writer(FrameWriter):
             self._gen.send(None)
         if (w, h) != self._padded:
             frame = np.pad(frame, ((0, self._padded[1] - h), (0, self._padded[0] - w), (0, 0)), mode="edge")
-        self._gen.send(np.ascontiguousarray(frame))
+        try:
+            self._gen.send(np.ascontiguousarray(frame))
+        except OSError as e:  # BrokenPipeError too: ffmpeg stopped (a full disk, most often)
+            raise self._failed(e) from None
+
+    def _failed(self, exc: OSError) -> OSError:
+        """One line for a failed ffmpeg: imageio-ffmpeg's message adds the whole command line."""
+        no_space = any(getattr(x, "errno", None) in (errno.ENOSPC, errno.EDQUOT)
+                       for x in (exc, exc.__cause__, exc.__context__))
+        try:
+            # ffmpeg reports ENOSPC to itself; we only see the pipe break: look at the disk
+            no_space = no_space or shutil.disk_usage(self._tmp.parent).free < 16 * 2**20
+        except OSError:
+            pass
+        self._closed = True
+        self._discard()
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        why = "no space left on the device" if no_space else f"ffmpeg stopped ({first})"
+        return OSError(f"{self.path}: writing the video failed after {self.frames_written} frames: {why}; "
+                       f"nothing was written")
 
     def _commit(self):
         if self._gen is None:
@@ -209,10 +309,16 @@ class Mp4Writer(FrameWriter):
             raise ValueError(f"{self.path}: no frames were written")
         try:
             self._gen.close()
+        except OSError as e:
+            raise self._failed(e) from None
         except BaseException:
             self._tmp.unlink(missing_ok=True)
             raise
-        publish(self._tmp, self.path)
+        try:
+            publish(self._tmp, self.path)
+        except BaseException:
+            self._tmp.unlink(missing_ok=True)
+            raise
 
     def _discard(self):
         if self._gen is not None:
@@ -298,13 +404,16 @@ class GifWriter(FrameWriter):
 class PngFolderWriter(FrameWriter):
     """Numbered PNG frames ``frame_00000.png, ...`` in a folder (created if missing).
 
-    Each file is written under a temporary name and renamed, so every ``frame_*.png`` present
-    is complete. Frames from an earlier, longer run are not deleted.
+    The frames are written into a hidden folder inside it and moved into place when the last
+    one is written, so an interrupted or failed run adds no frames (and removes the folder if
+    it made it). Frames from an earlier, longer run are not deleted.
     """
 
     def __init__(self, path, *, fps: float, compress_level: int = 3):
         super().__init__(path, fps=fps)
         self.compress_level = compress_level
+        self._staging: Path | None = None
+        self._made_folder = False
 
     def frame_path(self, i: int) -> Path:
         return self.path / f"frame_{i:05d}.png"
@@ -312,23 +421,40 @@ class PngFolderWriter(FrameWriter):
     def _write(self, frame):
         from PIL import Image
 
-        if self.frames_written == 0:
-            self.path.mkdir(exist_ok=True)
-        target = self.frame_path(self.frames_written)
-        tmp = temp_beside(target)
+        if self._staging is None:
+            if not self.path.is_dir():
+                self.path.mkdir()
+                self._made_folder = True
+            self._staging = temp_folder_in(self.path)
+        target = self._staging / self.frame_path(self.frames_written).name
         try:
-            Image.fromarray(frame).save(tmp, format="PNG", compress_level=self.compress_level)
-            publish(tmp, target)
+            Image.fromarray(frame).save(target, format="PNG", compress_level=self.compress_level)
         except BaseException:
-            tmp.unlink(missing_ok=True)
+            target.unlink(missing_ok=True)
             raise
 
     def _commit(self):
         if self.frames_written == 0:
             raise ValueError(f"{self.path}: no frames were written")
+        try:
+            mask = os.umask(0)
+            os.umask(mask)
+            for i in range(self.frames_written):
+                staged = self._staging / self.frame_path(i).name
+                os.chmod(staged, 0o666 & ~mask)
+                os.replace(staged, self.frame_path(i))
+        finally:
+            self._discard()
 
     def _discard(self):
-        pass
+        if self._staging is not None:
+            shutil.rmtree(self._staging, ignore_errors=True)
+            self._staging = None
+        if self._made_folder:
+            try:
+                self.path.rmdir()  # only if empty: a committed run's frames stay
+            except OSError:
+                pass
 
 
 def open_writer(path, *, fps: float) -> FrameWriter:

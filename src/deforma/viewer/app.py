@@ -165,6 +165,8 @@ class Viewer:
         self._status_text = None
         self._screenshot_requests: list[str] = []
         self.last_screenshot: np.ndarray | None = None
+        #: screenshots that could not be saved: path -> why (a scripted run reports them)
+        self.screenshot_errors: dict[str, str] = {}
         self._keymap = self._make_keymap()
         pygame.display.set_caption(f"deforma - {name}")
 
@@ -562,12 +564,22 @@ class Viewer:
             img = self.screenshot()
             from PIL import Image
 
+            from ..render.video import publish, temp_beside
+
             for path in self._screenshot_requests:
+                tmp = None
                 try:
-                    Image.fromarray(img).save(path)
+                    # whole or not at all, like every other output: a full disk leaves no half PNG
+                    tmp = temp_beside(Path(path))
+                    Image.fromarray(img).save(tmp, format="PNG")
+                    publish(tmp, path)
+                    self.screenshot_errors.pop(path, None)
                     if self.panel_visible:
                         self.inspector.say(f"screenshot saved to {path}")
                 except (OSError, ValueError) as e:
+                    if tmp is not None:
+                        tmp.unlink(missing_ok=True)
+                    self.screenshot_errors[path] = str(e)
                     self.inspector.say(f"cannot save the screenshot: {e}", error=True)
             self._screenshot_requests.clear()
 
@@ -742,8 +754,9 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
         out = Path(screenshot)
         if out.suffix.lower() != ".png":
             raise ValueError(f"{screenshot}: a screenshot is written as PNG; give a name ending in .png")
-        if not out.parent.is_dir():
-            raise ValueError(f"{screenshot}: the folder {str(out.parent)!r} does not exist")
+        from ..render.video import check_folder
+
+        check_folder(screenshot, out.parent)  # exists and writable, before a window opens
     session = Session(scene)  # a bad scene fails before a window opens
     if wireframe:
         session.wireframe = True
@@ -758,6 +771,8 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
         v.run(frames=frames, screenshot=screenshot)
     finally:
         v.close()
+    if screenshot is not None and str(screenshot) in v.screenshot_errors:
+        raise OSError(f"{screenshot}: cannot save the screenshot: {v.screenshot_errors[str(screenshot)]}")
     return None
 
 
