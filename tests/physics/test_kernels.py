@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import deforma
-from deforma.physics import integrators
+from deforma.physics import symplectic
 from deforma.physics.colliders import Rect, collide_point, pack_rects
 from deforma.physics.forces import spring_force
 from physics_meshes import grid_mesh
@@ -64,7 +64,7 @@ def test_one_step_matches_a_numpy_symplectic_euler_step():
 @pytest.mark.parametrize("material", [None, "corotated", "neo-hookean"])
 def test_parallel_and_serial_steps_agree_exactly(material):
     runs = []
-    for kernel in (integrators.symplectic_euler_serial, integrators.symplectic_euler_parallel):
+    for kernel in (symplectic.symplectic_euler_serial, symplectic.symplectic_euler_parallel):
         w, b = perturbed_world(40)
         if material is not None:  # the same mesh as finite elements, with damping
             b.material = deforma.Material(material, youngs_modulus=100.0, poisson_ratio=0.3, density=4.0,
@@ -77,7 +77,7 @@ def test_parallel_and_serial_steps_agree_exactly(material):
         w._rebuild_grabs()
         m, s, inp = w._model, w._state, w._inputs
         fbuf = np.zeros((3, m.n_vertices, 2))  # the same 3 chunks of springs and elements for both
-        chunks, elem_chunks, verts = integrators.merged_chunks(m.spring_i, m.spring_j, m.elem, 3)
+        chunks, elem_chunks, verts = symplectic.merged_chunks(m.spring_i, m.spring_j, m.elem, 3)
         for _ in range(50):
             kernel(s.x, s.v, s.x_start, s.v_start, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
                    m.spring_stiffness, m.spring_damping, elem_chunks, m.elem, m.elem_b, m.elem_area, m.elem_mu,
@@ -119,7 +119,7 @@ def test_world_results_do_not_depend_on_the_threading_mode():
 
 
 def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_loses():
-    integ = integrators.SymplecticEuler()
+    integ = symplectic.SymplecticEuler()
     integ._samples = {"parallel": [1.0, 1.2, 0.9], "serial": [2.0, 2.1, 1.9]}
     integ._estimate = {"parallel": 1.0, "serial": 2.0}
     picks = [integ._choose() for _ in range(200)]

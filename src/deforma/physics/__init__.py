@@ -5,6 +5,7 @@
 collider leaf. See ``docs/physics.md`` for the model and the friction scheme.
 """
 
+from . import symplectic, implicit, xpbd  # noqa: F401, I001  (each registers its integrator; the default first)
 from .colliders import Rect
 from .integrators import available_integrators, register_integrator
 from .material import Material

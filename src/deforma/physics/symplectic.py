@@ -1,0 +1,352 @@
+"""The symplectic (semi-implicit) Euler integrator, ``"symplectic-euler"``: the default.
+
+Semi-implicit (symplectic) Euler, per substep::
+
+    v = (v + h * F(x, v) / m) / (1 + h * air_drag)
+    x += h * v
+    x, v = collide(x_before, x, v)              # colliders, per vertex
+    x, v = push_edges_off_corners(x, v)         # collider corners against body outlines
+    x, v = contact_stage(x_before, x, v)        # bodies against bodies and themselves
+
+Every integrator ends its substeps with the same two responses: the collider response per
+vertex (fused into its last pass over the vertices) and then the body contact stage of
+:mod:`~deforma.physics.contacts` (collide, solve, verify), which needs the boundary's
+positions at the start of the substep (``contacts.gather_start``).
+
+It is fused into two passes over memory per substep: springs, each thread scattering a
+contiguous run of them into its own force buffer, then one per-vertex pass that sums the
+buffers, adds gravity and the grab pull, integrates, collides and checks the result. Both
+passes use all of Numba's threads for bodies big enough to pay for waking them
+(``PARALLEL_MIN_VERTICES``, measured in ``benchmarks/``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+
+import numba
+import numpy as np
+from numba import njit, prange
+
+from .colliders import (RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, jump_reach,
+                        push_edges_off_corners, record_hit)
+from .contacts import ST_STAMP, contact_stage, gather_start
+from .elements import element_forces
+from .forces import spring_force
+from .integrators import register_integrator
+from .jit import serial_and_parallel
+
+# Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
+PARALLEL_MIN_VERTICES = 512
+
+
+@njit(cache=True, inline="always")
+def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, keep, h):
+    # keep = 1 / (1 + h air_drag): the drag -air_drag v taken at the end of the substep (stable at any h)
+    vx = (vx + h * (fx * inv_mass + gx)) * keep
+    vy = (vy + h * (fy * inv_mass + gy)) * keep
+    return x0 + h * vx, y0 + h * vy, vx, vy
+
+
+@njit(cache=True)
+def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
+    """Add the force (N) of every spring to both of its ends in ``f`` (N, 2).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.zeros((2, 2))
+    >>> scatter_spring_forces(np.array([[0., 0.], [2., 0.]]), np.zeros((2, 2)), np.array([0], np.int32),
+    ...                       np.array([1], np.int32), np.ones(1), np.full(1, 10.0), np.zeros(1), f)
+    >>> f.tolist()
+    [[10.0, 0.0], [-10.0, 0.0]]
+    """
+    # Indices that Numba knows are >= 0 skip its negative-index wraparound test: the loop
+    # runs over range(len) (not range(lo, hi)) and vertex ids are read as unsigned; together
+    # this made the kernel 25-35% faster.
+    for e in range(spring_i.shape[0]):
+        a = np.uint64(spring_i[e])
+        b = np.uint64(spring_j[e])
+        fx, fy = spring_force(x[a, 0], x[a, 1], x[b, 0], x[b, 1], v[a, 0], v[a, 1], v[b, 0], v[b, 1],
+                              rest[e], ks[e], kd[e])
+        f[a, 0] += fx
+        f[a, 1] += fy
+        f[b, 0] -= fx
+        f[b, 1] -= fy
+
+
+# Both drivers below run the same two passes per substep:
+#   1. springs, split into len(chunk_ptr) - 1 contiguous chunks, each scattered into its own
+#      force buffer fbuf[t] (no two threads write the same buffer, so no races);
+#   2. per vertex: sum and re-zero the buffers, add gravity and the grab pull, integrate,
+#      collide, check. One chunk gives the serial step.
+# The per-vertex body is spelled out rather than split into helpers that take arrays: each
+# array passed to a compiled helper per vertex costs atomic reference-count updates that
+# Numba does not always prune (a helper taking a dozen arrays made the step 10x slower).
+# Scalar-only helpers are free.
+
+def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
+                      elem_ptr, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind, elem_damped,
+                      inv_mass, gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps,
+                      vmax2):
+    """``substeps`` symplectic Euler substeps of ``h`` s with collisions.
+
+    ``fbuf`` (T, N, 2) are zeroed force buffers, one per chunk ``t`` of springs
+    (``chunk_ptr[t]:chunk_ptr[t + 1]``) and of triangle elements (``elem_ptr[t]:elem_ptr[t +
+    1]``; see :mod:`deforma.physics.elements` for ``elem*``), and are left zeroed; chunk
+    ``t`` touches only the vertices ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see
+    :func:`spring_chunks`). A vertex with ``inv_mass`` 0 is pinned: it stays where it is. Saves the start state into ``x_start`` /
+    ``v_start``; stops early and returns the number of vertices that ended non-finite or
+    faster than ``sqrt(vmax2)`` m/s (or 0 at once when the contact buffer ``cbuf`` is too
+    small: ``cscr.status`` says so). ``hits`` records collider contacts (written only on a
+    hit); ``ctopo``, ``cscr``, ``cbuf``: the contact stage's topology, scratch and buffer.
+
+    Compiled twice below: ``symplectic_euler_serial`` (one thread: ``prange`` is ``range``)
+    and ``symplectic_euler_parallel`` (one spring chunk per thread, the vertex pass split
+    across threads); both give the same result for the same chunks.
+    """
+    n_chunks = chunk_ptr.shape[0] - 1
+    reach2 = jump_reach(rects)
+    for sub in range(substeps):
+        gather_start(x, ctopo, cscr)
+        stamp = cscr.status[ST_STAMP] + 1  # the contact stage counts this substep when it runs
+        for t in prange(n_chunks):
+            lo, hi = chunk_ptr[t], chunk_ptr[t + 1]
+            scatter_spring_forces(x, v, spring_i[lo:hi], spring_j[lo:hi], rest[lo:hi], ks[lo:hi], kd[lo:hi], fbuf[t])
+            lo, hi = elem_ptr[t], elem_ptr[t + 1]
+            if hi > lo:
+                element_forces(x, v, elem[lo:hi], elem_b[lo:hi], elem_area[lo:hi], elem_mu[lo:hi], elem_lam[lo:hi],
+                               elem_beta[lo:hi], elem_kind[lo:hi], elem_damped, fbuf[t])
+        save = sub == 0
+        bad = 0
+        for i in prange(x.shape[0]):
+            x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
+            if save:
+                x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
+            if n_chunks == 1:  # one buffer over every vertex: no range test (~7% of a 1e3-vertex step)
+                fx = fbuf[0, i, 0]
+                fy = fbuf[0, i, 1]
+                fbuf[0, i, 0] = 0.0
+                fbuf[0, i, 1] = 0.0
+            else:
+                fx = 0.0
+                fy = 0.0
+                for t in range(n_chunks):
+                    if chunk_vertices[t, 0] <= i < chunk_vertices[t, 1]:  # only where chunk t wrote
+                        fx += fbuf[t, i, 0]
+                        fy += fbuf[t, i, 1]
+                        fbuf[t, i, 0] = 0.0
+                        fbuf[t, i, 1] = 0.0
+            g = grab_slot[i]
+            if g >= 0:  # the grab pull: strength * (target - x), summed over the grabs holding i
+                fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
+                fy += grab_pull[g, 2] - grab_pull[g, 0] * y0
+            if inv_mass[i] == 0.0:  # pinned: it stays (its buffers are re-zeroed above)
+                v[i, 0] = 0.0
+                v[i, 1] = 0.0
+                continue
+            px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass[i], gx, gy, keep, h)
+            near = False
+            for r in range(rects.shape[0]):  # broad phase: bounding boxes (a helper for these
+                # lines, even inlined, costs reference counting on rects per vertex: 2.5x slower)
+                if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
+                    near = True
+            if near or (px - x0) * (px - x0) + (py - y0) * (py - y0) > reach2:  # or it may have jumped one
+                px, py, vx, vy, hit, nx, ny, depth = collide_point(x0, y0, px, py, vx, vy, rects, h)
+                if hit >= 0:
+                    record_hit(hits, i, stamp, hit, nx, ny, depth)
+            x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
+            bad += is_bad(px, py, vx, vy, vmax2)
+        if bad:
+            return bad
+        push_edges_off_corners(x, v, inv_mass, ctopo.ce_a, ctopo.ce_b, ctopo.cv_vertex, rects)
+        if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
+            return 0
+    return 0
+
+
+symplectic_euler_serial, symplectic_euler_parallel = serial_and_parallel(_symplectic_euler, "symplectic_euler")
+
+
+def element_chunks(elem, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
+    """Split the elements into ``n_chunks`` equal runs, as :func:`spring_chunks` does springs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ptr, verts = element_chunks(np.array([[0, 1, 2], [1, 3, 2]], np.int32), 2)
+    >>> ptr.tolist(), verts.tolist()
+    ([0, 1, 2], [[0, 3], [1, 4]])
+    """
+    return _row_chunks(elem, n_chunks)
+
+
+def _row_chunks(rows, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n_chunks`` equal runs of the rows of an (E, k) vertex-index array, and the vertex range each touches."""
+    n = len(rows)
+    ptr = (np.arange(n_chunks + 1, dtype=np.int64) * n) // n_chunks
+    verts = np.zeros((n_chunks, 2), np.int64)
+    for t in range(n_chunks):
+        lo, hi = ptr[t], ptr[t + 1]
+        if hi > lo:
+            verts[t] = rows[lo:hi].min(), rows[lo:hi].max() + 1
+    return ptr, verts
+
+
+def merged_chunks(spring_i, spring_j, elem, n_chunks: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Spring and element runs per chunk and the vertices each chunk touches (both runs).
+
+    Returns ``(spring_ptr, elem_ptr, chunk_vertices)``.
+    """
+    sp_ptr, sp_v = spring_chunks(spring_i, spring_j, n_chunks)
+    el_ptr, el_v = element_chunks(elem, n_chunks)
+    verts = np.zeros((n_chunks, 2), np.int64)
+    for t in range(n_chunks):
+        ranges = [r for r, used in ((sp_v[t], sp_ptr[t + 1] > sp_ptr[t]), (el_v[t], el_ptr[t + 1] > el_ptr[t]))
+                  if used]
+        if ranges:
+            verts[t] = min(r[0] for r in ranges), max(r[1] for r in ranges)
+    return sp_ptr, el_ptr, verts
+
+
+def spring_chunks(spring_i, spring_j, n_chunks: int) -> tuple[np.ndarray, np.ndarray]:
+    """Split the springs into ``n_chunks`` equal runs; say which vertices each run touches.
+
+    Returns ``(chunk_ptr, chunk_vertices)``: run ``t`` is springs ``chunk_ptr[t]:chunk_ptr[t +
+    1]`` and touches only vertices ``chunk_vertices[t, 0]:chunk_vertices[t, 1]``. Springs
+    are sorted by their first vertex, so on a mesh numbered row by row each run covers a
+    narrow band of vertices: its force buffer stays in cache and the vertex pass reads a
+    buffer only where its run wrote.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ptr, verts = spring_chunks(np.array([0, 0, 1, 2], np.int32), np.array([1, 2, 3, 3], np.int32), 2)
+    >>> ptr.tolist(), verts.tolist()
+    ([0, 2, 4], [[0, 3], [1, 4]])
+    """
+    return _row_chunks(np.stack([spring_i, spring_j], axis=1), n_chunks)
+
+
+@register_integrator("symplectic-euler")
+class SymplecticEuler:
+    """Semi-implicit Euler (the original's): ``v += h F/m; x += h v``, then collisions.
+
+    Stable for ``h`` below roughly ``2 / omega_max`` (see ``World.stable_dt``); energy
+    stays bounded without damping.
+
+    Bodies of at least ``PARALLEL_MIN_VERTICES`` vertices split their springs into one
+    chunk per Numba thread, and both the one-thread and the all-threads driver then give
+    bitwise the same result. Which one runs is measured, not assumed: threads that meet at
+    a barrier every pass are fast on an idle machine but can be 100x slower when other
+    processes keep the cores busy, so now and then two steps run on the other driver (every
+    16 steps, backing off to every 4096 while it keeps losing) and the faster one (median of
+    its last three timed steps) is used. Set ``mode`` to ``"serial"`` or ``"parallel"`` to
+    pin one (benchmarks, tests).
+
+    Examples
+    --------
+    >>> from deforma.physics.integrators import make_integrator
+    >>> make_integrator("symplectic-euler").name
+    'symplectic-euler'
+    """
+
+    name = "symplectic-euler"
+
+    def __init__(self):
+        self._fbuf = np.zeros((0, 0, 2))
+        self._model = None
+        self._chunks = np.zeros(1, np.int64)
+        self._elem_chunks = np.zeros(1, np.int64)
+        self._chunk_vertices = np.zeros((0, 2), np.int64)
+        self._threads = None  # numba.get_num_threads(), re-read every 1024 steps
+        self._ticks = 0
+        self._reset_timing()
+        self.mode = "auto"
+
+    def _reset_timing(self):
+        self._samples = {"serial": [], "parallel": []}  # recent seconds per substep
+        self._estimate = {"serial": math.inf, "parallel": math.inf}
+        self._last = None  # driver of the previous call
+        self._calls = 0  # calls since the last probe
+        self._probing = 0  # calls of the other driver still to make
+        self._probe_every = 16
+        self._last_best = None
+
+    def _choose(self) -> str:
+        smp = self._samples
+        for k in ("parallel", "serial"):
+            if len(smp[k]) < 3:
+                return k
+        est = self._estimate
+        best, other = ("parallel", "serial") if est["parallel"] <= est["serial"] else ("serial", "parallel")
+        if self._probing:
+            self._probing -= 1
+            return other
+        self._calls += 1
+        if self._calls < self._probe_every:
+            return best
+        # Probe the other driver for two calls (only the second is timed: the first wakes
+        # sleeping threads and warms caches). A probe can cost 100x a step when the cores
+        # are busy, so probe less often while it keeps losing, often again once it wins.
+        self._calls, self._probing = 0, 1
+        if est[other] > 10 * est[best]:  # hopeless (cores taken): look again much later
+            self._probe_every = 4096
+        elif best != self._last_best:
+            self._probe_every = 16
+        else:
+            self._probe_every = min(2 * self._probe_every, 4096)
+        self._last_best = best
+        return other
+
+    def advance(self, model, state, inputs, h, substeps):
+        n = model.n_vertices
+        self._ticks += 1
+        if self._ticks >= 1024 or self._threads is None:  # costs 1 us: a few % of a small step
+            self._ticks, self._threads = 0, numba.get_num_threads()
+        threads = self._threads
+        # the chunking, and so the result, depends on the body size and thread count only
+        n_chunks = threads if n >= PARALLEL_MIN_VERTICES and threads > 1 else 1
+        may_parallel = n_chunks > 1 and self.mode != "serial"
+        if self._model is not model or self._fbuf.shape[:2] != (n_chunks, n):
+            # scratch kept between steps: the kernels allocate nothing and leave it zeroed
+            self._model = model  # a new Model means new topology: new chunks
+            self._fbuf = np.zeros((n_chunks, n, 2))
+            self._chunks, self._elem_chunks, self._chunk_vertices = merged_chunks(
+                model.spring_i, model.spring_j, model.elem, n_chunks)
+            self._reset_timing()
+        if self.mode not in ("auto", "serial", "parallel"):
+            raise ValueError(f"mode must be 'auto', 'serial' or 'parallel', got {self.mode!r}")
+        if not may_parallel:
+            which = "serial"
+        elif self.mode == "parallel":
+            which = "parallel"
+        else:
+            which = self._choose()
+        kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
+        gx, gy = inputs.gravity
+        start = time.perf_counter()
+        bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks, self._chunk_vertices,
+                     model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
+                     model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
+                     model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
+                     bool(model.elem_damping.any()), model.vertex_inv_mass, float(gx), float(gy),
+                     1.0 / (1.0 + float(h) * inputs.air_drag), inputs.grab_slot,
+                     inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch,
+                     inputs.contacts,
+                     float(h), int(substeps), float(inputs.max_speed) ** 2)
+        if may_parallel:
+            took = (time.perf_counter() - start) / substeps
+            if which == self._last:  # the driver ran last call too: threads awake, caches warm
+                smp = self._samples[which]
+                smp.append(took)
+                del smp[:-3]
+                self._estimate[which] = sorted(smp)[len(smp) // 2]  # median: one outlier is ignored
+            self._last = which
+        return bad
+
+
+# Registered after SymplecticEuler so that it stays first (the default) in the listing; the
+# two modules import register_integrator from this one, which is complete by now.
