@@ -52,4 +52,4 @@ def limit_and_yield(model, state, dt: float) -> None:
             if t1 > t0 and yield_elements(state.x, model.elem[t0:t1], model.elem_b[t0:t1], model.elem_area[t0:t1],
                                           model.elem_b0[t0:t1], model.elem_area0[t0:t1], mat.yield_strain,
                                           mat.plastic_rate):
-                model.rest_version += 1
+                model.version += 1

@@ -212,9 +212,10 @@ class Model:
     spring_rest_length0, elem_b0, elem_area0 : arrays
         The rest shape as built: plasticity (:mod:`deforma.physics.plasticity`) moves
         ``spring_rest_length``, ``elem_b`` and ``elem_area`` and bounds them against these.
-    rest_version : int
-        Incremented whenever a rest shape changes in place (solvers that factor a matrix of
-        it refactor).
+    version : int
+        Incremented by every change of a parameter or rest shape made in place (the
+        ``set_*`` methods, plasticity): a solver that keeps something built from the
+        Model (a factored matrix) compares it instead of the arrays.
     pressure_a, pressure_b : (P,) int32
         Directed outline edges (global vertex indices, gas on the left) of the bodies that
         hold a gas (:mod:`deforma.physics.pressure`); ``body_pressure_offsets`` (B + 1,) says
@@ -238,6 +239,7 @@ class Model:
     def __init__(self, topologies, *, masses, stiffness, damping, materials=None, pinned=None, contact=None,
                  pressure=None):
         self.topologies = list(topologies)
+        self.version = 0
         nb = len(self.topologies)
         materials = [None] * nb if materials is None else list(materials)
         fem = [m is not None and m.is_fem for m in materials]
@@ -295,7 +297,6 @@ class Model:
         self.spring_rest_length0 = self.spring_rest_length.copy()
         self.elem_b0 = self.elem_b.copy()
         self.elem_area0 = self.elem_area.copy()
-        self.rest_version = 0
         self._pressure(pressure if pressure is not None else [None] * nb)
 
         # The contact stage's view: the collision vertices are every body's outline vertices,
@@ -435,6 +436,7 @@ class Model:
         return cache[body]
 
     def _inverse_masses(self, v0, v1):
+        self.version += 1  # every set_* that changes masses, springs or elements comes here
         # a pinned vertex has infinite mass: no force, impulse or projection moves it
         self.vertex_inv_mass[v0:v1] = np.where(self.pinned[v0:v1], 0.0, 1.0 / self.vertex_mass[v0:v1])
 
