@@ -268,3 +268,56 @@ def test_view_screenshot_that_cannot_be_saved_fails(tmp_path):
     assert r.returncode == EXIT_ERROR and r.stdout == ""
     assert "cannot save the screenshot" in one_line_error(r.stderr)
     assert os.listdir(tmp_path) == ["s.png"] and os.listdir(tmp_path / "s.png") == []
+
+
+# -- viewer sizes and deep TOML -----------------------------------------------------------------------
+@pytest.mark.parametrize("size", ["640x214", "100x100", "320x180", "639x720", "1280x271"])
+def test_view_refuses_a_window_smaller_than_its_layout(capsys, size):
+    from deforma.viewer.app import MIN_WINDOW_SIZE
+
+    with pytest.raises(SystemExit) as e:
+        main(["view", "sample", "--frames", "1", "--size", size])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert f"window size {size} is too small for the viewer: at least {MIN_WINDOW_SIZE[0]}x{MIN_WINDOW_SIZE[1]}" in err
+
+
+def test_the_smallest_window_matches_the_inspector_layout():
+    from deforma.viewer import inspector
+    from deforma.viewer.app import MIN_WINDOW_SIZE, check_window_size
+
+    assert MIN_WINDOW_SIZE == (inspector.PANEL_WIDTH + 300, inspector.TOP + 4 * inspector.ROW + inspector.MESSAGE_HEIGHT)
+    assert check_window_size(MIN_WINDOW_SIZE) == MIN_WINDOW_SIZE
+    with pytest.raises(ValueError, match="at least 640x272"):
+        check_window_size((640, 271))
+
+
+def test_view_runs_at_the_smallest_window_with_an_unstable_scene(tmp_path):
+    # at 320x180 an unstable scene asked for a message box of negative width
+    import os
+    import subprocess
+    import sys
+
+    from deforma.viewer.app import MIN_WINDOW_SIZE
+
+    unstable = "[physics]\ndt = 0.02\nstiffness = 50000.0\n[[body]]\ndetail = 4\nposition = [0.0, 1.0]\n" \
+               "[[collider]]\ncenter = [0.0, 0.0]\nsize = [5.0, 0.5]\n"
+    (tmp_path / "boom.toml").write_text(unstable)
+    w, h = MIN_WINDOW_SIZE
+    env = dict(os.environ, SDL_VIDEODRIVER="offscreen")
+    for scene in ("sample", "boom.toml"):
+        r = subprocess.run([sys.executable, "-m", "deforma.cli", "view", scene, "--frames", "30", "--size", f"{w}x{h}",
+                            "--screenshot", "s.png"], capture_output=True, text=True, env=env, timeout=120,
+                           cwd=tmp_path)
+        assert r.returncode == 0, r.stderr
+        assert Image.open(tmp_path / "s.png").size == (w, h)
+
+
+def test_deeply_nested_toml_names_the_file(tmp_path, capsys):
+    p = tmp_path / "deep.toml"
+    p.write_text("[[body]]\nvertices = " + "[" * 5000 + "]" * 5000 + "\n")
+    code, _, err = run(capsys, "run", p)
+    assert code == EXIT_ERROR
+    line = one_line_error(err)
+    assert str(p) in line and "nested too deep" in line

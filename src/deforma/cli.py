@@ -78,6 +78,19 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _window_size(text: str) -> tuple[int, int]:
+    """``view --size``: a size as for ``run``, and at least the viewer's smallest layout."""
+    w, h = _size(text)
+    try:
+        from .viewer.app import check_window_size
+    except ImportError:  # pragma: no cover - no viewer packages: cmd_view says so
+        return w, h
+    try:
+        return check_window_size((w, h))
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
 def _positive(kind, *, hi=None):
     def parse(text):
         try:
@@ -143,7 +156,8 @@ def _parser() -> argparse.ArgumentParser:
                                    "there is no display) and can save the last one.")
     v.add_argument("scene", metavar="SCENE", nargs="?", default="demo",
                    help="built-in scene name or a .toml file (default: demo)")
-    v.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="window size (default 1280x720)")
+    v.add_argument("--size", type=_window_size, default=(1280, 720), metavar="WxH",
+                   help="window size (default 1280x720, at least 640x272)")
     v.add_argument("--frames", type=_positive(int), metavar="N", help="run N frames, then close")
     v.add_argument("--screenshot", metavar="OUT.png", help="with --frames: save the last frame")
     v.add_argument("--no-panel", action="store_true", help="start with the inspector hidden (Tab shows it)")

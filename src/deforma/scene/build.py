@@ -39,6 +39,11 @@ class _Record:
 _REGISTRY: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
+#: Deepest nesting of arrays and tables a scene needs (a mesh body's vertex list is
+#: [[body]] > vertices > [x, y]); only named when a file is nested past what the reader handles.
+SCENE_MAX_NESTING = 4
+
+
 def load(name_or_path) -> Scene:
     """Read and validate a scene: a built-in name (``deforma scenes`` lists them) or a ``.toml`` path.
 
@@ -70,7 +75,15 @@ def load(name_or_path) -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"{shown}: invalid TOML: {e}") from None
-    scene = parse_scene(data, source=shown, base_dir=path.resolve().parent)
+    except RecursionError:
+        # arrays or tables nested hundreds deep: the TOML reader recurses once per level
+        raise SceneError(f"{shown}: invalid TOML: arrays or tables nested too deep for the reader "
+                         f"(a scene needs at most {SCENE_MAX_NESTING} levels)") from None
+    try:
+        scene = parse_scene(data, source=shown, base_dir=path.resolve().parent)
+    except RecursionError:
+        raise SceneError(f"{shown}: values nested too deep (a scene needs at most {SCENE_MAX_NESTING} "
+                         f"levels)") from None
     return replace(scene, path=str(path.resolve()))
 
 

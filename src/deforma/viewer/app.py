@@ -29,6 +29,27 @@ from .clock import FixedStepClock
 from .controls import KEYS, help_rows
 from .session import Session
 
+#: Smallest window (pixels) the viewer lays out: the inspector panel (340 px wide: 104 px of
+#: buttons, a scrolling list showing at least 4 rows of 26 px, a 64 px message box) beside a
+#: world area of 300 px, which holds the 260 px "unstable" message box. Smaller windows broke
+#: inside pygame_gui (a scroll bar with no room divides by zero or recurses without end) or
+#: asked for a message box of negative width (issue 17); the panel can be shown at any time
+#: (Tab), so the size is checked with the panel. Kept equal to ``inspector``'s constants by a test.
+MIN_WINDOW_SIZE = (340 + 300, 104 + 4 * 26 + 64)
+
+
+def check_window_size(size) -> tuple[int, int]:
+    """``size`` as two ints, or ValueError naming it and :data:`MIN_WINDOW_SIZE`."""
+    try:
+        w, h = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise ValueError(f"size must be (width, height) in pixels, got {size!r}") from None
+    mw, mh = MIN_WINDOW_SIZE
+    if w < mw or h < mh:
+        raise ValueError(f"window size {w}x{h} is too small for the viewer: at least {mw}x{mh} pixels "
+                         f"(the inspector panel and the world beside it)")
+    return w, h
+
 __all__ = ["Viewer", "run"]
 
 #: Simulated seconds per frame in ``frames=N`` mode (a 60 Hz display).
@@ -105,8 +126,8 @@ class Viewer:
         import pygame
 
         self.pg = pygame
+        self.window_size = check_window_size(size)
         self.session = session = scene if isinstance(scene, Session) else Session(scene)
-        self.window_size = (int(size[0]), int(size[1]))
         self._open_window(vsync=vsync, samples=samples)
         import moderngl
 
@@ -205,7 +226,8 @@ class Viewer:
         return (w, h)
 
     def _resize(self, size) -> None:
-        self.window_size = (max(200, int(size[0])), max(200, int(size[1])))
+        # a window dragged smaller is laid out at the smallest size (the rest is cut off)
+        self.window_size = (max(MIN_WINDOW_SIZE[0], int(size[0])), max(MIN_WINDOW_SIZE[1], int(size[1])))
         message = (self.inspector.message, self.inspector.message_is_error)
         self.inspector = self._Inspector(self.session, self.window_size[1], save_path=self.inspector.save_entry.get_text(),
                                          actions=self._actions)
@@ -750,6 +772,7 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
     RuntimeError
         No OpenGL window can be opened; ValueError for a bad scene or output path.
     """
+    size = check_window_size(size)
     if screenshot is not None:
         out = Path(screenshot)
         if out.suffix.lower() != ".png":
