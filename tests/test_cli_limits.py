@@ -321,3 +321,25 @@ def test_deeply_nested_toml_names_the_file(tmp_path, capsys):
     assert code == EXIT_ERROR
     line = one_line_error(err)
     assert str(p) in line and "nested too deep" in line
+
+
+def test_a_sigkilled_runs_temporary_file_is_removed_by_the_next_run(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import time
+
+    p = subprocess.Popen([_exe(), "run", "sample", "--seconds", "120", "--size", "64x48", "-o", "big.mp4", "--quiet"],
+                         cwd=tmp_path, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + 60
+    while time.time() < deadline and not any(".partial" in f for f in os.listdir(tmp_path)):
+        time.sleep(0.05)
+    time.sleep(0.3)
+    os.killpg(p.pid, signal.SIGKILL)
+    p.wait(timeout=30)
+    assert any(".partial" in f for f in os.listdir(tmp_path))  # nothing could clean up
+    time.sleep(0.05)  # the next run starts strictly after the file was last written
+    r = subprocess.run([_exe(), "run", "sample", "--seconds", "0.1", "--fps", "10", "--size", "64x48", "--quiet",
+                        "-o", "small.gif"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert os.listdir(tmp_path) == ["small.gif"]
