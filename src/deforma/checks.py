@@ -37,6 +37,7 @@ LIMITS = {
     "contact_thickness": (1e-9, 1e3),   # m
     "pressure": (0.0, 1e12),            # N/m
     "max_speed": (1e-9, 1e100),         # m/s (inf allowed: no speed check)
+    "scale": (1e-9, 1e3),               # m per pixel of a picture (its side is capped in pixels)
 }
 #: Largest coordinate or size of anything placed in a world (m), and of gravity (m/s^2).
 MAX_COORDINATE = 1e9

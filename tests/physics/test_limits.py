@@ -120,3 +120,14 @@ def test_a_scene_with_a_vanishing_step_is_refused_by_the_command(tmp_path):
     assert r.returncode != 0
     assert "dt must be in [1e-06, 0.1] s" in r.stderr and "Traceback" not in r.stderr
     assert not out.exists() and list(tmp_path.iterdir()) == [scene]
+
+
+def test_sizes_that_would_overflow_are_refused_where_they_enter():
+    with pytest.raises(ValueError, match=r"scale must be in \[1e-09, 1000\] m per pixel"):
+        deforma.mesh.from_image("bunny", resolution=8, scale=1e300)
+    with pytest.raises(ValueError, match="corners must lie within"):
+        deforma.mesh.box(((0, 0), (1e300, 0), (1e300, 1e300), (0, 1e300)), detail=2)
+    w = deforma.World()
+    with pytest.raises(ValueError, match="vertices must lie within"):
+        w.add_body(deforma.mesh.Mesh([[0, 0], [1e12, 0], [0, 1e12]], [[0, 1, 2]]))
+    assert not w.bodies

@@ -6,6 +6,7 @@ import operator
 
 import numpy as np
 
+from ..checks import MAX_COORDINATE
 from .delaunay import delaunay
 from .mesh import Mesh
 
@@ -160,6 +161,8 @@ def _check_corners(corners) -> np.ndarray:
         raise ValueError(f"corners must be four (x, y) pairs, shape (4, 2), got shape {c.shape}")
     if not np.all(np.isfinite(c)):
         raise ValueError("corners must be finite numbers (no NaN or inf)")
+    if np.abs(c).max() > MAX_COORDINATE:
+        raise ValueError(f"corners must lie within +-{MAX_COORDINATE:g} m, got {np.abs(c).max():g}")
     size = float(np.ptp(c, axis=0).max())
     if size == 0.0:
         raise ValueError("corners are all the same point; they must span a convex quadrilateral")

@@ -59,6 +59,7 @@ from numba import njit
 from PIL import Image, UnidentifiedImageError
 from scipy import ndimage
 
+from ..checks import positive
 from . import quality
 from .delaunay import delaunay
 from .mesh import Mesh, split_pinches
@@ -197,12 +198,7 @@ def from_image(
     limit = _check_int("max_points", max_points, 3)
     if not isinstance(detect_edges, (bool, np.bool_)):
         raise ValueError(f"detect_edges must be True or False, got {detect_edges!r}")
-    try:
-        scale = float(scale)
-    except (TypeError, ValueError):
-        raise ValueError(f"scale must be a number of metres per pixel > 0, got {scale!r}") from None
-    if not (np.isfinite(scale) and scale > 0):
-        raise ValueError(f"scale must be a finite number of metres per pixel > 0, got {scale!r}")
+    scale = positive(scale, "scale", "m per pixel")
 
     pic = _load(source, background, threshold)
     field, level, by_alpha = pic.field, pic.level, pic.by_alpha

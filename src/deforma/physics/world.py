@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import MAX_GRAVITY, MAX_SUBSTEPS, MIN_SUBSTEP
+from ..checks import MAX_COORDINATE, MAX_GRAVITY, MAX_SUBSTEPS, MIN_SUBSTEP
 from ..checks import non_negative as _non_negative
 from ..checks import number as _finite
 from ..checks import pair as _pair
@@ -398,6 +398,8 @@ class World:
         x = np.array(vertices, dtype=np.float64)
         if x.ndim == 2 and x.shape[1] == 2 and len(x) and position is not None:
             x += np.asarray(_pair(position, "position")) - (x.min(axis=0) + x.max(axis=0)) / 2
+        if x.ndim == 2 and x.size and np.all(np.isfinite(x)) and np.abs(x).max() > MAX_COORDINATE:
+            raise ValueError(f"a body's vertices must lie within +-{MAX_COORDINATE:g} m, got {np.abs(x).max():g}")
         topo = BodyTopology.from_arrays(x, edges, getattr(mesh, "triangles", None))
         material = _material(material)
         effective = material if material is not None else self._material
