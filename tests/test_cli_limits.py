@@ -192,7 +192,8 @@ def test_the_temporary_files_of_killed_runs_are_removed_by_the_next_run(tmp_path
     other = tmp_path / ".notes.partial.txt"  # not ours: kept
     for f in (alive, other):
         f.write_bytes(b"keep")
-    old = time.time() - 60
+    # last written before this (long-running) test process began: a day ago
+    old = time.time() - 86400
     for f in (*stale, staged, alive, other):
         os.utime(f, (old, old))
     code, _, err = run(capsys, "run", "sample", "--seconds", "0.1", "--fps", "10", "--size", "64x48", "--quiet",
