@@ -240,6 +240,7 @@ class Model:
                  pressure=None):
         self.topologies = list(topologies)
         self.version = 0
+        self._attachments = {}  # body -> its long-range attachments, until the pins change
         nb = len(self.topologies)
         materials = [None] * nb if materials is None else list(materials)
         fem = [m is not None and m.is_fem for m in materials]
@@ -342,7 +343,7 @@ class Model:
                 self.set_contact_parameters(b, **contact[b])
 
     def _pressure(self, pressure) -> None:
-        from .pressure import outline_loops
+        from .pressure import enclosed_area, outline_loops
 
         nb = len(self.topologies)
         loops = [np.zeros((0, 2), np.int32)] * nb
@@ -352,9 +353,7 @@ class Model:
             if p is None:
                 continue
             loops[b] = outline_loops(t.rest_positions, t.boundary_edges, t.springs, t.triangles)
-            x = t.rest_positions
-            a, c = x[loops[b][:, 0]], x[loops[b][:, 1]]
-            self.body_pressure_area[b] = 0.5 * float(np.sum(a[:, 0] * c[:, 1] - c[:, 0] * a[:, 1]))
+            self.body_pressure_area[b] = enclosed_area(t.rest_positions, loops[b][:, 0], loops[b][:, 1])
             self.body_pressure[b] = p
             loops[b] = loops[b] + self.body_vertex_offsets[b]
         self.body_pressure_offsets = np.zeros(nb + 1, np.int64)
@@ -424,7 +423,7 @@ class Model:
         """Body ``body``'s long-range attachments to its pins (body-local anchor index and path
         length, m; see :func:`deforma.physics.strain_limit.attachments`), cached until the pins
         change."""
-        cache = self.__dict__.setdefault("_attachments", {})
+        cache = self._attachments
         if body not in cache:
             from .strain_limit import attachments
 

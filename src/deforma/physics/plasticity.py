@@ -21,7 +21,6 @@ flow (its stretch has no meaning to make permanent); the elastic forces push it 
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from .elements import _corners, _gradient
@@ -121,16 +120,3 @@ def yield_elements(x, elem, b, area, b0, area0, yield_strain, rate):
         area[e] = area[e] * p1 * p2
         changed += 1
     return changed
-
-
-def plastic_set(rest, rest0):
-    """Largest relative change of rest lengths ``max |rest / rest0 - 1|`` (a NumPy helper for
-    reports and tests).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> round(plastic_set(np.array([1.0, 1.2]), np.ones(2)), 12)
-    0.2
-    """
-    return float(np.max(np.abs(np.asarray(rest) / np.asarray(rest0) - 1.0))) if len(rest) else 0.0

@@ -100,8 +100,7 @@ def _loops(edges) -> list:
 
 
 def _area(x, loop) -> float:
-    a, b = x[loop[:, 0]], x[loop[:, 1]]
-    return 0.5 * float(np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]))
+    return float(enclosed_area(x, loop[:, 0], loop[:, 1]))
 
 
 @njit(cache=True)

@@ -19,6 +19,7 @@ import numpy as np
 from numba import njit
 
 from .corotated import polar_rotation
+from .elements import deformation_gradients
 
 
 @njit(cache=True, inline="always")
@@ -57,15 +58,8 @@ def stretch_field(x, tris, b):
     >>> s.round(12).tolist(), np.abs(d).round(12).tolist()
     ([[2.0, 1.0]], [[1.0, 0.0]])
     """
-    x = np.asarray(x, dtype=np.float64)
-    t = np.asarray(tris, dtype=np.int64).reshape(-1, 3)
-    e1 = x[t[:, 1]] - x[t[:, 0]]
-    e2 = x[t[:, 2]] - x[t[:, 0]]
-    b = np.asarray(b).reshape(-1, 4)
-    f00 = e1[:, 0] * b[:, 0] + e2[:, 0] * b[:, 2]
-    f01 = e1[:, 0] * b[:, 1] + e2[:, 0] * b[:, 3]
-    f10 = e1[:, 1] * b[:, 0] + e2[:, 1] * b[:, 2]
-    f11 = e1[:, 1] * b[:, 1] + e2[:, 1] * b[:, 3]
+    f = deformation_gradients(x, np.asarray(tris).reshape(-1, 3), np.asarray(b).reshape(-1, 4))
+    f00, f01, f10, f11 = f[:, 0, 0], f[:, 0, 1], f[:, 1, 0], f[:, 1, 1]
     c, s = f00 + f11, f10 - f01
     r = np.hypot(c, s)
     safe = np.where(r > 0, r, 1.0)

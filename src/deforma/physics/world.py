@@ -32,6 +32,7 @@ from .body import Body, Grab, _fem_mesh_check, _material, _pressure
 from .material import Material
 from .model import BodyTopology, Model
 from .state import State
+from .strain import spring_strains
 
 # Automatic contact thickness: this fraction of a body's median boundary edge (see World).
 AUTO_THICKNESS = 0.05
@@ -773,8 +774,8 @@ class World:
                 body._tear_source = slice(None)
 
     def _check_shape(self) -> None:
-        """Refuse a state in which a body has lost its shape: a spring or triangle stretched
-        ``LOST_STRETCH`` times its rest size, or a finite-element body's triangles turned inside
+        """Refuse a state in which a body has lost its shape: a spring stretched
+        ``LOST_STRETCH`` times its rest length, or a finite-element body's triangles turned inside
         out over most of it (its area below ``LOST_AREA`` of its rest area), at two checks in a row (an
         impact may crush a body for a moment). No stable step keeps either; a run that did is
         garbage however finite its numbers (a step too long for the stiffness, a body started
@@ -786,17 +787,16 @@ class World:
             s0, s1 = m.body_spring_offsets[b], m.body_spring_offsets[b + 1]
             what = None
             if s1 > s0:
-                d = x[m.spring_j[s0:s1]] - x[m.spring_i[s0:s1]]
-                ratio = float(np.max(np.hypot(d[:, 0], d[:, 1]) / m.spring_rest_length[s0:s1]))
+                ratio = 1.0 + float(np.max(spring_strains(x, m.spring_i[s0:s1], m.spring_j[s0:s1],
+                                                          m.spring_rest_length[s0:s1])))
                 if ratio > limit:
                     what = f"a spring is {ratio:.3g} times its rest length"
-            t = body.topology.triangles
-            # (a springs body folded flat keeps every spring's length: a state of the model,
-            # which has no area to keep, so only finite elements are held to their area)
-            if what is None and len(t) and body.is_fem:
-                v0 = int(m.body_vertex_offsets[b])
-                area = signed_areas(x, t + v0)
-                rest = signed_areas(body.topology.rest_positions, t)
+            t0, t1 = m.body_elem_offsets[b], m.body_elem_offsets[b + 1]
+            # only finite elements are held to their area: a springs body (no elements in the
+            # Model) folded flat keeps every spring's length, a state of that model
+            if what is None and t1 > t0:
+                area = signed_areas(x, m.elem[t0:t1])
+                rest = m.elem_area[t0:t1]
                 if area.sum() < LOST_AREA * rest.sum():
                     what = (f"its area fell to {area.sum() / rest.sum():.0%} of its rest area "
                             f"({np.mean(area < 0):.0%} of its triangles inside out)")
