@@ -295,3 +295,9 @@ def test_a_body_placed_overlapping_another_is_refused_and_nothing_changes():
     with pytest.raises(ValueError, match="would overlap body 0"):
         ghost.collide = True
     assert ghost.collide is False
+    other = w.add_body(grid_mesh(0.2, 0.2, 3, 3), position=(2, 0))
+    x = w._state.x.copy()
+    with pytest.raises(ValueError, match="body 2 would overlap body 0"):  # moved into it by hand
+        other.positions = other.positions - (2.0, 0.0)
+    assert np.array_equal(w._state.x, x)
+    other.positions = other.positions + (0.5, 0.0)  # clear of it: fine

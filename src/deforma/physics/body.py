@@ -119,12 +119,21 @@ class Body:
 
     @property
     def positions(self) -> np.ndarray:
-        """(N, 2) vertex positions in metres: a view into the world's state, writable."""
+        """(N, 2) vertex positions in metres: a view into the world's state, writable.
+
+        Setting it refuses positions where a colliding body would overlap another (contacts
+        keep bodies apart from a start where they are apart; writing into the view in place
+        skips that check, so keep such edits clear of other bodies).
+        """
         return self._check()._state.x[self.vertex_slice]
 
     @positions.setter
     def positions(self, value):
-        self.positions[...] = self._checked_array(value, "positions", shapes=((self.n_vertices, 2),))
+        x = self._checked_array(value, "positions", shapes=((self.n_vertices, 2),))
+        world = self._check()
+        if self._overrides["collide"]:
+            world._check_no_overlap(self, x)
+        self.positions[...] = x
 
     @property
     def velocities(self) -> np.ndarray:

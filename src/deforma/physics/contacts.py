@@ -8,11 +8,14 @@ edge's ends; and a vertex off the outline against another body's outline, where 
 is folded (below). The stage runs once per substep, after the integrator has moved every
 vertex from ``x_prev`` to ``x``; the motion in between is taken as a straight line.
 
-0. **Which vertices.** Every outline vertex of a body with contacts on. Off the outline,
-   only the vertices of triangles turned over (or flat) in a body whose box overlaps
-   another colliding body's: self contact keeps an outline from crossing itself, and a body
-   whose triangles all keep their orientation lies inside its outline, so only a
-   folded-over part can carry such a vertex into another body. They get a hair of
+0. **Which vertices.** Every outline vertex of a body with contacts on; and, of a colliding
+   body, every other vertex whose swept box meets another colliding body's. Self contact
+   keeps an outline from crossing itself, and a body whose triangles all keep their
+   orientation lies inside its outline, so only a folded body can carry a vertex off its
+   outline into another body; but a folded flap carries vertices of triangles that are not
+   turned over too, and the response can fold a body after the test, so all such vertices
+   are tested (measured: testing only the vertices of turned-over triangles let the `pile`
+   at 1/60 s x 2 put a vertex inside another body within 2 s). They get a hair of
    thickness, so their contacts are crossings only.
 1. **Broad phase.** The swept box of every outline edge (its ends at both times, grown by
    a margin: ``SPECULATIVE`` times the largest contact thickness) goes into a uniform grid
@@ -32,10 +35,12 @@ vertex from ``x_prev`` to ``x``; the motion in between is taken as a straight li
    (``PROXIMITY``), or if its straight-line motion crossed the segment itself
    (``CROSSING``: continuous collision detection; the time at which ``p`` and the moving
    edge are collinear is a root of a quadratic, found by bisection on its sign change, and
-   ``s`` at that time must lie in [0, 1]). A vertex that started behind an edge of another
-   body is inside that body (only an overlap set up by hand does that) and may leave. A
-   vertex behind an edge of its own body lies across a part of that body and must stay
-   there, so self pairs are watched from both sides. Two outlines use the larger of their
+   ``s`` at that time must lie in [0, 1]; a point on the same side at both ends may still
+   have crossed twice, which the quadratic's extremum tells, and the first of the two
+   crossings that passes through the segment counts). Pairs are watched from both sides:
+   bodies start apart (the world refuses an overlap), so a vertex behind an edge lies
+   beyond a part of that edge's body (across a thin limb, or a folded flap whose outline
+   runs backwards) and must stay there. Two outlines use the larger of their
    bodies' thicknesses, so that both sides of a pair agree on the gap.
 3. **Solve** (Gauss-Seidel over the contacts). Velocities first, once: the relative
    velocity ``v_p - (1 - s) v_a - s v_b`` may approach the edge by what is left of the gap
@@ -145,7 +150,6 @@ ContactTopology = namedtuple("ContactTopology", [
 ContactScratch = namedtuple("ContactScratch", [
     "xp",               # (V, 2): collision vertices at the start of the substep
     "active",           # (V,) int32: the collision vertices tested this substep (status[ST_ACTIVE] of them)
-    "mark",             # (V,) int64: the substep a vertex was last listed in active
     "body_box",         # (B, 4) float64: each body's swept box xmin, ymin, xmax, ymax
     "xq",               # (V, 2): ... when the grid was built
     "dirty",            # (V,) int32: vertices the response moved since the last check (status[ST_DIRTY])
@@ -198,7 +202,7 @@ def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScr
         t *= 2
     v = n_vertices
     never = np.full(v, -1, np.int64)
-    return ContactScratch(np.zeros((v, 2)), np.zeros(v, np.int32), never.copy(), np.zeros((n_bodies, 4)),
+    return ContactScratch(np.zeros((v, 2)), np.zeros(v, np.int32), np.zeros((n_bodies, 4)),
                           np.zeros((v, 2)), np.zeros(v, np.int32), never.copy(), np.zeros(v, np.int32), never.copy(),
                           np.zeros(v + 1, np.int64), np.zeros(v, np.int64), np.zeros(v, np.int32), never.copy(),
                           np.zeros((n_edges, 4)), np.zeros((n_edges, 4), np.int64), np.zeros(t + 1, np.int64),
@@ -318,15 +322,14 @@ def _cross_at(t, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey):
 
 
 @njit(cache=True)
-def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thickness, two_sided):
+def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thickness):
     """Contact of a point moving ``p0 -> p1`` with an edge moving ``(a0, b0) -> (a1, b1)``.
 
     The edge's body lies on its left; ``d`` is the point's signed distance from the edge's
     line, positive in front. The side the point starts on is the exact sign of ``d0``.
     Returns ``(kind, s, nx, ny, depth, target)``: ``kind`` is 0 (no contact),
     ``PROXIMITY`` (started in front, ended within ``thickness`` m in front of the segment)
-    or ``CROSSING`` (crossed the segment: from the front, or with ``two_sided`` from
-    behind); ``s`` the foot's position along the edge; ``(nx, ny)`` the unit normal toward
+    or ``CROSSING`` (crossed the segment, from either side); ``s`` the foot's position along the edge; ``(nx, ny)`` the unit normal toward
     the side the point must stay on; ``target`` the distance from the line along it that
     the response restores, and ``depth`` how far the point is from it.
 
@@ -334,13 +337,22 @@ def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thi
     --------
     The edge runs from (1, 0) to (0, 0), so its body lies below it:
 
-    >>> k, s, nx, ny, depth, target = pair_contact(0.5, 1, 0.5, -0.5, 1, 0, 1, 0, 0, 0, 0, 0, 0.01, False)
+    >>> k, s, nx, ny, depth, target = pair_contact(0.5, 1, 0.5, -0.5, 1, 0, 1, 0, 0, 0, 0, 0, 0.01)
     >>> k == CROSSING, s, (nx, ny), depth, target     # fell through the edge from above
     (True, 0.5, (0.0, 1.0), 0.51, 0.01)
-    >>> pair_contact(0.5, 0.1, 0.5, 0.005, 1, 0, 1, 0, 0, 0, 0, 0, 0.01, False)[0] == PROXIMITY
+    >>> pair_contact(0.5, 0.1, 0.5, 0.005, 1, 0, 1, 0, 0, 0, 0, 0, 0.01)[0] == PROXIMITY
     True
-    >>> pair_contact(0.5, -0.1, 0.5, 0.2, 1, 0, 1, 0, 0, 0, 0, 0, 0.01, False)[0]  # left the body
-    0
+    >>> k, s, nx, ny, depth, target = pair_contact(0.5, -0.1, 0.5, 0.2, 1, 0, 1, 0, 0, 0, 0, 0, 0.01)
+    >>> k == CROSSING, (nx, ny), round(depth, 6)      # from behind: held behind, at its start distance
+    (True, (-0.0, -1.0), 0.3)
+
+    A point that stays put at (0.5, 0.5), in front of the edge's line at the start and at the
+    end, while the edge swings past it: the line passes it twice, first beyond the edge's
+    end (it is then behind, legitimately), then with the segment itself. Held behind:
+
+    >>> k, s, nx, ny, depth, target = pair_contact(0.5, 0.5, 0.5, 0.5, -1, -1, -1, 2, -1, 0, 2, 0, 0.01)
+    >>> k == CROSSING, round(s, 3), (round(nx, 3), round(ny, 3))  # the normal out of the back
+    (True, 0.634, (0.555, 0.832))
     """
     e0x = b0x - a0x
     e0y = b0y - a0y
@@ -354,12 +366,30 @@ def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thi
     q0y = p0y - a0y
     f0 = q0x * e0y - q0y * e0x          # d0 * |e0|
     front = f0 >= 0.0
-    if not front and not two_sided:
-        return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # inside another body: leaving it is no crossing
     q1x = p1x - a1x
     q1y = p1y - a1y
     f1 = q1x * e1y - q1y * e1x          # d1 * |e1|
-    if front and f1 >= 0.0:
+    dqx = q1x - q0x
+    dqy = q1y - q0y
+    dex = e1x - e0x
+    dey = e1y - e0y
+    # f(t) = (q0 + t dq) x (e0 + t de), |e(t)| times the distance from the moving line, is a
+    # quadratic in t: on the same side at both ends, the point may still have crossed the
+    # line twice (around an end of the edge, then back through the edge itself: an edge
+    # turning fast at a large step). Its extremum tells.
+    if (f1 >= 0.0) == front:
+        qa = dqx * dey - dqy * dex
+        tm = -0.5 * ((q0x * dey - q0y * dex) + (dqx * e0y - dqy * e0x)) / qa if qa != 0.0 else -1.0
+        if 0.0 < tm < 1.0 and (_cross_at(tm, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey) >= 0.0) != front:
+            # two crossings of the line, at t1 < tm < t2; the first through the segment counts
+            t1, s1 = _line_crossing(0.0, tm, front, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey)
+            if 0.0 <= s1 <= 1.0:
+                return _crossed(front, s1, f0, f1, l0, e1x, e1y, l1, thickness, True)
+            t2, s2 = _line_crossing(tm, 1.0, not front, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey)
+            if 0.0 <= s2 <= 1.0:  # came back through the segment: the side it held in between
+                return _crossed(not front, s2, f0, f1, l0, e1x, e1y, l1, thickness, False)
+        if not front:
+            return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # stayed behind
         reach = SPECULATIVE * thickness
         if f1 * f1 >= reach * reach * l1:
             return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # clear in front: the common case, no root taken
@@ -368,18 +398,21 @@ def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thi
             r1 = math.sqrt(l1)
             return PROXIMITY, s1, e1y / r1, -e1x / r1, thickness - f1 / r1, thickness
         return 0, 0.0, 0.0, 0.0, 0.0, 0.0
-    if not front and f1 < 0.0:
-        return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # stayed behind
-    # the point changed sides of the line: did it cross the segment itself?
-    dqx = q1x - q0x
-    dqy = q1y - q0y
-    dex = e1x - e0x
-    dey = e1y - e0y
-    lo = 0.0
-    hi = 1.0
-    for _ in range(48):  # f(lo), f(hi) on either side of 0: one sign change of a quadratic in [0, 1]
+    # the point changed sides of the line (one root): did it cross the segment itself?
+    t, s = _line_crossing(0.0, 1.0, front, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey)
+    if s < 0.0 or s > 1.0:
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # passed the line beyond the segment's ends
+    return _crossed(front, s, f0, f1, l0, e1x, e1y, l1, thickness, True)
+
+
+@njit(cache=True, inline="always")
+def _line_crossing(lo, hi, side, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey):
+    """The time in ``[lo, hi]`` at which the point reaches the moving line, leaving ``side``
+    (``f(lo)`` on it, ``f(hi)`` not: one sign change, found by bisection), and where along
+    the edge it does (``s``; outside [0, 1]: beyond the ends, 2.0 for a vanished edge)."""
+    for _ in range(48):
         mid = 0.5 * (lo + hi)
-        if (_cross_at(mid, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey) >= 0.0) == front:
+        if (_cross_at(mid, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey) >= 0.0) == side:
             lo = mid
         else:
             hi = mid
@@ -389,19 +422,24 @@ def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thi
     ey = e0y + hi * dey
     lt = ex * ex + ey * ey
     if lt <= 0.0:
-        return 0, 0.0, 0.0, 0.0, 0.0, 0.0
-    s = (qx * ex + qy * ey) / lt
-    if s < 0.0 or s > 1.0:
-        return 0, 0.0, 0.0, 0.0, 0.0, 0.0  # passed the line beyond the segment's ends
+        return hi, 2.0
+    return hi, (qx * ex + qy * ey) / lt
+
+
+@njit(cache=True, inline="always")
+def _crossed(side, s, f0, f1, l0, e1x, e1y, l1, thickness, from_start):
+    """A ``CROSSING`` contact for a point that passed through the segment from ``side`` (True:
+    the front); the response puts it back on that side."""
     r1 = math.sqrt(l1)
     d1 = f1 / r1
     nx = e1y / r1
     ny = -e1x / r1
     # Back to the distance it started at, at most the thickness, and a hair off the line so
     # that the side is unambiguous: every pair had its start distance at once, so these
-    # targets never contradict each other.
-    d0 = f0 / math.sqrt(l0)
-    if front:
+    # targets never contradict each other. A point that held the side only between two
+    # crossings has no start distance on it: a hair.
+    d0 = f0 / math.sqrt(l0) if from_start else 0.0
+    if side:
         target = max(min(thickness, d0), SIDE_MARGIN * thickness)
         return CROSSING, s, nx, ny, target - d1, target
     target = max(-d0, SIDE_MARGIN * thickness)
@@ -544,12 +582,7 @@ def detect_contacts(x, topo, scr, out):
     ``out`` was too small (as :func:`contact_stage`).
     """
     status = scr.status
-    # _activate dedupes folded vertices by the substep's stamp; a stamp of its own (negative,
-    # never a real one) keeps the stage that follows from skipping the ones listed here
-    stamp = status[ST_STAMP]
-    status[ST_STAMP] = -stamp - 2
     n, _ = _collide(x, topo, scr, out)
-    status[ST_STAMP] = stamp
     return n
 
 
@@ -643,7 +676,7 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
         ib = cv[b]
         kind, s, nx, ny, depth, target = pair_contact(xp[k, 0], xp[k, 1], x[i, 0], x[i, 1], xp[a, 0], xp[a, 1],
                                                       x[ia, 0], x[ia, 1], xp[b, 0], xp[b, 1], x[ib, 0], x[ib, 1],
-                                                      thick, own)
+                                                      thick)
         if kind == 0 or (crossings_only and kind != CROSSING):
             continue
         if n < cap:
@@ -1014,21 +1047,22 @@ def gather_start(x, topo, scr):
 
 
 @njit(cache=True)
-def _activate_folded(x, topo, scr, b, n):
-    """Append to ``scr.active`` the off-outline vertices of body ``b``'s turned-over triangles."""
-    tri, vertex_cv, active, mark = topo.tri, topo.vertex_cv, scr.active, scr.mark
-    n_outline = topo.body_interior[0]
-    stamp = scr.status[ST_STAMP]
-    for t in range(topo.body_tri[b], topo.body_tri[b + 1]):
-        i, j, k = tri[t, 0], tri[t, 1], tri[t, 2]
-        if (x[j, 0] - x[i, 0]) * (x[k, 1] - x[i, 1]) - (x[j, 1] - x[i, 1]) * (x[k, 0] - x[i, 0]) > 0.0:
-            continue
-        for q in (i, j, k):
-            c = vertex_cv[q]
-            if c >= n_outline and mark[c] != stamp:
-                mark[c] = stamp
-                active[n] = c
+def _activate_inner(x, topo, scr, b, n, near, n_near):
+    """Append to ``scr.active`` the off-outline vertices of body ``b`` whose swept box meets
+    the box of one of the bodies ``near[:n_near]`` (grown by the margin)."""
+    cv, xp, box, active = topo.cv_vertex, scr.xp, scr.body_box, scr.active
+    margin = topo.margin[0]
+    for k in range(topo.body_interior[b], topo.body_interior[b + 1]):
+        x0 = min(xp[k, 0], x[cv[k], 0]) - margin
+        x1 = max(xp[k, 0], x[cv[k], 0]) + margin
+        y0 = min(xp[k, 1], x[cv[k], 1]) - margin
+        y1 = max(xp[k, 1], x[cv[k], 1]) + margin
+        for m in range(n_near):
+            c = near[m]
+            if x0 <= box[c, 2] and box[c, 0] <= x1 and y0 <= box[c, 3] and box[c, 1] <= y1:
+                active[n] = k
                 n += 1
+                break
     return n
 
 
@@ -1037,11 +1071,15 @@ def _activate(x, topo, scr):
     """List the collision vertices to test this substep in ``scr.active``; returns how many.
 
     None if nothing can touch (no self contact and fewer than two colliding bodies). Else
-    every outline vertex of a body with contacts on; and, of a colliding body whose swept
-    box (grown by the margin) overlaps another colliding body's, the other vertices of its
-    triangles that are turned over (or flat). Self contact keeps an outline from crossing
-    itself, and where no triangle is turned over a body lies inside its outline: only a
-    folded-over part can carry a vertex that is not on the outline into another body.
+    every outline vertex of a body with contacts on; and, of a colliding body, the other
+    vertices whose swept box meets another colliding body's swept box (grown by the
+    margin). Self contact keeps an outline from crossing itself, and a body whose
+    triangles all keep their orientation lies inside its outline, so only a folded body
+    can carry a vertex that is not on the outline into another; but where a body is folded
+    at the end of the stage is not known before it (the response moves outline vertices),
+    and a folded flap carries along vertices of triangles that are not turned over. So
+    every vertex that may meet another body is tested: sound, and cheap, since a vertex
+    off the outline meets another body's edges only where it has entered it.
     """
     cv, flags, box, active = topo.cv_vertex, topo.body_flags, scr.body_box, scr.active
     n = 0
@@ -1069,16 +1107,20 @@ def _activate(x, topo, scr):
                     box[b, 1] = min(box[b, 1], x[cv[k], 1])
                     box[b, 2] = max(box[b, 2], x[cv[k], 0])
                     box[b, 3] = max(box[b, 3], x[cv[k], 1])
+        near = np.empty(nb, np.int64)
         for b in range(nb):
             if (flags[b] & COLLIDE) == 0:
                 continue
+            n_near = 0
             for c in range(nb):
                 if c == b or (flags[c] & COLLIDE) == 0:
                     continue
                 if box[b, 0] - margin <= box[c, 2] and box[c, 0] - margin <= box[b, 2] \
                         and box[b, 1] - margin <= box[c, 3] and box[c, 1] - margin <= box[b, 3]:
-                    n = _activate_folded(x, topo, scr, b, n)
-                    break
+                    near[n_near] = c
+                    n_near += 1
+            if n_near:
+                n = _activate_inner(x, topo, scr, b, n, near, n_near)
     scr.status[ST_ACTIVE] = n
     return n
 
