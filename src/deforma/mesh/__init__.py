@@ -4,5 +4,6 @@ from .box import box
 from .delaunay import delaunay
 from .image import from_image
 from .mesh import Mesh
+from .outline import outline
 
-__all__ = ["Mesh", "box", "delaunay", "from_image"]
+__all__ = ["Mesh", "box", "delaunay", "from_image", "outline"]
