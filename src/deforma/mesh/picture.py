@@ -39,8 +39,13 @@ def _check_size(size) -> int:
 
 
 def _collider_outline(c) -> np.ndarray:
-    """(K, 2) outline of a collider in metres: a Rect's corners, a polygon's points, a circle or
-    a segment (a capsule when it has a radius) as a polygon."""
+    """(K, 2) outer boundary of a collider in metres, in its pose now: what its ``outline()``
+    gives (a Rect's corners, a polygon's outer points, a circle or a capsule as a polygon, a
+    wire's two ends), or, for look-alikes without it, a Rect's corners, a polygon's points, a
+    circle or a segment (a capsule when it has a radius) from their attributes."""
+    outline = getattr(c, "outline", None)
+    if callable(outline):
+        return np.asarray(outline(_CIRCLE_SIDES), dtype=np.float64)
     if hasattr(c, "corners"):
         return np.asarray(c.corners, dtype=np.float64)
     if hasattr(c, "points"):
@@ -65,6 +70,15 @@ def _collider_outline(c) -> np.ndarray:
                     f"radius or ends")
 
 
+def _collider_loops(c) -> list[np.ndarray]:
+    """The boundary loops of a collider now (m): the outer one first, then its holes (a
+    Polygon's ``loops``); one loop of 2 points is a wire."""
+    loops = getattr(c, "loops", None)
+    if loops is not None:
+        return [np.asarray(p, np.float64) for p in loops]
+    return [_collider_outline(c)]
+
+
 def content_bounds(world) -> tuple[np.ndarray, np.ndarray]:
     """Lower-left and upper-right corners (metres) of every body and collider of ``world``.
 
@@ -79,6 +93,7 @@ def content_bounds(world) -> tuple[np.ndarray, np.ndarray]:
     >>> lo.tolist(), hi.tolist()
     ([-2.0, -0.5], [2.0, 0.5])
     """
+    # a polygon's holes lie inside its outer boundary, so outlines are enough
     parts = [b.positions for b in world.bodies] + [_collider_outline(c) for c in world.colliders]
     if not parts:
         return np.array([-1.0, -1.0]), np.array([1.0, 1.0])
@@ -134,12 +149,30 @@ class _Canvas:
             self.draw.line(q, fill=color, width=1)
         return True
 
-    def outline(self, points, fill, edge) -> None:
-        px = [tuple(p) for p in self.pixels(points).tolist()]
-        if len(px) == 2:
-            self.draw.line(px[0] + px[1], fill=edge, width=2 * _SUPERSAMPLE)
-        else:
-            self.draw.polygon(px, fill=fill, outline=edge, width=_SUPERSAMPLE)
+    def shape(self, loops, fill, edge) -> None:
+        """A collider: the inside of ``loops[0]`` minus the other loops (holes) filled, every
+        loop bordered; a single loop of 2 points is a wire, drawn as a line."""
+        from PIL import Image, ImageDraw
+
+        px = [self.pixels(p) for p in loops]
+        if len(px) == 1 and len(px[0]) == 2:
+            self.draw.line([tuple(p) for p in px[0].tolist()], fill=edge, width=2 * _SUPERSAMPLE)
+            return
+        # the fill through a mask of the shape's box: holes are cut out of it, so whatever
+        # was drawn before shows through them (another collider, the background)
+        lo = np.floor(np.concatenate(px).min(axis=0)).astype(int) - 1
+        hi = np.ceil(np.concatenate(px).max(axis=0)).astype(int) + 2
+        lo = np.maximum(lo, 0)
+        hi = np.minimum(hi, self.image.size)
+        if np.all(hi > lo):
+            mask = Image.new("L", tuple(int(v) for v in hi - lo), 0)
+            pen = ImageDraw.Draw(mask)
+            for k, p in enumerate(px):
+                pen.polygon([tuple(q) for q in (p - lo).tolist()], fill=255 if k == 0 else 0)
+            self.image.paste(fill, (int(lo[0]), int(lo[1]), int(hi[0]), int(hi[1])), mask)
+        for p in px:
+            ring = [tuple(q) for q in p.tolist()]
+            self.draw.line(ring + ring[:1], fill=edge, width=_SUPERSAMPLE, joint="curve")
 
     def finish(self):
         from PIL import Image
@@ -201,6 +234,10 @@ def mesh_picture(mesh, *, size: int = 400):
 def world_picture(world, *, size: int = 400):
     """A picture of a world as it is now: colliders in grey, bodies as filled triangles.
 
+    Every collider is drawn in its current pose (a moving one where it has got to): a
+    rectangle, a circle, a capsule, a polygon with its holes (what is behind shows through
+    them), a wire as a line.
+
     A body made from a picture takes its colours; other bodies get one colour each. The view
     fits every body and collider (see :func:`content_bounds`), unlike a scene's camera.
 
@@ -226,7 +263,7 @@ def world_picture(world, *, size: int = 400):
     lo, hi = content_bounds(world)
     canvas = _Canvas(lo, hi, size)
     for c in world.colliders:
-        canvas.outline(_collider_outline(c), COLLIDER_FILL, COLLIDER_EDGE)
+        canvas.shape(_collider_loops(c), COLLIDER_FILL, COLLIDER_EDGE)
     for k, b in enumerate(world.bodies):
         fallback = BODY_FILLS[k % len(BODY_FILLS)]
         if len(b.triangles) == 0:  # a body of springs only: its springs are all there is to see

@@ -15,6 +15,8 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
+from .collider_mesh import FLOATS_PER_VERTEX, ColliderGeometry, collider_corners, collider_shape
+
 __all__ = ["Camera", "MeshHandle", "Renderer", "collider_corners"]
 
 # Colours are linear RGBA floats in [0, 1]; the palette is chosen to read well on video:
@@ -92,17 +94,6 @@ class Camera:
         return np.stack([x, y], axis=-1)
 
 
-def collider_corners(center, size, angle) -> np.ndarray:
-    """The four corners (4, 2) of a rectangle, counter-clockwise; ``angle`` in degrees."""
-    cx, cy = center
-    hw, hh = size[0] / 2.0, size[1] / 2.0
-    a = np.radians(angle)
-    c, s = np.cos(a), np.sin(a)
-    local = np.array([[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]])
-    rot = np.array([[c, -s], [s, c]])
-    return local @ rot.T + (cx, cy)
-
-
 def _as_rgba(color) -> tuple[float, float, float, float]:
     """A colour as RGBA floats: accepts '#rrggbb', '#rrggbbaa', or 3/4 numbers in [0, 1]."""
     if isinstance(color, str):
@@ -117,14 +108,6 @@ def _as_rgba(color) -> tuple[float, float, float, float]:
     if len(vals) != 4 or not all(0.0 <= v <= 1.0 for v in vals):
         raise ValueError(f"colour must be 3 or 4 numbers in [0, 1] or a hex string, got {color!r}")
     return tuple(vals)
-
-
-def _collider_fields(c):
-    """(center, size, angle) from a Rect-like object or a 3-tuple."""
-    if hasattr(c, "center"):
-        return c.center, c.size, c.angle
-    center, size, angle = c
-    return center, size, angle
 
 
 _BACKGROUND_VS = """
@@ -187,38 +170,22 @@ _COLLIDER_VS = """
 #version 330
 uniform vec2 u_center;
 uniform vec2 u_half;
+uniform vec2 u_pixel;   // normalised device units per pixel: 2 / viewport
 in vec2 in_pos;
-in vec2 in_local;
-in vec2 in_halfsize;
-in vec4 in_fill;
-out vec2 v_local;
-out vec2 v_halfsize;
-out vec4 v_fill;
+in vec2 in_offset;      // pixels, along world axes: an outline's width does not follow the zoom
+in vec4 in_color;
+out vec4 v_color;
 void main() {
-    v_local = in_local;
-    v_halfsize = in_halfsize;
-    v_fill = in_fill;
-    gl_Position = vec4((in_pos - u_center) / u_half, 0.0, 1.0);
+    v_color = in_color;
+    gl_Position = vec4((in_pos - u_center) / u_half + in_offset * u_pixel, 0.0, 1.0);
 }
 """
 
 _COLLIDER_FS = """
 #version 330
-uniform vec4 u_edge;
-in vec2 v_local;
-in vec2 v_halfsize;
-in vec4 v_fill;
+in vec4 v_color;
 out vec4 f_color;
-void main() {
-    // distance to the nearest side in pixels, so the border is 2 px at any zoom
-    vec2 px = fwidth(v_local);
-    vec2 d = (v_halfsize - abs(v_local)) / max(px, vec2(1e-6));
-    float edge = 1.0 - clamp(min(d.x, d.y) - 1.5, 0.0, 1.0);
-    // a light top face and a soft vertical shade give the slab some volume
-    float shade = 0.92 + 0.08 * (v_local.y / max(v_halfsize.y, 1e-6));
-    vec4 fill = vec4(v_fill.rgb * shade, v_fill.a);
-    f_color = mix(fill, u_edge, edge);
-}
+void main() { f_color = v_color; }
 """
 
 
@@ -370,6 +337,9 @@ class Renderer:
         self._coll_vbo = None
         self._coll_vao = None
         self._coll_capacity = 0
+        self._coll_count = 0
+        self._coll_key = None     # what the collider buffer holds (see draw_colliders)
+        self._coll_cache = {}     # id(collider) -> (collider, _version, ColliderGeometry)
         self._white = None
         self._meshes: list[MeshHandle] = []
         self._owns_ctx = False
@@ -532,27 +502,69 @@ class Renderer:
         self._grid_vao.render(moderngl.LINES, vertices=len(seg))
 
     def draw_colliders(self, colliders: Iterable, *, colors: Sequence | None = None) -> None:
-        """Filled rotated rectangles with a dark 2-pixel border.
+        """Every collider filled and bordered, in its pose now.
 
-        ``colliders`` holds objects with ``.center .size .angle`` (like ``deforma.Rect``) or
-        ``(center, size, angle_degrees)`` tuples; ``colors`` optionally one colour each.
+        ``colliders`` holds ``deforma`` colliders (Rect, Circle, Polygon with holes, Segment:
+        a capsule, or a wire drawn a few pixels wide), objects with ``.center .size .angle``,
+        or ``(center, size, angle_degrees)`` tuples of rectangles; ``colors`` optionally one
+        fill colour each (None: the default slate).
+
+        A collider's triangles and border are rebuilt only when it changed (its ``_version``
+        counter, which moving it also raises) and the buffer is written only when one did or
+        a colour changed: a still scene costs one draw call.
         """
         import moderngl
 
-        items = [_collider_fields(c) for c in colliders]
-        if not items:
-            return
+        items = list(colliders)
         if colors is not None and len(colors) != len(items):
             raise ValueError(f"colors must give one colour per collider ({len(items)}), got {len(colors)}")
+        if not items:
+            return
+        fills = [COLLIDER_FILL if colors is None or colors[i] is None else _as_rgba(colors[i])
+                 for i in range(len(items))]
+        key = (tuple(self._collider_key(c) for c in items), tuple(fills))
+        if key != self._coll_key:
+            self._upload_colliders(items, fills)
+            self._coll_key = key
+        if not self._coll_count:
+            return
+        p = self._coll_prog
+        self._set_camera(p)
+        p["u_pixel"].value = (2.0 / self.size[0], 2.0 / self.size[1])
+        self.ctx.enable(moderngl.BLEND)
+        self.ctx.blend_func = _blend()
+        self._coll_vao.render(moderngl.TRIANGLES, vertices=self._coll_count)
+
+    @staticmethod
+    def _collider_key(c):
+        """What identifies a collider's look now: its identity and change counter, or its values."""
+        version = getattr(c, "_version", None)
+        if version is not None:
+            return (id(c), version)
+        if isinstance(c, (tuple, list)):
+            center, size, angle = c
+            return (tuple(map(float, center)), tuple(map(float, size)), float(angle))
+        return (id(c), tuple(map(float, c.center)), tuple(map(float, c.size)), float(c.angle))
+
+    def _upload_colliders(self, items, fills) -> None:
+        cache = {}
         rows = []
-        for i, (center, size, angle) in enumerate(items):
-            fill = COLLIDER_FILL if colors is None or colors[i] is None else _as_rgba(colors[i])
-            corners = collider_corners(center, size, angle)
-            hw, hh = size[0] / 2.0, size[1] / 2.0
-            local = np.array([[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]])
-            for k in (0, 1, 2, 0, 2, 3):
-                rows.append((*corners[k], *local[k], hw, hh, *fill))
-        data = np.asarray(rows, dtype=np.float32)
+        for c, fill in zip(items, fills):
+            version = getattr(c, "_version", None)
+            old = self._coll_cache.get(id(c))
+            if version is not None and old is not None and old[0] is c and old[1] == version:
+                geometry = old[2]
+            else:
+                # the triangles of the collider's last pose usually still fit (it only moved)
+                previous = old[2].triangles if old is not None and old[0] is c else None
+                geometry = ColliderGeometry(collider_shape(c), previous)
+            if version is not None:
+                cache[id(c)] = (c, version, geometry)   # holding c keeps its id from being reused
+            geometry.vertices(fill, COLLIDER_EDGE, rows)
+        self._coll_cache = cache
+        data = np.ascontiguousarray(np.concatenate(rows) if rows else np.zeros((0, FLOATS_PER_VERTEX)),
+                                    dtype=np.float32)
+        self._coll_count = len(data)
         if data.nbytes > self._coll_capacity:
             if self._coll_vao is not None:
                 self._coll_vao.release()
@@ -560,16 +572,9 @@ class Renderer:
             self._coll_capacity = max(data.nbytes, 2 * self._coll_capacity)
             self._coll_vbo = self.ctx.buffer(reserve=self._coll_capacity, dynamic=True)
             self._coll_vao = self.ctx.vertex_array(
-                self._coll_prog,
-                [(self._coll_vbo, "2f 2f 2f 4f", "in_pos", "in_local", "in_halfsize", "in_fill")],
-            )
-        self._coll_vbo.write(data.tobytes())
-        p = self._coll_prog
-        self._set_camera(p)
-        p["u_edge"].value = COLLIDER_EDGE
-        self.ctx.enable(moderngl.BLEND)
-        self.ctx.blend_func = _blend()
-        self._coll_vao.render(moderngl.TRIANGLES, vertices=len(data))
+                self._coll_prog, [(self._coll_vbo, "2f 2f 4f", "in_pos", "in_offset", "in_color")])
+        if len(data):
+            self._coll_vbo.write(data.tobytes())
 
     def _choose_filter(self, handle: MeshHandle) -> None:
         """Mipmaps only when the picture is drawn smaller than it is (they cost ~10% of a frame)."""

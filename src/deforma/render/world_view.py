@@ -57,13 +57,20 @@ class WorldView:
         """Pick up bodies and colliders added or removed since the last call."""
         from ..scene import load_texture, scene_of
 
-        current = scene_of(self.world)
-        colors = [c.color for c in current.collider]
+        try:
+            current = scene_of(self.world)
+        except AttributeError:
+            # a collider shape the scene format cannot describe (yet): the colliders are then
+            # drawn in the default colour; the bodies' looks still need the scene below
+            current = None
+        colors = [c.color for c in current.collider] if current is not None else []
         self.collider_colors = colors if any(colors) else None
         self._n_colliders = len(self.world.colliders)
         bodies = self.world.bodies
         if [(id(b), id(b.topology)) for b in bodies] == self._shown:
             return
+        if current is None:
+            current = scene_of(self.world)  # raises what the scene could not describe
         for h in self._handles:
             self.renderer.remove_mesh(h)
         self._handles = []
