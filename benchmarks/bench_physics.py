@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import Row  # noqa: E402
 
 import deforma  # noqa: E402
-from deforma.physics.colliders import pack_rects  # noqa: E402
+from deforma.physics.colliders import pack_colliders  # noqa: E402
 
 GRAVITY = (0.0, -9.81)
 
@@ -276,7 +276,7 @@ def run(quick: bool) -> list[Row]:
         x, v = s.x.copy(), s.v.copy()
         f = np.zeros_like(x)
         args = (m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness, m.spring_damping)
-        rects = pack_rects(w.colliders, friction=w.friction, static_friction=w.static_friction)
+        rects = pack_colliders(w.colliders, friction=w.friction, static_friction=w.static_friction)
         xn, vn = x.copy(), v.copy()
         candidates = {
             "auto": worlds["auto"].step,

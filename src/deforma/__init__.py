@@ -1,8 +1,8 @@
 """deforma: deformable 2D objects.
 
 A shape (a box or an image) becomes a Delaunay triangle mesh, the mesh becomes a
-mass-spring soft body, and the body moves under gravity among rotated-rectangle
-colliders with friction.
+soft body (springs or finite elements), and the body moves under gravity among colliders
+of any shape (rectangles, circles, polygons, capsules; fixed or moving) with friction.
 
 Examples
 --------
@@ -14,10 +14,11 @@ Examples
 
 from . import mesh
 from .mesh.delaunay import delaunay
-from .physics import Material, Rect, SimulationUnstable, World
+from .physics import Circle, Material, Polygon, Rect, Segment, SimulationUnstable, World, colliders_from_image
 from .scene import load_scene, save_scene
 
-__all__ = ["Material", "Rect", "SimulationUnstable", "World", "delaunay", "load_scene", "mesh", "save_scene", "show"]
+__all__ = ["Circle", "Material", "Polygon", "Rect", "Segment", "SimulationUnstable", "World", "colliders_from_image",
+           "delaunay", "load_scene", "mesh", "save_scene", "show"]
 __version__ = "0.1.0"
 
 

@@ -212,13 +212,13 @@ def test_squeezed_balloon_springs_back():
     w.add_collider(deforma.Rect((-0.8, 0), (0.5, 3), 0.0))
     w.add_collider(deforma.Rect((0.8, 0), (0.5, 3), 0.0))
     for k in range(300):  # the walls close in to 0.5 m apart
-        w.colliders[0] = deforma.Rect((-0.8 + 0.3 * k / 300, 0.0), (0.5, 3), 0.0)
-        w.colliders[1] = deforma.Rect((0.8 - 0.3 * k / 300, 0.0), (0.5, 3), 0.0)
+        w.colliders[0].center = (-0.8 + 0.3 * k / 300, 0.0)
+        w.colliders[1].center = (0.8 - 0.3 * k / 300, 0.0)
         w.step()
     squeezed = area(b.positions) / a0
     width = np.ptp(b.positions[:, 0])
-    w.colliders[0] = deforma.Rect((-5.0, 0.0), (0.5, 3), 0.0)
-    w.colliders[1] = deforma.Rect((5.0, 0.0), (0.5, 3), 0.0)
+    w.colliders[0].center = (-5.0, 0.0)
+    w.colliders[1].center = (5.0, 0.0)
     for _ in range(600):
         w.step()
     assert width < 0.52 and squeezed < 0.9

@@ -111,7 +111,7 @@ def test_moving_a_collider_onto_a_body_pushes_it_out():
     w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
     b = w.add_body(grid_mesh(0.2, 0.1, 3, 2), position=(0.0, 0.05))
     w.step()
-    w.colliders[0] = deforma.Rect((0, -0.47), (10, 1.0), 0.0)  # raised 3 cm into the body
+    w.colliders[0].center = (0, -0.47)  # raised 3 cm into the body
     w.step()
     assert b.positions[:, 1].min() >= 0.03
     w.friction = 0.1  # world coefficients feed colliders that leave them unset

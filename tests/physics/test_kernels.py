@@ -5,7 +5,7 @@ import pytest
 
 import deforma
 from deforma.physics import symplectic
-from deforma.physics.colliders import Rect, collide_point, pack_rects
+from deforma.physics.colliders import Rect, collide_point, pack_colliders
 from deforma.physics.forces import spring_force
 from physics_meshes import grid_mesh
 
@@ -92,7 +92,7 @@ def test_parallel_and_serial_steps_agree_exactly(material):
 
 def test_collide_point_puts_a_point_on_the_face_it_came_through():
     r = Rect((0, 0), (2, 2), 30.0)
-    packed = pack_rects([r], friction=0.0, static_friction=0.0)
+    packed = pack_colliders([r], friction=0.0, static_friction=0.0)
     u, wv = r.axes
     # a point coming down through the top face, slightly inside; frictionless: keeps sliding
     prev = 1.01 * wv + 0.2 * u

@@ -191,9 +191,16 @@ def test_other_arguments_are_validated():
         with pytest.raises(ValueError) as info:
             f()
         assert "\n" not in str(info.value)
-    w.colliders.append("junk")
-    with pytest.raises(ValueError, match="only deforma.Rect"):
-        w.step()
+    with pytest.raises(ValueError, match="must be a deforma.Rect, Circle, Polygon or Segment"):
+        w.add_collider("junk")
+    with pytest.raises(AttributeError):
+        w.colliders.append(deforma.Rect((0, 0), (1, 1)))  # a read-only view: add_collider is the way
+    r = w.add_collider(deforma.Rect((0, -5), (1, 1)))
+    with pytest.raises(ValueError, match="in the world already"):
+        w.add_collider(r)
+    w.remove_collider(r)
+    with pytest.raises(ValueError, match="not in this world"):
+        w.remove_collider(r)
 
 
 def test_integrator_registry_names_the_choices():

@@ -1,4 +1,4 @@
-"""Physics: soft bodies of springs or finite elements, rotated-rectangle colliders with Coulomb friction.
+"""Physics: soft bodies of springs or finite elements, colliders of any shape with Coulomb friction.
 
 ``World`` ties together the constant ``Model`` (springs, rest lengths, masses), the
 ``State`` (positions, velocities), the force kernels, an integrator chosen by name and the
@@ -6,10 +6,10 @@ collider leaf. See ``docs/physics.md`` for the model and the friction scheme.
 """
 
 from . import symplectic, implicit, xpbd  # noqa: F401, I001  (each registers its integrator; the default first)
-from .colliders import Rect
+from .shapes import Circle, Collider, Polygon, Rect, Segment, colliders_from_image
 from .integrators import available_integrators, register_integrator
 from .material import Material
 from .world import Body, Energy, Grab, SimulationUnstable, World
 
-__all__ = ["Body", "Energy", "Grab", "Material", "Rect", "SimulationUnstable", "World", "available_integrators",
-           "register_integrator"]
+__all__ = ["Body", "Circle", "Collider", "Energy", "Grab", "Material", "Polygon", "Rect", "Segment",
+           "SimulationUnstable", "World", "available_integrators", "colliders_from_image", "register_integrator"]

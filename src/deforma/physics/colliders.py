@@ -1,55 +1,59 @@
-"""Rotated-rectangle colliders and the point collision + Coulomb friction response.
+"""The point collision + Coulomb friction response against colliders of every shape.
 
-A leaf module: it knows shapes and points, not worlds or bodies.
+A leaf module: it knows shapes (:mod:`~deforma.physics.shapes`, packed into one array) and
+points, not worlds or bodies.
 
 The scheme, per vertex and substep of length ``h`` (velocities already updated by the
-integrator, ``p = p_prev + h*v``):
+integrator, ``p = p_prev + h*v``; the colliders already moved to the end of the substep):
 
-1. Test the point against every rectangle (local coordinates along the rectangle's axes,
-   the original's dot-product test; an axis-aligned bounding box rejects far points first).
-2. If it is inside, choose the face to leave by: among the faces the *previous* position
-   was outside of (the way it came in), the one with the least penetration; if it was
-   inside already (spawned there, or the rectangle moved onto it) any face, i.e. the
-   shortest way out.
-3. Split the velocity into normal ``vn`` and tangential ``vt`` parts of that face. An
-   inward ``vn`` is removed; its size ``jn = -vn`` is the normal impulse per unit mass
-   this substep, i.e. ``h * N / m``. Coulomb friction then acts on ``vt``
+1. Test the point against every collider (a bounding box rejects far points first; then
+   per kind: the rectangle's local-axes test, the distance to a circle's centre or a
+   capsule's segment, an even-odd crossing count over a polygon's edges, holes included).
+2. If it is inside, choose where to leave by, from the *previous* position seen from the
+   collider (where it would be had it ridden on it): a rectangle's face among those the
+   previous position was outside of (the way it came in), the one with the least
+   penetration; a polygon's edge the path came in through; a round shape's nearest
+   surface point. If it was inside already (spawned there, or the collider moved onto
+   it), the shortest way out.
+3. Split the velocity *relative to the collider's surface there* (``v + w x (q - c)``:
+   zero for a fixed collider) into normal ``vn`` and tangential ``vt`` parts. An inward
+   ``vn`` is removed; its size ``jn = -vn`` is the normal impulse per unit mass this
+   substep, i.e. ``h * N / m``. Coulomb friction then acts on ``vt``
    (:func:`deforma.physics.friction.coulomb`, the rule body contacts use too): if
-   ``|vt| <= static_friction * jn`` the vertex sticks (``vt = 0``), otherwise dynamic
-   friction removes ``friction * jn`` from ``|vt|`` (never reversing it).
-4. Put the point on the face (plus a nanometre skin so it is strictly outside) and move it
-   along the face by ``h * (vt_new - vt_old)``: the position is the one the *corrected*
-   velocity would have produced. Correcting only the velocity after the position update
-   (as many codes do) lets a stuck vertex creep by ``h * vt`` every substep; correcting
-   only the position (the original restored the whole previous position) makes sliding
-   impossible.
+   ``|vt| <= static_friction * jn`` the vertex sticks (``vt = 0``: it moves with the
+   surface, so a conveyor carries it), otherwise dynamic friction removes
+   ``friction * jn`` from ``|vt|`` (never reversing it).
+4. Put the point on the surface (plus a nanometre skin so it is strictly outside) and
+   move it along the surface by ``h * (vt_new - vt_old)``: the position is the one the
+   *corrected* velocity would have produced. Correcting only the velocity after the
+   position update (as many codes do) lets a stuck vertex creep by ``h * vt`` every
+   substep; correcting only the position (the original restored the whole previous
+   position) makes sliding impossible.
 
 With this, the total friction on a block is exactly ``friction * sum(N)`` while it slides
 (acceleration ``g (sin a - mu cos a)`` on a slope) and a block whose bottom vertices all
-satisfy the static test does not move at all.
+satisfy the static test does not move at all. A point that moved further in a substep than
+a collider's half-thickness gets a swept test of its path (it may have jumped a thin one).
 
-Angles are degrees in the API, radians nowhere outside this module. Units: m, m/s.
+Units: m, m/s; the packed array holds angles in radians.
 """
 
 from __future__ import annotations
 
 import math
 from collections import namedtuple
-from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from ..checks import coefficient as _coefficient
-from ..checks import pair as _pair
 from .friction import coulomb
+from .shapes import (CIRCLE, EDGE, EDGE_AX, EDGE_AY, EDGE_BX, EDGE_BY, EDGE_NX, EDGE_NY, KIND, OMEGA, POLYGON, RECT,
+                     RECT_COLUMNS, RECT_CX, RECT_CY, RECT_FRICTION, RECT_HX, RECT_HY, RECT_REACH, RECT_SKIN,
+                     RECT_STATIC_FRICTION, RECT_UX, RECT_UY, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, SEGMENT,
+                     VEL_X, VEL_Y, Circle, Polygon, Rect, Segment, pack_colliders)
 
-# Columns of the packed collider array read by the kernels.
-RECT_CX, RECT_CY, RECT_UX, RECT_UY, RECT_HX, RECT_HY = 0, 1, 2, 3, 4, 5
-RECT_FRICTION, RECT_STATIC_FRICTION = 6, 7
-RECT_XMIN, RECT_XMAX, RECT_YMIN, RECT_YMAX, RECT_SKIN = 8, 9, 10, 11, 12
-RECT_REACH = 13  # the squared half-thickness: a vertex moving further per substep may jump it
-RECT_COLUMNS = 14
+__all__ = ["Circle", "Polygon", "Rect", "Segment", "collide_point", "contact_planes", "finish_position_step",
+           "pack_colliders", "path_hits", "push_edges_off_corners", "RECT_COLUMNS"]
 
 # Per vertex of a world, the last collider contact: written only when a vertex touches one.
 ColliderHits = namedtuple("ColliderHits", [
@@ -66,157 +70,185 @@ def make_hits(n_vertices: int) -> ColliderHits:
                         np.zeros((n_vertices, 2)), np.zeros(n_vertices))
 
 
-# Pushing a point out of one rectangle can push it into a touching one; a few passes settle
+# Pushing a point out of one collider can push it into a touching one; a few passes settle
 # every sane arrangement, and a point still trapped falls back to its previous position.
 MAX_PASSES = 4
-
-
-@dataclass(frozen=True)
-class Rect:
-    """A fixed rotated rectangle that vertices collide with.
-
-    Parameters
-    ----------
-    center : (float, float)
-        Centre in metres.
-    size : (float, float)
-        Width and height in metres (before rotation), both > 0.
-    angle : float
-        Counter-clockwise rotation in degrees.
-    friction, static_friction : float, optional
-        Dynamic and static Coulomb coefficients (>= 0, dimensionless). ``None`` uses the
-        world's coefficients, also when those change later.
-
-    Examples
-    --------
-    >>> r = Rect((0, 0), (4, 1), 90.0)
-    >>> r.contains([[0.0, 1.5], [1.5, 0.0]]).tolist()
-    [True, False]
-    >>> r.corners.round(3).tolist()
-    [[0.5, 2.0], [-0.5, 2.0], [-0.5, -2.0], [0.5, -2.0]]
-    """
-
-    center: tuple[float, float]
-    size: tuple[float, float]
-    angle: float = 0.0
-    friction: float | None = None
-    static_friction: float | None = None
-
-    def __init__(self, center, size, angle=0.0, *, friction=None, static_friction=None):
-        a = float(angle)
-        if not math.isfinite(a):
-            raise ValueError(f"angle must be a finite number of degrees, got {angle!r}")
-        object.__setattr__(self, "center", _pair(center, "center"))
-        object.__setattr__(self, "size", _pair(size, "size", positive=True))
-        object.__setattr__(self, "angle", a)
-        object.__setattr__(self, "friction", _coefficient(friction, "friction"))
-        object.__setattr__(self, "static_friction", _coefficient(static_friction, "static_friction"))
-
-    @property
-    def axes(self) -> np.ndarray:
-        """(2, 2): the rectangle's unit x axis (along the width) and y axis (along the height)."""
-        t = math.radians(self.angle)
-        c, s = math.cos(t), math.sin(t)
-        return np.array([[c, s], [-s, c]])
-
-    @property
-    def corners(self) -> np.ndarray:
-        """(4, 2) corners in metres, counter-clockwise from the local (+x, -y) corner."""
-        u, w = self.axes
-        hx, hy = self.size[0] / 2, self.size[1] / 2
-        c = np.array(self.center)
-        return np.array([c + hx * u - hy * w, c + hx * u + hy * w, c - hx * u + hy * w, c - hx * u - hy * w])
-
-    def contains(self, points) -> np.ndarray:
-        """Whether each point (N, 2) lies strictly inside the rectangle, as (N,) bool."""
-        p = np.asarray(points, dtype=np.float64).reshape(-1, 2) - np.array(self.center)
-        u, w = self.axes
-        return (np.abs(p @ u) < self.size[0] / 2) & (np.abs(p @ w) < self.size[1] / 2)
-
-
-def pack_rects(rects, *, friction: float, static_friction: float, out=None) -> np.ndarray:
-    """Pack rectangles into the (R, RECT_COLUMNS) float64 array the kernels read.
-
-    ``friction`` / ``static_friction`` fill in coefficients a rectangle leaves as ``None``.
-
-    Examples
-    --------
-    >>> pack_rects([Rect((0, 0), (2, 1), 0.0)], friction=0.3, static_friction=0.5).shape
-    (1, 14)
-    """
-    a = np.empty((len(rects), RECT_COLUMNS)) if out is None else out
-    for k, r in enumerate(rects):
-        u = r.axes[0]
-        hx, hy = r.size[0] / 2, r.size[1] / 2
-        ext = np.abs(r.corners - np.array(r.center)).max(axis=0)
-        scale = abs(r.center[0]) + abs(r.center[1]) + hx + hy
-        a[k] = (r.center[0], r.center[1], u[0], u[1], hx, hy,
-                friction if r.friction is None else r.friction,
-                static_friction if r.static_friction is None else r.static_friction,
-                r.center[0] - ext[0], r.center[0] + ext[0], r.center[1] - ext[1], r.center[1] + ext[1],
-                # strictly outside after rounding back to world coordinates
-                1e-9 + 1e-13 * scale,
-                min(hx, hy) ** 2)
-    return a
 
 
 @njit(cache=True, inline="always")
 def _inside(rects, r, px, py):
     if px <= rects[r, RECT_XMIN] or px >= rects[r, RECT_XMAX] or py <= rects[r, RECT_YMIN] or py >= rects[r, RECT_YMAX]:
-        return False
+        return False  # (a polygon's edge rows have an empty box: never inside)
+    kind = rects[r, KIND]
     dx = px - rects[r, RECT_CX]
     dy = py - rects[r, RECT_CY]
-    ux = rects[r, RECT_UX]
-    uy = rects[r, RECT_UY]
-    return abs(dx * ux + dy * uy) < rects[r, RECT_HX] and abs(dy * ux - dx * uy) < rects[r, RECT_HY]
+    if kind == RECT:
+        ux = rects[r, RECT_UX]
+        uy = rects[r, RECT_UY]
+        return abs(dx * ux + dy * uy) < rects[r, RECT_HX] and abs(dy * ux - dx * uy) < rects[r, RECT_HY]
+    if kind == CIRCLE:
+        return dx * dx + dy * dy < rects[r, RECT_HX] * rects[r, RECT_HX]
+    if kind == SEGMENT:
+        along = abs(dx * rects[r, RECT_UX] + dy * rects[r, RECT_UY]) - rects[r, RECT_HX]
+        across = dy * rects[r, RECT_UX] - dx * rects[r, RECT_UY]
+        along = max(along, 0.0)
+        return along * along + across * across < rects[r, RECT_HY] * rects[r, RECT_HY]
+    # polygon: even-odd over its edges (holes included)
+    first = np.int64(rects[r, RECT_HX])
+    odd = False
+    for e in range(first, first + np.int64(rects[r, RECT_HY])):
+        ay = rects[e, EDGE_AY]
+        by = rects[e, EDGE_BY]
+        if (ay > py) != (by > py):
+            ax = rects[e, EDGE_AX]
+            if px < ax + (py - ay) * (rects[e, EDGE_BX] - ax) / (by - ay):
+                odd = not odd
+    return odd
+
+
+@njit(cache=True, inline="always")
+def _relative_start(rects, r, x0, y0, h):
+    """Where a point that was at ``(x0, y0)`` at the start of the substep would be now had it
+    ridden on collider ``r`` (which the substep moved): the start seen from the collider."""
+    w = rects[r, OMEGA]
+    return (x0 + h * (rects[r, VEL_X] - w * (y0 - rects[r, RECT_CY])),
+            y0 + h * (rects[r, VEL_Y] + w * (x0 - rects[r, RECT_CX])))
 
 
 @njit(cache=True, inline="always")
 def _exit_face(rects, r, x0, y0, px, py):
-    """The face of rectangle ``r`` by which a point inside it leaves (see the module docstring).
+    """The surface point by which a point inside collider ``r`` leaves it (see the module
+    docstring), from where it started, ``(x0, y0)``, seen from the collider.
 
-    Returns ``(nx, ny, tx, ty, s, d, depth)``: the face's outward normal and tangent, the
-    point's coordinate along the tangent and the face's distance from the centre (so the
-    point on the face is ``centre + d n + s t``), and how deep the point is inside (m).
+    Returns ``(nx, ny, qx, qy, depth)``: the outward normal there, the point on the
+    surface (for a flat face, the point's own projection onto the face's line) and how
+    deep the point is inside (m).
     """
+    kind = rects[r, KIND]
     cx = rects[r, RECT_CX]
     cy = rects[r, RECT_CY]
     ux = rects[r, RECT_UX]
     uy = rects[r, RECT_UY]
     hx = rects[r, RECT_HX]
     hy = rects[r, RECT_HY]
-    a = (px - cx) * ux + (py - cy) * uy
-    b = (py - cy) * ux - (px - cx) * uy
-    a0 = (x0 - cx) * ux + (y0 - cy) * uy
-    b0 = (y0 - cy) * ux - (x0 - cx) * uy
-    came_in = a0 >= hx or a0 <= -hx or b0 >= hy or b0 <= -hy
-    # faces: 0 = +x, 1 = -x, 2 = +y, 3 = -y (local); pick the least penetration
-    face = -1
+    if kind == RECT:
+        a = (px - cx) * ux + (py - cy) * uy
+        b = (py - cy) * ux - (px - cx) * uy
+        a0 = (x0 - cx) * ux + (y0 - cy) * uy
+        b0 = (y0 - cy) * ux - (x0 - cx) * uy
+        came_in = a0 >= hx or a0 <= -hx or b0 >= hy or b0 <= -hy
+        # faces: 0 = +x, 1 = -x, 2 = +y, 3 = -y (local); pick the least penetration among
+        # those the start was outside of
+        face = -1
+        best = np.inf
+        if (not came_in or a0 >= hx) and hx - a < best:
+            best = hx - a
+            face = 0
+        if (not came_in or a0 <= -hx) and hx + a < best:
+            best = hx + a
+            face = 1
+        if (not came_in or b0 >= hy) and hy - b < best:
+            best = hy - b
+            face = 2
+        if (not came_in or b0 <= -hy) and hy + b < best:
+            best = hy + b
+            face = 3
+        if face == 0:
+            nx, ny = ux, uy
+        elif face == 1:
+            nx, ny = -ux, -uy
+        elif face == 2:
+            nx, ny = -uy, ux
+        else:
+            nx, ny = uy, -ux
+        return nx, ny, px + best * nx, py + best * ny, best
+    if kind == CIRCLE or kind == SEGMENT:
+        # round: out along the line from the nearest point of the core (the centre, or the
+        # segment) through the point, to the radius
+        kx, ky, radius = cx, cy, hx
+        beside = False
+        if kind == SEGMENT:
+            along = (px - cx) * ux + (py - cy) * uy
+            t = min(max(along, -hx), hx)
+            kx, ky, radius = cx + t * ux, cy + t * uy, hy
+            # beside the segment (not at an end cap) and come from outside: out by the side it
+            # came from, so that a point that crossed a thin capsule or a wire within the
+            # substep goes back, whichever side of the line its end landed on
+            across0 = (y0 - cy) * ux - (x0 - cx) * uy
+            beside = abs(along) <= hx and across0 * across0 >= hy * hy
+        dx = px - kx
+        dy = py - ky
+        dist = math.sqrt(dx * dx + dy * dy)
+        if beside:
+            nx, ny = (-uy, ux) if across0 > 0.0 else (uy, -ux)
+            across = dx * nx + dy * ny
+            return nx, ny, kx + radius * nx, ky + radius * ny, radius - across
+        if dist > 1e-12 * radius:
+            nx, ny = dx / dist, dy / dist
+        else:  # on the core itself: back toward the side it came from
+            sx, sy = x0 - kx, y0 - ky
+            if kind == SEGMENT:
+                side = sy * ux - sx * uy
+                nx, ny = (-uy, ux) if side >= 0.0 else (uy, -ux)
+            else:
+                ls = math.sqrt(sx * sx + sy * sy)
+                nx, ny = (sx / ls, sy / ls) if ls > 0.0 else (0.0, 1.0)
+        return nx, ny, kx + radius * nx, ky + radius * ny, radius - dist
+    # polygon: out by the edge the path came in through, if it came in from outside
+    first = np.int64(hx)
+    last = first + np.int64(hy)
+    entry = -1
+    if not _inside(rects, r, x0, y0):
+        t_first = np.inf
+        for e in range(first, last):
+            t = _path_crosses(x0, y0, px, py, rects[e, EDGE_AX], rects[e, EDGE_AY], rects[e, EDGE_BX],
+                              rects[e, EDGE_BY])
+            if t < t_first:
+                t_first = t
+                entry = e
+    if entry >= 0:
+        nx, ny = rects[entry, EDGE_NX], rects[entry, EDGE_NY]
+        depth = (rects[entry, EDGE_AX] - px) * nx + (rects[entry, EDGE_AY] - py) * ny
+        return nx, ny, px + depth * nx, py + depth * ny, depth
+    # else the nearest point of the boundary
     best = np.inf
-    if (not came_in or a0 >= hx) and hx - a < best:
-        best = hx - a
-        face = 0
-    if (not came_in or a0 <= -hx) and hx + a < best:
-        best = hx + a
-        face = 1
-    if (not came_in or b0 >= hy) and hy - b < best:
-        best = hy - b
-        face = 2
-    if (not came_in or b0 <= -hy) and hy + b < best:
-        best = hy + b
-        face = 3
-    if face == 0:
-        return ux, uy, -uy, ux, b, hx, best
-    if face == 1:
-        return -ux, -uy, -uy, ux, b, hx, best
-    if face == 2:
-        return -uy, ux, ux, uy, a, hy, best
-    return uy, -ux, ux, uy, a, hy, best
+    bnx, bny, bqx, bqy = 0.0, 1.0, px, py
+    for e in range(first, last):
+        ax, ay = rects[e, EDGE_AX], rects[e, EDGE_AY]
+        ex, ey = rects[e, EDGE_BX] - ax, rects[e, EDGE_BY] - ay
+        t = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
+        end = t <= 0.0 or t >= 1.0
+        t = min(max(t, 0.0), 1.0)
+        qx, qy = ax + t * ex, ay + t * ey
+        d = math.sqrt((qx - px) * (qx - px) + (qy - py) * (qy - py))
+        if d < best:
+            best = d
+            bqx, bqy = qx, qy
+            if end and d > 0.0:  # nearest at a corner: out along the way to it
+                bnx, bny = (qx - px) / d, (qy - py) / d
+            else:
+                bnx, bny = rects[e, EDGE_NX], rects[e, EDGE_NY]
+    return bnx, bny, bqx, bqy, best
+
+
+@njit(cache=True, inline="always")
+def _path_crosses(x0, y0, px, py, ax, ay, bx, by):
+    """Where (0..1 along it) the path from (x0, y0) to (px, py) crosses segment a-b; inf if not."""
+    dx, dy = px - x0, py - y0
+    ex, ey = bx - ax, by - ay
+    den = dx * ey - dy * ex
+    if den == 0.0:
+        return np.inf
+    t = ((ax - x0) * ey - (ay - y0) * ex) / den
+    u = ((ax - x0) * dy - (ay - y0) * dx) / den
+    if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0:
+        return t
+    return np.inf
 
 
 @njit(cache=True)
 def jump_reach(rects):
-    """Squared half-thickness (m^2) of the thinnest rectangle: a point that moves further in
+    """Squared half-thickness (m^2) of the thinnest collider: a point that moves further in
     one substep may have jumped over it, and gets the swept test of :func:`collide_point`."""
     reach = np.inf
     for r in range(rects.shape[0]):
@@ -224,26 +256,22 @@ def jump_reach(rects):
     return reach
 
 
-@njit(cache=True)
-def _swept_entry(x0, y0, px, py, rects):
-    """A point that ended outside every rectangle but whose path from ``(x0, y0)`` went
-    through one: moved back to the middle of its path's chord in the first one it entered
-    (so the response below puts it on the face it came in by). Unchanged otherwise."""
-    first = 2.0
-    t_in = 0.0
-    t_out = 0.0
-    d2 = (px - x0) * (px - x0) + (py - y0) * (py - y0)
-    for r in range(rects.shape[0]):
-        if d2 <= rects[r, RECT_REACH]:
-            continue  # moved less than this rectangle's half-thickness: it cannot have jumped it
-        cx, cy, ux, uy = rects[r, RECT_CX], rects[r, RECT_CY], rects[r, RECT_UX], rects[r, RECT_UY]
+@njit(cache=True, inline="always")
+def _path_interval(x0, y0, px, py, rects, r):
+    """The part ``[t_in, t_out]`` of the path from (x0, y0) to (px, py) inside collider ``r``
+    (``t_in > t_out``: it misses)."""
+    kind = rects[r, KIND]
+    cx, cy, ux, uy = rects[r, RECT_CX], rects[r, RECT_CY], rects[r, RECT_UX], rects[r, RECT_UY]
+    hx, hy = rects[r, RECT_HX], rects[r, RECT_HY]
+    dx, dy = px - x0, py - y0
+    if kind == RECT:
         a0 = (x0 - cx) * ux + (y0 - cy) * uy
         b0 = (y0 - cy) * ux - (x0 - cx) * uy
-        da = (px - x0) * ux + (py - y0) * uy
-        db = (py - y0) * ux - (px - x0) * uy
+        da = dx * ux + dy * uy
+        db = dy * ux - dx * uy
         lo = 0.0
         hi = 1.0
-        for o, d, half in ((a0, da, rects[r, RECT_HX]), (b0, db, rects[r, RECT_HY])):  # slab clipping
+        for o, d, half in ((a0, da, hx), (b0, db, hy)):  # slab clipping
             if d == 0.0:
                 if abs(o) >= half:
                     lo = 2.0
@@ -252,7 +280,88 @@ def _swept_entry(x0, y0, px, py, rects):
             t2 = (half - o) / d
             lo = max(lo, min(t1, t2))
             hi = min(hi, max(t1, t2))
-        if lo < hi and lo < first:
+        return lo, hi
+    if kind == CIRCLE:
+        fx, fy = x0 - cx, y0 - cy
+        qa = dx * dx + dy * dy
+        qb = 2.0 * (fx * dx + fy * dy)
+        qc = fx * fx + fy * fy - hx * hx
+        disc = qb * qb - 4.0 * qa * qc
+        if qa == 0.0 or disc <= 0.0:
+            return 2.0, 0.0
+        root = math.sqrt(disc)
+        return max((-qb - root) / (2.0 * qa), 0.0), min((-qb + root) / (2.0 * qa), 1.0)
+    if kind == SEGMENT:
+        # the path's point nearest the core segment, if within the radius (a capsule is thin:
+        # one point of the path inside it stands for the chord)
+        best, t_best = np.inf, 2.0
+        for k in range(33):
+            t = k / 32.0
+            qx, qy = x0 + t * dx - cx, y0 + t * dy - cy
+            s = min(max(qx * ux + qy * uy, -hx), hx)
+            ex, ey = qx - s * ux, qy - s * uy
+            d2 = ex * ex + ey * ey
+            if d2 < best:
+                best, t_best = d2, t
+        # refine around the best sample: the distance along a line is convex in t
+        lo, hi = max(t_best - 1.0 / 32.0, 0.0), min(t_best + 1.0 / 32.0, 1.0)
+        for _ in range(40):
+            m1 = lo + (hi - lo) / 3.0
+            m2 = hi - (hi - lo) / 3.0
+            d1 = 0.0
+            d2 = 0.0
+            for m, which in ((m1, 0), (m2, 1)):
+                qx, qy = x0 + m * dx - cx, y0 + m * dy - cy
+                s = min(max(qx * ux + qy * uy, -hx), hx)
+                ex, ey = qx - s * ux, qy - s * uy
+                if which == 0:
+                    d1 = ex * ex + ey * ey
+                else:
+                    d2 = ex * ex + ey * ey
+            if d1 < d2:
+                hi = m2
+            else:
+                lo = m1
+        t = 0.5 * (lo + hi)
+        qx, qy = x0 + t * dx - cx, y0 + t * dy - cy
+        s = min(max(qx * ux + qy * uy, -hx), hx)
+        ex, ey = qx - s * ux, qy - s * uy
+        if ex * ex + ey * ey < hy * hy:
+            return t, t
+        return 2.0, 0.0
+    # polygon: the first two crossings of its boundary
+    t1 = np.inf
+    t2 = np.inf
+    first = np.int64(hx)
+    for e in range(first, first + np.int64(hy)):
+        t = _path_crosses(x0, y0, px, py, rects[e, EDGE_AX], rects[e, EDGE_AY], rects[e, EDGE_BX], rects[e, EDGE_BY])
+        if t < t1:
+            t2 = t1
+            t1 = t
+        elif t < t2:
+            t2 = t
+    if t2 <= 1.0:
+        return t1, t2
+    return 2.0, 0.0
+
+
+@njit(cache=True)
+def _swept_entry(x0, y0, px, py, rects):
+    """A point that ended outside every collider but whose path from ``(x0, y0)`` went
+    through one: moved back to the middle of its path's chord in the first one it entered
+    (so the response below puts it on the face it came in by). Unchanged otherwise."""
+    first = 2.0
+    t_in = 0.0
+    t_out = 0.0
+    d2 = (px - x0) * (px - x0) + (py - y0) * (py - y0)
+    for r in range(rects.shape[0]):
+        if d2 <= rects[r, RECT_REACH]:
+            continue  # moved less than this collider's half-thickness: it cannot have jumped it
+        if max(x0, px) <= rects[r, RECT_XMIN] or min(x0, px) >= rects[r, RECT_XMAX] \
+                or max(y0, py) <= rects[r, RECT_YMIN] or min(y0, py) >= rects[r, RECT_YMAX]:
+            continue
+        lo, hi = _path_interval(x0, y0, px, py, rects, r)
+        if lo <= hi and lo < first:
             first = lo
             t_in = lo
             t_out = hi
@@ -264,12 +373,12 @@ def _swept_entry(x0, y0, px, py, rects):
 
 @njit(cache=True)
 def path_hits(x0, y0, px, py, rects):
-    """Whether a point moving from ``(x0, y0)`` to ``(px, py)`` ends inside a rectangle or
+    """Whether a point moving from ``(x0, y0)`` to ``(px, py)`` ends inside a collider or
     passes through one on the way.
 
     Examples
     --------
-    >>> thin = pack_rects([Rect((0, 0), (10, 0.02), 0.0)], friction=0.3, static_friction=0.5)
+    >>> thin = pack_colliders([Rect((0, 0), (10, 0.02), 0.0)], friction=0.3, static_friction=0.5)
     >>> path_hits(0.0, 0.05, 0.0, -0.05, thin), path_hits(0.0, 0.05, 0.0, 0.02, thin)
     (True, False)
     """
@@ -282,11 +391,13 @@ def path_hits(x0, y0, px, py, rects):
 
 @njit(cache=True)
 def collide_point(x0, y0, px, py, vx, vy, rects, h):
-    """Resolve one point against all rectangles.
+    """Resolve one point against all colliders.
 
     Returns ``(px, py, vx, vy, hit, nx, ny, depth)``: the new position and velocity, the
-    index of the last rectangle the point was put out of (-1 if none), that face's outward
-    normal and how deep (m) the point was inside it.
+    index of the last collider the point was put out of (-1 if none), that surface's
+    outward normal and how deep (m) the point was inside it. A moving collider's surface
+    velocity (``v + w x (q - c)`` at the surface point ``q``) is the reference for the
+    normal and friction response: what rests on a moving platform moves with it.
 
     Parameters
     ----------
@@ -295,25 +406,33 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
     px, py, vx, vy : float
         Position (m) and velocity (m/s) after the unconstrained substep.
     rects : (R, RECT_COLUMNS) float64
-        From :func:`pack_rects`.
+        From :func:`~deforma.physics.shapes.pack_colliders`, at the end of the substep.
     h : float
         Substep length in seconds.
 
     Examples
     --------
-    >>> r = pack_rects([Rect((0, -1), (10, 2), 0.0)], friction=0.3, static_friction=0.5)
+    >>> r = pack_colliders([Rect((0, -1), (10, 2), 0.0)], friction=0.3, static_friction=0.5)
     >>> px, py, vx, vy, hit, nx, ny, depth = collide_point(0.0, 0.0, 0.01, -0.01, 1.0, -1.0, r, 0.01)
     >>> round(py, 6), vy, round(vx, 3), hit, (nx, ny), round(depth, 6)
     (0.0, 0.0, 0.7, 0, (-0.0, 1.0), 0.01)
 
     A point that jumped over a thin rectangle within the substep is caught too:
 
-    >>> thin = pack_rects([Rect((0, 0), (10, 0.02), 0.0)], friction=0.3, static_friction=0.5)
+    >>> thin = pack_colliders([Rect((0, 0), (10, 0.02), 0.0)], friction=0.3, static_friction=0.5)
     >>> px, py, vx, vy, hit, nx, ny, depth = collide_point(0.0, 0.05, 0.0, -0.05, 0.0, -10.0, thin, 0.01)
     >>> hit, round(py, 6), vy
     (0, 0.01, 0.0)
+
+    A point at rest on a platform rising at 1 m/s (its top at 0 a substep ago, 1 cm up now)
+    rises with it:
+
+    >>> lift = pack_colliders([Rect((0, -0.99), (10, 2), 0.0, velocity=(0, 1))], friction=0.3, static_friction=0.5)
+    >>> px, py, vx, vy, hit, nx, ny, depth = collide_point(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, lift, 0.01)
+    >>> round(py, 6), vy
+    (0.01, 1.0)
     """
-    # the swept test only for a point that moved further than some rectangle's half-thickness
+    # the swept test only for a point that moved further than some collider's half-thickness
     # (rare), and decided inline: a call per point would cost reference counting on rects
     d2 = (px - x0) * (px - x0) + (py - y0) * (py - y0)
     jumpy = False
@@ -338,57 +457,65 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
             if not _inside(rects, r, px, py):
                 continue
             hit = True
-            nx, ny, tx, ty, s, d, best = _exit_face(rects, r, x0, y0, px, py)
-            vn = vx * nx + vy * ny
-            vt = vx * tx + vy * ty
+            rx0, ry0 = _relative_start(rects, r, x0, y0, h)
+            nx, ny, qx, qy, best = _exit_face(rects, r, rx0, ry0, px, py)
+            tx, ty = -ny, nx
+            w = rects[r, OMEGA]
+            sx = rects[r, VEL_X] - w * (qy - rects[r, RECT_CY])  # the surface's velocity at q
+            sy = rects[r, VEL_Y] + w * (qx - rects[r, RECT_CX])
+            vn = (vx - sx) * nx + (vy - sy) * ny
+            vt = (vx - sx) * tx + (vy - sy) * ty
             jn = 0.0
             if vn < 0.0:
                 jn = -vn
                 vn = 0.0
             vt_new = coulomb(vt, jn, rects[r, RECT_STATIC_FRICTION], rects[r, RECT_FRICTION])
-            s += h * (vt_new - vt)
+            shift = h * (vt_new - vt)
             last = r
             hx_n = nx
             hy_n = ny
             last_depth = best
-            d += rects[r, RECT_SKIN]
-            px = rects[r, RECT_CX] + d * nx + s * tx
-            py = rects[r, RECT_CY] + d * ny + s * ty
-            vx = vn * nx + vt_new * tx
-            vy = vn * ny + vt_new * ty
+            skin = rects[r, RECT_SKIN]
+            px = qx + skin * nx + shift * tx
+            py = qy + skin * ny + shift * ty
+            vx = sx + vn * nx + vt_new * tx
+            vy = sy + vn * ny + vt_new * ty
         if not hit:
             break
     if hit:
         for r in range(rects.shape[0]):
             if _inside(rects, r, px, py):
-                # trapped between rectangles: the original's answer, back to where it was
+                # trapped between colliders: the original's answer, back to where it was
                 return x0, y0, 0.0, 0.0, last, hx_n, hy_n, last_depth
     return px, py, vx, vy, last, hx_n, hy_n, last_depth
 
 
 @njit(cache=True)
-def contact_planes(x0, y, rects, planes, index):
+def contact_planes(x0, y, rects, planes, index, h):
     """The collider contacts a stable solver puts inside its solve: which vertices, and where.
 
-    A vertex whose predicted end of substep ``y`` lies inside a rectangle gets the plane of
-    the face it would leave by (chosen as :func:`collide_point` chooses it, from where it
-    started, ``x0``); of several rectangles, the one it is deepest in. A point ``p`` is
-    outside that face when ``n . p >= c``. Only vertices headed inside are listed: the
-    solvers hold a listed vertex near its iterate, and listing vertices a hair outside too
-    made the next row up of a body on the floor follow its free fall
-    (``docs/integrators.md``).
+    A vertex whose predicted end of substep ``y`` lies inside a collider gets the plane
+    tangent to the surface point it would leave by (chosen as :func:`collide_point`
+    chooses it, from where it started, ``x0``); of several colliders, the one it is
+    deepest in. A point ``p`` is outside that plane when ``n . p >= c``. Only vertices
+    headed inside are listed: the solvers hold a listed vertex near its iterate, and
+    listing vertices a hair outside too made the next row up of a body on the floor
+    follow its free fall (``docs/integrators.md``).
 
     Parameters
     ----------
     x0, y : (N, 2) float64
         Positions at the start of the substep and predicted at its end (m).
     rects : (R, RECT_COLUMNS) float64
-        From :func:`pack_rects`.
-    planes : (N, 5) float64
-        Output: ``nx, ny, c, static_friction, friction`` per listed vertex (the first
-        ``count`` rows).
+        From :func:`~deforma.physics.shapes.pack_colliders`.
+    planes : (N, 7) float64 or wider
+        Output: ``nx, ny, c, static_friction, friction, sx, sy`` per listed vertex (the
+        first ``count`` rows); ``(sx, sy)`` is how far the collider's surface moved there
+        in the substep (m), which friction measures slip against.
     index : (N,) int32
         Output: the listed vertices, ascending.
+    h : float
+        Substep (s).
 
     Returns
     -------
@@ -398,13 +525,13 @@ def contact_planes(x0, y, rects, planes, index):
     Examples
     --------
     >>> import numpy as np
-    >>> floor = pack_rects([Rect((0, -0.5), (10, 1.0), 0.0)], friction=0.3, static_friction=0.5)
-    >>> planes, index = np.zeros((2, 5)), np.zeros(2, np.int32)
+    >>> floor = pack_colliders([Rect((0, -0.5), (10, 1.0), 0.0)], friction=0.3, static_friction=0.5)
+    >>> planes, index = np.zeros((2, 7)), np.zeros(2, np.int32)
     >>> x0 = np.array([[0.0, 0.01], [1.0, 2.0]])
-    >>> contact_planes(x0, x0 - [0.0, 0.02], floor, planes, index)  # the low one only
+    >>> contact_planes(x0, x0 - [0.0, 0.02], floor, planes, index, 0.01)  # the low one only
     1
     >>> int(index[0]), (planes[0] + 0.0).round(6).tolist()  # + 0.0 turns -0.0 into 0.0
-    (0, [0.0, 1.0, 0.0, 0.5, 0.3])
+    (0, [0.0, 1.0, 0.0, 0.5, 0.3, 0.0, 0.0])
     """
     count = 0
     for i in range(y.shape[0]):
@@ -413,18 +540,80 @@ def contact_planes(x0, y, rects, planes, index):
         for r in range(rects.shape[0]):
             if not _inside(rects, r, px, py):
                 continue
-            nx, ny, tx, ty, t, d, depth = _exit_face(rects, r, x0[i, 0], x0[i, 1], px, py)
+            rx0, ry0 = _relative_start(rects, r, x0[i, 0], x0[i, 1], h)
+            nx, ny, qx, qy, depth = _exit_face(rects, r, rx0, ry0, px, py)
             if depth > best_depth:
                 best_depth = depth
+                w = rects[r, OMEGA]
                 planes[count, 0] = nx
                 planes[count, 1] = ny
-                planes[count, 2] = rects[r, RECT_CX] * nx + rects[r, RECT_CY] * ny + d + rects[r, RECT_SKIN]
+                planes[count, 2] = qx * nx + qy * ny + rects[r, RECT_SKIN]
                 planes[count, 3] = rects[r, RECT_STATIC_FRICTION]
                 planes[count, 4] = rects[r, RECT_FRICTION]
+                planes[count, 5] = h * (rects[r, VEL_X] - w * (qy - rects[r, RECT_CY]))
+                planes[count, 6] = h * (rects[r, VEL_Y] + w * (qx - rects[r, RECT_CX]))
         if best_depth > -np.inf:
             index[count] = i
             count += 1
     return count
+
+
+@njit(cache=True)
+def advance_colliders(rects, h):
+    """Move every moving collider in the packed array by one substep of ``h`` s: its centre
+    by ``h v``, its frame (and a polygon's edges) turned by ``h w`` about the centre, its
+    bounding box to match. Returns whether any moved. The world repacks from the collider
+    objects before each step, so the packed poses never drift from them.
+
+    Examples
+    --------
+    >>> a = pack_colliders([Rect((0, 0), (2, 2), 0.0, velocity=(1, 0), angular_velocity=90)],
+    ...                    friction=0.3, static_friction=0.5)
+    >>> advance_colliders(a, 1.0), a[0, :4].round(6).tolist()  # a quarter turn, 1 m right
+    (True, [1.0, 0.0, 0.0, 1.0])
+    """
+    moved = False
+    for r in range(rects.shape[0]):
+        kind = rects[r, KIND]
+        if kind == EDGE:
+            continue
+        vx, vy, w = rects[r, VEL_X], rects[r, VEL_Y], rects[r, OMEGA]
+        if vx == 0.0 and vy == 0.0 and w == 0.0:
+            continue
+        moved = True
+        cx, cy = rects[r, RECT_CX], rects[r, RECT_CY]
+        c, sn = math.cos(h * w), math.sin(h * w)
+        ux, uy = rects[r, RECT_UX], rects[r, RECT_UY]
+        ux, uy = c * ux - sn * uy, sn * ux + c * uy
+        norm = math.sqrt(ux * ux + uy * uy)  # keep it a unit vector over many substeps
+        ux, uy = ux / norm, uy / norm
+        nx_, ny_ = cx + h * vx, cy + h * vy
+        rects[r, RECT_CX], rects[r, RECT_CY], rects[r, RECT_UX], rects[r, RECT_UY] = nx_, ny_, ux, uy
+        hx, hy = rects[r, RECT_HX], rects[r, RECT_HY]
+        if kind == RECT:
+            ex = abs(hx * ux) + abs(hy * uy)
+            ey = abs(hx * uy) + abs(hy * ux)
+        elif kind == CIRCLE:
+            ex = ey = hx
+        elif kind == SEGMENT:
+            ex = abs(hx * ux) + hy
+            ey = abs(hx * uy) + hy
+        else:
+            lox = loy = np.inf
+            hix = hiy = -np.inf
+            for e in range(np.int64(hx), np.int64(hx) + np.int64(hy)):
+                for col in (0, 2):  # the two ends: turned about the old centre, then moved
+                    px, py = rects[e, col] - cx, rects[e, col + 1] - cy
+                    px, py = nx_ + c * px - sn * py, ny_ + sn * px + c * py
+                    rects[e, col], rects[e, col + 1] = px, py
+                    lox, hix, loy, hiy = min(lox, px), max(hix, px), min(loy, py), max(hiy, py)
+                enx, eny = rects[e, EDGE_NX], rects[e, EDGE_NY]
+                rects[e, EDGE_NX], rects[e, EDGE_NY] = c * enx - sn * eny, sn * enx + c * eny
+            rects[r, RECT_XMIN], rects[r, RECT_XMAX], rects[r, RECT_YMIN], rects[r, RECT_YMAX] = lox, hix, loy, hiy
+            continue
+        rects[r, RECT_XMIN], rects[r, RECT_XMAX] = nx_ - ex, nx_ + ex
+        rects[r, RECT_YMIN], rects[r, RECT_YMAX] = ny_ - ey, ny_ + ey
+    return moved
 
 
 @njit(cache=True, inline="always")
@@ -461,7 +650,7 @@ def finish_position_step(x, v, x_prev, rects, hits, stamp, h, vmax2):
     x_prev : (N, 2) float64
         Positions at the start of the substep (m).
     rects : (R, RECT_COLUMNS) float64
-        From :func:`pack_rects`.
+        From :func:`~deforma.physics.shapes.pack_colliders`.
     hits : ColliderHits
         Where each vertex that touches a collider is noted, with ``stamp``.
     h : float
@@ -527,12 +716,12 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
     vertex : (V,) int32
         Collision vertex -> row of ``x`` (``ContactTopology.cv_vertex``).
     rects : (R, RECT_COLUMNS) float64
-        From :func:`pack_rects`.
+        From :func:`~deforma.physics.shapes.pack_colliders`.
 
     Examples
     --------
     >>> import numpy as np
-    >>> r = pack_rects([Rect((0, 0), (2, 2), 45.0)], friction=0.3, static_friction=0.5)
+    >>> r = pack_colliders([Rect((0, 0), (2, 2), 45.0)], friction=0.3, static_friction=0.5)
     >>> x = np.array([[-1.0, 1.3], [1.0, 1.3]])  # an edge running right: the body is above it
     >>> v = np.array([[0.0, -1.0], [0.0, -1.0]])
     >>> push_edges_off_corners(x, v, np.ones(2), np.array([0], np.int32), np.array([1], np.int32),
@@ -551,6 +740,9 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
             if max(ax, bx) <= rects[r, RECT_XMIN] or min(ax, bx) >= rects[r, RECT_XMAX] \
                     or max(ay, by) <= rects[r, RECT_YMIN] or min(ay, by) >= rects[r, RECT_YMAX]:
                 continue
+            kind = rects[r, KIND]
+            if kind != RECT and kind != POLYGON:
+                continue  # round shapes have no corner to poke through an edge
             cx, cy = rects[r, RECT_CX], rects[r, RECT_CY]
             ux, uy = rects[r, RECT_UX], rects[r, RECT_UY]
             hx, hy = rects[r, RECT_HX], rects[r, RECT_HY]
@@ -560,20 +752,28 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
                 continue
             inv_len = 1.0 / np.sqrt(length2)
             nx, ny = -dy * inv_len, dx * inv_len  # toward the body
-            # does the edge cross the rectangle? (separating axes: its two axes, the edge's normal)
-            pax, pay = (ax - cx) * ux + (ay - cy) * uy, -(ax - cx) * uy + (ay - cy) * ux
-            pbx, pby = (bx - cx) * ux + (by - cy) * uy, -(bx - cx) * uy + (by - cy) * ux
-            if min(pax, pbx) >= hx or max(pax, pbx) <= -hx or min(pay, pby) >= hy or max(pay, pby) <= -hy:
-                continue
-            mx, my = nx * ux + ny * uy, -nx * uy + ny * ux  # the normal in the rectangle's frame
-            if abs(pax * mx + pay * my) >= hx * abs(mx) + hy * abs(my):
-                continue
+            n_corners = 4
+            if kind == RECT:
+                # does the edge cross the rectangle? (separating axes: its two axes, the edge's normal)
+                pax, pay = (ax - cx) * ux + (ay - cy) * uy, -(ax - cx) * uy + (ay - cy) * ux
+                pbx, pby = (bx - cx) * ux + (by - cy) * uy, -(bx - cx) * uy + (by - cy) * ux
+                if min(pax, pbx) >= hx or max(pax, pbx) <= -hx or min(pay, pby) >= hy or max(pay, pby) <= -hy:
+                    continue
+                mx, my = nx * ux + ny * uy, -nx * uy + ny * ux  # the normal in the rectangle's frame
+                if abs(pax * mx + pay * my) >= hx * abs(mx) + hy * abs(my):
+                    continue
+            else:
+                n_corners = np.int64(hy)  # a polygon's corners: the first ends of its edges
             best, best_s = 0.0, 0.0
-            for k in range(4):
-                sx = hx if k == 0 or k == 3 else -hx
-                sy = hy if k < 2 else -hy
-                px = cx + sx * ux - sy * uy
-                py = cy + sx * uy + sy * ux
+            for k in range(n_corners):
+                if kind == RECT:
+                    sx = hx if k == 0 or k == 3 else -hx
+                    sy = hy if k < 2 else -hy
+                    px = cx + sx * ux - sy * uy
+                    py = cy + sx * uy + sy * ux
+                else:
+                    e = np.int64(hx) + k
+                    px, py = rects[e, EDGE_AX], rects[e, EDGE_AY]
                 t = ((px - ax) * dx + (py - ay) * dy) / length2
                 depth = (px - ax) * nx + (py - ay) * ny
                 # a corner poking through this edge: beside it, on the body's side, and not

@@ -581,7 +581,6 @@ def detect_contacts(x, topo, scr, out):
     ``scr.xp`` and only grows the body boxes). Returns the number of contacts, or -1 if
     ``out`` was too small (as :func:`contact_stage`).
     """
-    status = scr.status
     n, _ = _collide(x, topo, scr, out)
     return n
 

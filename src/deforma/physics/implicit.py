@@ -64,7 +64,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from .colliders import contact_planes, finish_position_step, push_edges_off_corners
+from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start
 from .elements import element_matrix, implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
@@ -155,7 +155,7 @@ def contact_rhs(x, x_n, planes, index, count, weight, b):
     >>> import numpy as np
     >>> b = np.zeros((1, 2))
     >>> x, x_n = np.array([[0.3, -0.1]]), np.array([[0.0, 0.5]])
-    >>> floor = np.array([[0.0, 1.0, 0.0, 0.5, 0.3]])
+    >>> floor = np.array([[0.0, 1.0, 0.0, 0.5, 0.3, 0.0, 0.0]])
     >>> contact_rhs(x, x_n, floor, np.zeros(1, np.int32), 1, np.array([2.0]), b)
     >>> b.round(9).tolist()  # slid 0.3 m, more than 0.5 * 0.1: held back by 0.3 * 0.1
     [[0.54, 0.0]]
@@ -169,8 +169,9 @@ def contact_rhs(x, x_n, planes, index, count, weight, b):
             push = -gap
             px += push * nx
             py += push * ny
-            # tangential motion since the substep began (t = (-ny, nx))
-            slide = (x_n[i, 0] - x[i, 0]) * -ny + (x_n[i, 1] - x[i, 1]) * nx
+            # tangential motion since the substep began, relative to the collider's surface
+            # (which moved by planes[k, 5:7]; t = (-ny, nx))
+            slide = (x_n[i, 0] + planes[k, 5] - x[i, 0]) * -ny + (x_n[i, 1] + planes[k, 6] - x[i, 1]) * nx
             if abs(slide) > planes[k, 3] * push:
                 slide = planes[k, 4] * push * (1.0 if slide > 0.0 else -1.0)
             px -= slide * ny
@@ -389,7 +390,7 @@ class ImplicitEuler:
             self._x_n = np.empty((n, 2))
             self._y = np.empty((n, 2))
             self._b = np.empty((n, 2))
-            self._planes = np.empty((n, 5))
+            self._planes = np.empty((n, 7))
             self._touch = np.empty(n, np.int32)
             self._scratch_n = n
         self._base_if_needed(model, inputs, h)
@@ -402,6 +403,7 @@ class ImplicitEuler:
         np.copyto(state.v_start, v)
         keep = 1.0 / (1.0 + h * inputs.air_drag)
         for _ in range(substeps):
+            advance_colliders(inputs.rects, h)  # moving colliders to where they are at the end of the substep
             np.copyto(x_n, x)
             if keep != 1.0:  # air drag: the prediction's share here, the mass's in the matrix (see _base_if_needed)
                 v *= keep
@@ -413,7 +415,7 @@ class ImplicitEuler:
             # start of the substep (Baraff & Witkin's one Newton step, with the directions
             # of x_n). Starting at the prediction y measured worse on impacts: y can already
             # have a row of vertices pushed through the next, and the iteration keeps it.
-            count = contact_planes(x_n, y, inputs.rects, self._planes, self._touch)
+            count = contact_planes(x_n, y, inputs.rects, self._planes, self._touch, float(h))
             scr, topo, buf = inputs.contact_scratch, model.contact, inputs.contacts
             gather_start(x_n, topo, scr)
             n_body = detect_contacts(y, topo, scr, buf)  # of the predicted motion

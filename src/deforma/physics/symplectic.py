@@ -30,8 +30,8 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from .colliders import (RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, collide_point, is_bad, jump_reach,
-                        push_edges_off_corners, record_hit)
+from .colliders import (RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, advance_colliders, collide_point, is_bad,
+                        jump_reach, push_edges_off_corners, record_hit)
 from .contacts import ST_STAMP, contact_stage, gather_start
 from .elements import element_forces
 from .forces import spring_force
@@ -110,6 +110,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
     n_chunks = chunk_ptr.shape[0] - 1
     reach2 = jump_reach(rects)
     for sub in range(substeps):
+        advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
         gather_start(x, ctopo, cscr)
         stamp = cscr.status[ST_STAMP] + 1  # the contact stage counts this substep when it runs
         for t in prange(n_chunks):

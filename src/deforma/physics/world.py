@@ -25,7 +25,8 @@ from ..checks import switch as _switch
 from . import behaviours as _behaviours
 from . import contacts as _contacts
 from . import tearing as _tearing
-from .colliders import Rect, make_hits, pack_rects
+from .colliders import make_hits
+from .shapes import SHAPES, Collider, pack_colliders
 from .elements import element_energy, gradient_row_sums, max_stiffness, signed_areas
 from .integrators import make_integrator
 from .body import Body, Grab, _fem_mesh_check, _material, _pressure
@@ -88,7 +89,7 @@ class _StepInputs:
 
 
 class World:
-    """Soft bodies, rotated-rectangle colliders, gravity and Coulomb friction.
+    """Soft bodies, colliders of any shape (fixed or moving), gravity and Coulomb friction.
 
     Parameters
     ----------
@@ -146,8 +147,8 @@ class World:
                  integrator="symplectic-euler", contact_thickness=None, air_drag=0.0, material=None):
         self._inputs = _StepInputs()
         self._bodies: list[Body] = []
-        self._colliders: list[Rect] = []
-        self._packed_colliders: list | None = None
+        self._colliders: list[Collider] = []
+        self._packed_colliders: tuple | None = None  # what was packed: (id, version) per collider
         self._grabs: list[Grab] = []
         self._grabs_dirty = True
         self._lost_shape = {}  # id(body) -> checks in a row at which it had lost its shape
@@ -222,7 +223,7 @@ class World:
             for b in range(len(self._bodies)):  # bodies that follow the world (friction: body contacts)
                 self._apply_body_parameters(b)
             if name in ("friction", "static_friction"):
-                self._packed_colliders = None
+                self._packed_colliders = None  # colliders that follow the world's
         return property(get, set_, doc=f"World default {name} ({unit}).")
 
     mass = _world_param("mass", "kg", _positive)
@@ -532,19 +533,21 @@ class World:
         >>> sorted(set(c.collider.tolist())), bool((c.normal[c.collider == -1, 1] > 0.99).any())
         ([-1, 0], True)
         """
-        if self._packed_colliders is None or self._packed_colliders != self._colliders:
+        if self._colliders_changed():
             self._pack_colliders()
         return _contacts.snapshot(self._model.contact, self._inputs.contact_scratch, self._inputs.contacts,
                                   self._inputs.hits, self._inputs.rects)
 
     # -- colliders --------------------------------------------------------------------------
     @property
-    def colliders(self) -> list[Rect]:
-        """The collider list itself: append, remove or replace Rects freely."""
-        return self._colliders
+    def colliders(self) -> tuple:
+        """The colliders, in the order added (a read-only view: use add_collider /
+        remove_collider; a collider's own pose, motion and friction can be set directly)."""
+        return tuple(self._colliders)
 
-    def add_collider(self, rect: Rect) -> Rect:
-        """Add a rotated rectangle; returns it.
+    def add_collider(self, collider: Collider) -> Collider:
+        """Add a collider (a :class:`~deforma.Rect`, :class:`~deforma.Circle`,
+        :class:`~deforma.Polygon` or :class:`~deforma.Segment`); returns it.
 
         Examples
         --------
@@ -552,19 +555,39 @@ class World:
         >>> w = deforma.World()
         >>> w.add_collider(deforma.Rect((0, 0), (10, 0.5), 15.0)).angle
         15.0
+        >>> paddle = w.add_collider(deforma.Segment((-1, 2), (1, 2), 0.05, angular_velocity=90.0))
+        >>> len(w.colliders)
+        2
         """
-        if not isinstance(rect, Rect):
-            raise ValueError(f"collider must be a deforma.Rect, got {type(rect).__name__}")
-        self._colliders.append(rect)
-        return rect
+        if not isinstance(collider, SHAPES):
+            raise ValueError(f"collider must be a deforma.Rect, Circle, Polygon or Segment, "
+                             f"got {type(collider).__name__}")
+        if any(c is collider for c in self._colliders):
+            raise ValueError("this collider is in the world already")
+        self._colliders.append(collider)
+        return collider
+
+    def remove_collider(self, collider: Collider) -> None:
+        """Take a collider out of the world.
+
+        Raises
+        ------
+        ValueError
+            If ``collider`` is not a collider of this world.
+        """
+        for k, c in enumerate(self._colliders):
+            if c is collider:
+                del self._colliders[k]
+                return
+        raise ValueError("that collider is not in this world (see world.colliders)")
+
+    def _colliders_changed(self) -> bool:
+        return self._packed_colliders != tuple((id(c), c._version) for c in self._colliders)
 
     def _pack_colliders(self):
-        for r in self._colliders:
-            if not isinstance(r, Rect):
-                raise ValueError(f"world.colliders may hold only deforma.Rect, found {type(r).__name__}")
-        self._inputs.rects = pack_rects(self._colliders, friction=self.friction,
-                                        static_friction=self.static_friction)
-        self._packed_colliders = list(self._colliders)
+        self._inputs.rects = pack_colliders(self._colliders, friction=self.friction,
+                                            static_friction=self.static_friction)
+        self._packed_colliders = tuple((id(c), c._version) for c in self._colliders)
 
     # -- interaction ------------------------------------------------------------------------
     def explode(self, strength: float, *, center=None) -> None:
@@ -707,7 +730,8 @@ class World:
             If a vertex ends non-finite or faster than ``max_speed``; the state is then put
             back to what it was before this step.
         """
-        moved = self._packed_colliders is None or self._packed_colliders != self._colliders
+        moving = any(c.moving for c in self._colliders)
+        moved = self._colliders_changed() or moving
         if moved:
             self._pack_colliders()
         if self._grabs_dirty:
@@ -727,6 +751,8 @@ class World:
                     break
                 # the contact buffer was too small: grow it and run the step again from its start
                 self._state.restore()
+                if moving:  # the kernels moved the packed colliders: back to the start
+                    self._pack_colliders()
                 buf = self._inputs.contacts
                 self._inputs.contacts = _contacts.make_buffer(max(2 * need_c, len(buf.vertex)),
                                                               max(2 * need_p, len(buf.pair_vertex)))
@@ -734,8 +760,16 @@ class World:
                 if kicked is not None:
                     self._state.v_start[...] = kicked
                 self._fail()
-            if moved:
-                self._check_not_trapped()
+            poses = [(c, c.center, c.angle) for c in self._colliders if c.moving]
+            for c, _, _ in poses:  # the kernels moved the packed copies; now the objects
+                c.advance(self._dt)
+            if moved or poses:
+                try:
+                    self._check_not_trapped()
+                except SimulationUnstable:
+                    for c, center, angle in poses:  # the step is undone: so is their motion
+                        c.center, c.angle = center, angle
+                    raise
             _behaviours.limit_and_yield(self._model, self._state, self._dt)
             self._tear()
             if self.step_count % SHAPE_CHECK_EVERY == 0:

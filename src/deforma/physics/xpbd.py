@@ -52,7 +52,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .colliders import contact_planes, finish_position_step, push_edges_off_corners
+from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, project_contacts
 from .elements import project_elements
 from .integrators import register_integrator
@@ -125,7 +125,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     ...                     np.zeros(2, np.int32), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
     ...                     np.zeros(1), *no_elements, 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
-    ...                     np.zeros((0, 14)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
+    ...                     np.zeros((0, 18)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
     ...                     0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
     1.0
@@ -135,6 +135,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     for i in range(n):
         x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
     for sub in range(substeps):
+        advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
         for i in range(n):
             x_prev[i, 0] = x[i, 0]
             x_prev[i, 1] = x[i, 1]
@@ -161,9 +162,9 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         for e in range(elem.shape[0]):
             elem_lam_acc[e, 0] = 0.0
             elem_lam_acc[e, 1] = 0.0
-        count = contact_planes(x_prev, x, rects, planes, touch)
+        count = contact_planes(x_prev, x, rects, planes, touch, h)
         for k in range(count):
-            planes[k, 5] = -1.0  # stick or slide: not decided yet
+            planes[k, 7] = -1.0  # stick or slide: not decided yet
         gather_start(x_prev, ctopo, cscr)
         n_body = detect_contacts(x, ctopo, cscr, cbuf)  # of the predicted motion
         if n_body < 0:
@@ -182,10 +183,11 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
                 # substep's normal impulse, as in the collider rule); a stuck vertex has its
                 # tangential motion undone in every sweep, a sliding one is held back by the
                 # dynamic coefficient times each sweep's push
-                slide = (x_prev[i, 0] - x[i, 0]) * -ny + (x_prev[i, 1] - x[i, 1]) * nx
-                if planes[k, 5] < 0.0:
-                    planes[k, 5] = 1.0 if abs(slide) <= planes[k, 3] * push else 0.0
-                if planes[k, 5] == 0.0:
+                # (relative to the collider's surface, which moved by planes[k, 5:7])
+                slide = (x_prev[i, 0] + planes[k, 5] - x[i, 0]) * -ny + (x_prev[i, 1] + planes[k, 6] - x[i, 1]) * nx
+                if planes[k, 7] < 0.0:
+                    planes[k, 7] = 1.0 if abs(slide) <= planes[k, 3] * push else 0.0
+                if planes[k, 7] == 0.0:
                     slide = min(abs(slide), planes[k, 4] * push) * (1.0 if slide > 0.0 else -1.0)
                 x[i, 0] += push * nx - slide * ny
                 x[i, 1] += push * ny + slide * nx
@@ -260,7 +262,7 @@ class XPBD:
             self._x_prev = np.empty((shape[0], 2))
             self._lam = np.empty(shape[1])
             self._elem_lam = np.empty((shape[2], 2))
-            self._planes = np.empty((shape[0], 6))
+            self._planes = np.empty((shape[0], 8))
             self._touch = np.empty(shape[0], np.int32)
             self._n = shape
         gx, gy = inputs.gravity
