@@ -8,7 +8,7 @@ import pytest
 import deforma
 from deforma.scene import BoxBody, ImageBody
 from deforma.viewer.params import GROUPS, PARAMS, parse_value
-from deforma.viewer.session import OBJECTS, Session
+from deforma.viewer.session import COLLIDER_FIELDS, OBJECTS, Session
 from seed_scenes import seed
 
 
@@ -21,7 +21,9 @@ def test_every_original_inspector_value_is_a_parameter():
     assert [g for g, _ in GROUPS] == ["Square", "Texture", "Physics", "Material", "Contact", "Collision", "Mouse"]
     assert {"tear_strain", "yield_strain", "plastic_rate", "max_stretch", "pressure"} <= names
     s = Session("demo")
-    for name in names:  # every parameter reads back from a live session (None: a value that is off)
+    shape_only = set(COLLIDER_FIELDS) - set(s.collider_params())  # a rect has no radius: greyed out
+    assert shape_only == {"collider_radius"}
+    for name in names - shape_only:  # every parameter reads back from a live session (None: a value that is off)
         assert s.get_param(name) is not None or PARAMS[name].optional
 
 

@@ -275,7 +275,7 @@ def test_panel_adds_selects_and_removes_colliders(demo):
     post(pygame_gui.UI_BUTTON_PRESSED, ui_element=ins.add_collider)
     run(demo, 2)
     assert len(demo.session.world.colliders) == n + 1 and demo.session.collider_index == n
-    assert ins.collider_label.text == f"{n + 1} of {n + 1}"
+    assert ins.collider_label.text == f"{n + 1} of {n + 1}: rect"
     assert demo.view.collider_colors[n] is not None  # the new one is highlighted
     entry = ins.rows["collider_angle"].entry
     entry.set_text("25")

@@ -323,8 +323,37 @@ class Viewer:
             path = f"deforma-{k:03d}.png"
         self._screenshot_requests.append(str(path))
 
-    def _do(self, action: str) -> None:
-        if action == "explode":
+    def rotate_collider(self, degrees: float) -> None:
+        """Turn the selected collider about its centre (the Z and X keys)."""
+        s = self.session
+        # only one the person picked (it is drawn highlighted), not the panel's default choice
+        if s.collider is None or not s.collider_active:
+            self.inspector.say("click a collider first to turn it")
+            return
+        angle = s.rotate_collider(degrees)
+        self.inspector.say(f"{s.collider_shape} {s.collider_index + 1} at {angle:g}°")
+        self.inspector.refresh()
+
+    def remove_collider(self) -> None:
+        """Remove the selected collider (the Delete key)."""
+        s = self.session
+        if s.collider is None or not s.collider_active:
+            self.inspector.say("click a collider first to remove it")
+            return
+        self._collider_drag = None
+        shape = s.collider_shape
+        s.remove_collider()
+        self.inspector.say(f"removed the {shape}")
+        self.inspector.refresh()
+
+    def _do(self, action: str, *, mod: int = 0) -> None:
+        if action.startswith("rotate:"):
+            step = float(action.split(":", 1)[1])
+            # Shift for fine turns: 1° a press
+            self.rotate_collider(step / abs(step) if mod & self.pg.KMOD_SHIFT else step)
+        elif action == "remove_collider":
+            self.remove_collider()
+        elif action == "explode":
             self.explode()
         elif action == "pause":
             self.toggle_pause()
@@ -426,7 +455,7 @@ class Viewer:
                     return
                 action = self._keymap.get(e.key)
                 if action is not None:
-                    self._do(action)
+                    self._do(action, mod=getattr(e, "mod", 0))
             return
         # the panel's own events (button presses, entries finished, ...)
         self.inspector.process_event(e)

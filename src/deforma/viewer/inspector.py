@@ -25,7 +25,7 @@ from pygame_gui.elements import (UIButton, UICheckBox, UIDropDownMenu, UIHorizon
 
 from ..physics import available_integrators
 from .params import GROUPS, PARAMS, Param, format_value, parse_value
-from .session import MATERIAL_MODELS, OBJECTS
+from .session import COLLIDER_FIELDS, COLLIDER_SHAPES, MATERIAL_MODELS, OBJECTS
 
 __all__ = ["PANEL_WIDTH", "Inspector"]
 
@@ -40,7 +40,7 @@ THEME = {
     "defaults": {
         "colours": {
             "normal_bg": "#e9edf3", "hovered_bg": "#dde4ee", "disabled_bg": "#f1f2f4", "selected_bg": "#cfdcf0",
-            "active_bg": "#c3d3ec", "dark_bg": "#f7f8fa",
+            "active_bg": "#c3d3ec", "dark_bg": "#f7f8fa", "disabled_dark_bg": "#eef0f3",
             "normal_text": "#1f2a37", "hovered_text": "#111827", "selected_text": "#111827",
             "active_text": "#111827", "disabled_text": "#9aa3ad",
             "normal_border": "#c4ccd6", "hovered_border": "#8fa6c6", "disabled_border": "#dde1e6",
@@ -121,6 +121,8 @@ class Inspector:
         self.message_is_error = False
         self._message_shown = None
         self._save_path = save_path
+        #: The shape the Add button makes (the menu beside it).
+        self.new_shape = COLLIDER_SHAPES[0]
         self.dirty = True
         self._since_draw = 0.0
         self._build()
@@ -168,13 +170,16 @@ class Inspector:
             if group == "Collision":
                 self.prev_collider = UIButton(pygame.Rect(14, y, 26, 24), "<", m, container=c,
                                               tool_tip_text="previous collider")
-                self.collider_label = UILabel(pygame.Rect(42, y, 70, 24), "", m, container=c)
-                self.next_collider = UIButton(pygame.Rect(114, y, 26, 24), ">", m, container=c,
+                self.collider_label = UILabel(pygame.Rect(42, y, 124, 24), "", m, container=c)
+                self.next_collider = UIButton(pygame.Rect(168, y, 26, 24), ">", m, container=c,
                                               tool_tip_text="next collider (or click one in the world)")
-                self.add_collider = UIButton(pygame.Rect(150, y, 66, 24), "Add", m, container=c,
-                                             tool_tip_text="a new 3 m rectangle at the view's centre")
                 self.remove_collider = UIButton(pygame.Rect(222, y, 90, 24), "Remove", m, container=c,
-                                                tool_tip_text="remove the selected collider")
+                                                tool_tip_text="remove the selected collider (Delete)")
+                y += ROW
+                self._shape_rect = pygame.Rect(14, y, 180, 24)
+                self._make_shape_menu()
+                self.add_collider = UIButton(pygame.Rect(222, y, 90, 24), "Add", m, container=c,
+                                             tool_tip_text="a new collider of the chosen shape at the view's centre")
                 y += ROW
             for p in params:
                 self.rows[p.name] = self._row(p, y)
@@ -196,13 +201,17 @@ class Inspector:
             row.slider = UIHorizontalSlider(pygame.Rect(124, y + 3, 112, 18), 0.0, (0.0, 1.0), m, container=c,
                                             click_increment=0.02)
             row.entry = UITextEntryLine(pygame.Rect(240, y, 72, 24), m, container=c,
-                                        placeholder_text="off" if p.optional else None)
+                                        placeholder_text=p.off_text if p.optional else None)
         return row
 
     def _make_menu(self) -> None:
         self._menu_made_for = self._selected_text()
         self.selected_menu = UIDropDownMenu(list(OBJECTS), self._menu_made_for, self._menu_rect, self.manager,
                                             container=self.scroll, expansion_height_limit=4 * 26)
+
+    def _make_shape_menu(self) -> None:
+        self.shape_menu = UIDropDownMenu(list(COLLIDER_SHAPES), self.new_shape, self._shape_rect, self.manager,
+                                         container=self.scroll, expansion_height_limit=len(COLLIDER_SHAPES) * 26)
 
     def _make_integrator_menu(self) -> None:
         names = available_integrators()  # the registry: a user-registered integrator shows too
@@ -249,6 +258,10 @@ class Inspector:
         elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.selected_menu:
             self.apply_object(event.text)
             used = True
+        elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.shape_menu:
+            self.new_shape = event.text
+            self.say(f"Add puts a {event.text} at the view's centre")
+            used = True
         elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.integrator_menu:
             self.apply_integrator(event.text)
             used = True
@@ -267,8 +280,9 @@ class Inspector:
             if name in self.actions:
                 self.actions[name]()
         elif el is self.add_collider:
-            s.add_collider()
-            self.say(f"added collider {s.collider_index + 1}; drag it or type its values")
+            if self._try(lambda: s.add_collider(self.new_shape)):
+                self.say(f"added a {self.new_shape} (collider {s.collider_index + 1}); drag it, turn it with Z / X "
+                         f"or type its values")
         elif el is self.remove_collider:
             self._try(s.remove_collider)
         elif el in (self.prev_collider, self.next_collider) and s.world.colliders:
@@ -418,9 +432,19 @@ class Inspector:
                     row.slider.set_current_value(t, warn=False)
                 row.slider_value = row.slider.get_current_value()
         n = len(s.world.colliders)
-        text = "none" if s.collider_index is None else f"{s.collider_index + 1} of {n}"
+        text = "none" if s.collider_index is None else f"{s.collider_index + 1} of {n}: {s.collider_shape}"
         if self.collider_label.text != text:
             self.collider_label.set_text(text)
+        # the rows of values the selected collider's shape does not have are greyed out
+        has = set(s.collider_params())
+        for name in COLLIDER_FIELDS:
+            row = self.rows.get(name)
+            if row is None:
+                continue
+            for widget in (row.slider, row.entry):
+                if widget is not None and widget.is_enabled != (name in has):
+                    widget.enable() if name in has else widget.disable()
+                    self.dirty = True
         # A drop-down has no setter, so one the session changed behind it (a number key, a
         # loaded scene) is made anew. Compare with what the menu was made for, not with what it
         # shows: a choice just clicked shows before its event reaches apply_*(), and remaking

@@ -22,7 +22,8 @@ class Param:
     whether it moves in equal ratios (stiffness from 10 to 100000 N/m needs that).
     ``rebuild`` marks values that rebuild the body (the original's mesh settings).
     ``optional`` marks values that may be off (``None``: a material behaviour that is not
-    used, a body without gas): an empty text box shows and sets "off".
+    used, a body without gas, a collider's friction that follows the world's): an empty text
+    box shows ``off_text`` and sets None.
     """
 
     name: str
@@ -35,6 +36,7 @@ class Param:
     rebuild: bool = False
     tip: str = ""
     optional: bool = False
+    off_text: str = "off"
 
     def to_slider(self, value: float) -> float:
         """Slider position in [0, 1] for ``value`` (clamped)."""
@@ -106,12 +108,23 @@ GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
         Param("collide", "Collide", "bool", tip="the selected body touches other bodies"),
         Param("self_collision", "Self collision", "bool", tip="the selected body touches itself"),
     )),
+    # the selected collider; rows its shape does not have are greyed out (see the inspector)
     ("Collision", (
         Param("collider_x", "Center x", "float", -20, 20, unit="m"),
         Param("collider_y", "Center y", "float", -10, 20, unit="m"),
-        Param("collider_width", "Width", "float", 0.05, 30, log=True, unit="m"),
-        Param("collider_height", "Height", "float", 0.05, 10, log=True, unit="m"),
-        Param("collider_angle", "Angle", "float", -90, 90, unit="°"),
+        Param("collider_angle", "Angle", "float", -90, 90, unit="°", tip="Z / X turn it by 5°"),
+        Param("collider_width", "Width", "float", 0.05, 30, log=True, unit="m", tip="rectangles"),
+        Param("collider_height", "Height", "float", 0.05, 10, log=True, unit="m", tip="rectangles"),
+        Param("collider_radius", "Radius", "float", 0.01, 5, log=True, unit="m",
+              tip="circles and segments; type 0 for a segment that is a thin wire"),
+        Param("collider_vx", "Velocity x", "float", -5, 5, unit="m/s", tip="the world moves it every step"),
+        Param("collider_vy", "Velocity y", "float", -5, 5, unit="m/s", tip="the world moves it every step"),
+        Param("collider_angular_velocity", "Spin", "float", -360, 360, unit="°/s",
+              tip="angular velocity about its centre, counter-clockwise"),
+        Param("collider_friction", "Friction", "float", 0.0, 2.0, optional=True, off_text="world",
+              tip="its own dynamic friction; empty: the world's"),
+        Param("collider_static_friction", "Static friction", "float", 0.0, 2.0, optional=True, off_text="world",
+              tip="its own static friction; empty: the world's"),
     )),
     ("Mouse", (
         Param("mouse_strength", "Mouse strength", "float", 1.0, 2000.0, log=True, unit="N/m",
@@ -133,7 +146,7 @@ def format_value(param: Param, value) -> str:
 
 def parse_value(param: Param, text: str):
     """The number typed in a value box; for an optional parameter, ``None`` (off) when the box
-    is empty or says ``off`` or ``none``.
+    is empty or says ``off``, ``none`` or its ``off_text``.
 
     Raises
     ------
@@ -152,7 +165,7 @@ def parse_value(param: Param, text: str):
     True
     """
     s = text.strip().replace(",", ".")
-    if param.optional and s.lower() in ("", "off", "none"):
+    if param.optional and s.lower() in ("", "off", "none", param.off_text):
         return None
     try:
         v = float(s)

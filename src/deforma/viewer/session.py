@@ -20,13 +20,14 @@ Everything here is testable without pygame; :mod:`deforma.viewer.app` only forwa
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..physics import Material, Rect, available_integrators
+from ..physics import Circle, Material, Polygon, Rect, Segment, available_integrators
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 from ..scene.build import pin_mask
@@ -42,7 +43,8 @@ def _builtin_texture_names() -> tuple:
     return tuple(first + sorted(n for n in names if n not in first))
 
 
-__all__ = ["BEHAVIOURS", "MATERIAL_DEFAULTS", "MATERIAL_MODELS", "MESH_LIMITS", "OBJECTS", "MeshSettings", "Session"]
+__all__ = ["BEHAVIOURS", "COLLIDER_FIELDS", "COLLIDER_SHAPES", "MATERIAL_DEFAULTS", "MATERIAL_MODELS", "MESH_LIMITS",
+           "OBJECTS", "MeshSettings", "Session"]
 
 #: What a finite-element model starts with when the scene gives no value: a soft gel of
 #: 1 kg/m^2 (a 1.5 m box weighs 2.25 kg), undamped: stiffness-proportional damping shrinks
@@ -60,6 +62,38 @@ _SPRINGS = Material("springs")  # what a world without a material (None) is made
 
 #: The original's "Selected" choices, in the order of the number keys 1-4.
 OBJECTS = (*_builtin_texture_names(), "box")
+
+#: The collider shapes the inspector adds, in the order of its menu, and their classes.
+COLLIDER_SHAPES = ("rect", "circle", "polygon", "segment")
+_SHAPE_CLASSES = {"rect": Rect, "circle": Circle, "polygon": Polygon, "segment": Segment}
+#: A new polygon: a small cup (1.2 m wide, 0.6 m high, walls 0.1 m), concave on purpose, so
+#: that it can hold something; its centroid goes where it is added.
+CUP = ((-0.6, -0.3), (0.6, -0.3), (0.6, 0.3), (0.5, 0.3), (0.5, -0.2), (-0.5, -0.2), (-0.5, 0.3), (-0.6, 0.3))
+#: The collider values the inspector edits: name -> (attribute, component or None, the shapes
+#: that have it). Angles in degrees, angular velocity in degrees/s; a friction of None
+#: follows the world's.
+COLLIDER_FIELDS = {
+    "collider_x": ("center", 0, COLLIDER_SHAPES),
+    "collider_y": ("center", 1, COLLIDER_SHAPES),
+    "collider_angle": ("angle", None, COLLIDER_SHAPES),
+    "collider_width": ("size", 0, ("rect",)),
+    "collider_height": ("size", 1, ("rect",)),
+    "collider_radius": ("radius", None, ("circle", "segment")),
+    "collider_vx": ("velocity", 0, COLLIDER_SHAPES),
+    "collider_vy": ("velocity", 1, COLLIDER_SHAPES),
+    "collider_angular_velocity": ("angular_velocity", None, COLLIDER_SHAPES),
+    "collider_friction": ("friction", None, COLLIDER_SHAPES),
+    "collider_static_friction": ("static_friction", None, COLLIDER_SHAPES),
+}
+
+
+def collider_shape_name(c) -> str:
+    """``rect``, ``circle``, ``polygon`` or ``segment``: what the inspector calls a collider's shape."""
+    for name, cls in _SHAPE_CLASSES.items():
+        if isinstance(c, cls):
+            return name
+    raise ValueError(f"colliders must be deforma.Rect, Circle, Polygon or Segment, found {type(c).__name__}")
+
 
 #: Ranges the inspector accepts for mesh values. Tighter than the scene schema on purpose:
 #: a live window must rebuild in a fraction of a second and still run at 60 frames/s, and
@@ -187,8 +221,8 @@ class Session:
         return bodies[self.body_index] if bodies else None
 
     @property
-    def collider(self) -> Rect | None:
-        """The collider the inspector edits."""
+    def collider(self):
+        """The collider the inspector edits (a Rect, Circle, Polygon or Segment), or None."""
         if self.collider_index is None:
             return None
         return self.world.colliders[self.collider_index]
@@ -220,12 +254,13 @@ class Session:
             return w.grab_strength
         if name in ("detail", "edges", "resolution", "detect_edges", "edge_step", "scale"):
             return getattr(self.mesh, name)
-        if name.startswith("collider_"):
+        if name in COLLIDER_FIELDS:
             c = self.collider
-            if c is None:
+            attr, part, shapes = COLLIDER_FIELDS[name]
+            if c is None or collider_shape_name(c) not in shapes:
                 return None
-            return {"collider_x": c.center[0], "collider_y": c.center[1], "collider_width": c.size[0],
-                    "collider_height": c.size[1], "collider_angle": c.angle}[name]
+            value = getattr(c, attr)
+            return value if part is None else value[part]
         raise KeyError(f"unknown parameter {name!r}")
 
     def set_param(self, name: str, value) -> None:
@@ -280,7 +315,7 @@ class Session:
             if not lo <= v <= hi:
                 raise ValueError(f"scale must be in [{lo:g}, {hi:g}] m/px in the viewer, got {value!r}")
             self._set_mesh(scale=v)
-        elif name.startswith("collider_"):
+        elif name in COLLIDER_FIELDS:
             self._edit_collider(name, value)
         else:
             raise KeyError(f"unknown parameter {name!r}")
@@ -551,20 +586,70 @@ class Session:
         self._rebuild()
 
     # -- colliders ----------------------------------------------------------------------------
-    def add_collider(self, *, center=None, size=(3.0, 0.3), angle=0.0) -> Rect:
-        """Add a rectangle (by default 3 m x 0.3 m at the camera centre) and select it."""
-        r = self.world.add_collider(Rect(self.camera_center if center is None else center, size, angle))
+    @property
+    def collider_shape(self) -> str | None:
+        """Shape of the selected collider (see :data:`COLLIDER_SHAPES`), or None."""
+        c = self.collider
+        return None if c is None else collider_shape_name(c)
+
+    def collider_params(self) -> tuple:
+        """Names of the collider values the selected collider has (none without a selection)."""
+        shape = self.collider_shape
+        return tuple(n for n, (_, _, shapes) in COLLIDER_FIELDS.items() if shape in shapes)
+
+    def add_collider(self, shape: str = "rect", *, center=None, angle: float = 0.0, size=(3.0, 0.3),
+                     radius=None):
+        """Add a collider at ``center`` (default: the camera centre) and select it.
+
+        Parameters
+        ----------
+        shape : str
+            ``rect`` (``size``, default 3 m x 0.3 m), ``circle`` (``radius``, default 0.5 m),
+            ``polygon`` (a small concave cup, :data:`CUP`) or ``segment`` (2 m long, ``radius``
+            default 0.05 m; 0 makes a wire).
+        center : (float, float), optional
+            Metres; for a polygon, where its centroid goes.
+        angle : float
+            Degrees, counter-clockwise.
+
+        Returns
+        -------
+        the new collider
+
+        Examples
+        --------
+        >>> s = Session("demo")
+        >>> c = s.add_collider("circle", center=(1.0, 2.0))
+        >>> c.radius, s.collider_shape, s.get_param("collider_width") is None
+        (0.5, 'circle', True)
+        """
+        if shape not in COLLIDER_SHAPES:
+            raise ValueError(f"collider shape must be one of {', '.join(COLLIDER_SHAPES)}, got {shape!r}")
+        cx, cy = (float(v) for v in (self.camera_center if center is None else center))
+        if shape == "rect":
+            c = Rect((cx, cy), size, angle)
+        elif shape == "circle":
+            c = Circle((cx, cy), 0.5 if radius is None else radius)
+        elif shape == "polygon":
+            c = Polygon(np.asarray(CUP) + (cx, cy))
+        else:
+            c = Segment((cx - 1.0, cy), (cx + 1.0, cy), 0.05 if radius is None else radius)
+        if shape != "rect" and angle:
+            c.angle = c.angle + angle
+        if shape == "polygon":
+            c.center = (cx, cy)  # the cup's centroid is low in it: put the centroid where asked
+        self.world.add_collider(c)
         self.collider_active = True
         self.collider_colors.append(None)
         self.collider_index = len(self.world.colliders) - 1
-        return r
+        return c
 
     def remove_collider(self) -> None:
         """Remove the selected collider."""
         if self.collider_index is None:
             raise ValueError("there is no collider to remove")
         i = self.collider_index
-        del self.world.colliders[i]
+        self.world.remove_collider(self.world.colliders[i])
         if i < len(self.collider_colors):
             del self.collider_colors[i]
         n = len(self.world.colliders)
@@ -583,36 +668,54 @@ class Session:
         c = self.collider
         if c is None:
             raise ValueError("there is no collider selected")
-        self._replace_collider(center=tuple(float(v) for v in center))
+        self._change_collider(center=tuple(float(v) for v in center))
+
+    def rotate_collider(self, degrees: float) -> float:
+        """Turn the selected collider about its centre by ``degrees`` (counter-clockwise);
+        its angle stays in (-180, 180]. Returns the new angle."""
+        c = self.collider
+        if c is None:
+            raise ValueError("there is no collider selected: click one first")
+        angle = (float(c.angle) + float(degrees)) % 360.0
+        angle = angle - 360.0 if angle > 180.0 else angle
+        self._change_collider(angle=round(angle, 9))
+        return c.angle
 
     def _edit_collider(self, name, value) -> None:
         c = self.collider
         if c is None:
             raise ValueError("there is no collider selected: add one first")
-        v = float(value)
-        if name == "collider_x":
-            self._replace_collider(center=(v, c.center[1]))
-        elif name == "collider_y":
-            self._replace_collider(center=(c.center[0], v))
-        elif name == "collider_width":
-            self._replace_collider(size=(v, c.size[1]))
-        elif name == "collider_height":
-            self._replace_collider(size=(c.size[0], v))
-        elif name == "collider_angle":
-            if not -360.0 <= v <= 360.0:
-                raise ValueError(f"collider angle must be in [-360, 360] degrees, got {value!r}")
-            self._replace_collider(angle=v)
+        attr, part, shapes = COLLIDER_FIELDS[name]
+        shape = collider_shape_name(c)
+        if shape not in shapes:
+            raise ValueError(f"a {shape} has no {name.removeprefix('collider_').replace('_', ' ')}")
+        if isinstance(value, bool):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        if value is None:
+            if attr not in ("friction", "static_friction"):
+                raise ValueError(f"{name} must be a number, got None")
         else:
-            raise KeyError(f"unknown parameter {name!r}")
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"{name} must be a number, got {value!r}") from None
+        if attr == "angle" and not -360.0 <= value <= 360.0:
+            raise ValueError(f"collider angle must be in [-360, 360] degrees, got {value!r}")
+        if part is not None:
+            whole = list(getattr(c, attr))
+            whole[part] = value
+            value = tuple(whole)
+        self._change_collider(**{attr: value})
 
-    def _replace_collider(self, **changes) -> None:
+    def _change_collider(self, **changes) -> None:
+        """Set attributes of the selected collider, all or none: each is set on a copy first,
+        whose setters check it, so a refused value leaves the collider as it was."""
         c = self.collider
-        fields = dict(center=c.center, size=c.size, angle=c.angle)
-        fields.update(changes)
-        # Rect is frozen and validates: a bad value raises before the world sees it
-        new = Rect(fields["center"], fields["size"], fields["angle"], friction=c.friction,
-                   static_friction=c.static_friction)
-        self.world.colliders[self.collider_index] = new
+        trial = copy.copy(c)
+        for attr, value in changes.items():
+            setattr(trial, attr, value)
+        for attr, value in changes.items():
+            setattr(c, attr, value)
         self.collider_active = True
 
     def collider_at(self, point) -> int | None:
