@@ -68,9 +68,14 @@ def test_session_adds_edits_turns_and_removes_each_shape(session, shape):
         with pytest.raises(ValueError):
             s.set_param(name, value)
         assert state(c) == before, name
-    if shape == "segment":  # radius 0: a wire
+    if shape == "segment":  # radius 0: a wire, which has no inside but can still be picked near it
         s.set_param("collider_radius", 0.0)
         assert c.radius == 0.0
+        mid = np.add(c.a, c.b) / 2
+        s.select_collider(None)
+        assert s.collider_at(mid + (0.0, 0.001)) is None
+        assert s.collider_at(mid + (0.0, 0.001), radius=0.01) == n
+        s.select_collider(n)
     s.move_collider((4.0, 4.0))
     assert c.center == (4.0, 4.0)
     x0, y0, x1, y1 = c.bounds()

@@ -60,7 +60,8 @@ PHYSICS_BUDGET = 0.05
 STATUS_INTERVAL = 0.25   # seconds between status line updates
 GREETING = "Left-drag the body to pull it, Space blows it up, H lists every key."
 SELECTED_COLLIDER_COLOR = "#6d8fcb"  # a bluer slate: selected, not shouting
-#: How far off a body's outline (pixels) the pin key and shift+click still find a vertex.
+#: How far off a body's outline (pixels) the pin key and shift+click still find a vertex, and
+#: a click still picks a collider (a wire has no inside).
 PIN_PICK_PIXELS = 10
 
 
@@ -481,7 +482,7 @@ class Viewer:
                     self.inspector.refresh(force=True)
                 return
             s.world.release(g)
-            i = s.collider_at(p)
+            i = s.collider_at(p, radius=PIN_PICK_PIXELS * self._metres_per_pixel())
             if i is not None:
                 s.select_collider(i)
                 c = s.world.colliders[i]

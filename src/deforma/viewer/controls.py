@@ -33,7 +33,7 @@ KEYS: tuple[tuple[tuple[str, ...], str, str], ...] = (
 #: (button, what it does).
 MOUSE: tuple[tuple[str, str], ...] = (
     ("left drag on a body", "pull it toward the pointer (mouse strength)"),
-    ("left drag on a collider", "move it (and select it in the panel)"),
+    ("left drag on a collider", "move it (and select it in the panel); a wire is picked within 10 px"),
     ("shift+left click on a body", "pin / unpin the vertex nearest the pointer"),
     ("right drag", "pan the view"),
     ("wheel", "zoom"),

@@ -95,6 +95,17 @@ def collider_shape_name(c) -> str:
     raise ValueError(f"colliders must be deforma.Rect, Circle, Polygon or Segment, found {type(c).__name__}")
 
 
+def _boundary_distance(c, point) -> float:
+    """Metres from ``point`` to the nearest edge of a collider's boundary (its holes' too);
+    a wire's boundary is the wire."""
+    loops = c.loops if isinstance(c, Polygon) else [c.outline()]
+    a = np.concatenate([p if len(p) > 2 else p[:1] for p in loops])
+    b = np.concatenate([np.roll(p, -1, axis=0) if len(p) > 2 else p[1:] for p in loops])
+    d = b - a
+    t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+    return float(np.hypot(*(a + t[:, None] * d - point).T).min())
+
+
 #: Ranges the inspector accepts for mesh values. Tighter than the scene schema on purpose:
 #: a live window must rebuild in a fraction of a second and still run at 60 frames/s, and
 #: detail 100 or resolution 3 already give about ten thousand points (``deforma run`` takes
@@ -718,13 +729,21 @@ class Session:
             setattr(c, attr, value)
         self.collider_active = True
 
-    def collider_at(self, point) -> int | None:
-        """Index of the topmost collider containing ``point`` (metres), or None."""
+    def collider_at(self, point, *, radius: float = 0.0) -> int | None:
+        """Index of the topmost collider containing ``point`` (metres); failing that, of the
+        collider whose boundary passes nearest it within ``radius`` metres (a wire has no
+        inside to click, a thin slab little); None if there is neither."""
         p = np.asarray([point], dtype=np.float64)
-        for i in range(len(self.world.colliders) - 1, -1, -1):
-            if bool(self.world.colliders[i].contains(p)[0]):
+        colliders = self.world.colliders
+        for i in range(len(colliders) - 1, -1, -1):
+            if bool(colliders[i].contains(p)[0]):
                 return i
-        return None
+        best = None
+        for i, c in enumerate(colliders):
+            d = _boundary_distance(c, p[0])
+            if d <= radius and (best is None or d <= best[0]):
+                best = (d, i)
+        return None if best is None else best[1]
 
     # -- files --------------------------------------------------------------------------------
     def save(self, path) -> Path:
