@@ -201,7 +201,53 @@ def _write_atomic(path: Path, write) -> None:
         raise
 
 
-def _save_states(path: str, world, scene, times, frames) -> None:
+def _collider_arrays(colliders, poses) -> dict:
+    """The ``--states`` arrays that describe the colliders (docs/cli.md): every shape, its pose
+    per frame (``poses``: per frame, ``(cx, cy, angle)`` per collider) and at the end."""
+    from .physics import Circle, Polygon, Rect, Segment
+
+    kinds = {Rect: "rect", Circle: "circle", Polygon: "polygon", Segment: "segment"}
+    rows, outlines, holes = [], [], {}
+    for j, c in enumerate(colliders):
+        # w, h: a rect's size; for the other shapes their box in their own frame, what a reader
+        # that draws every row as a rectangle (as before there were other shapes) draws instead
+        if isinstance(c, Rect):
+            w, h = c.size
+        elif isinstance(c, Circle):
+            w = h = 2 * c.radius
+        elif isinstance(c, Segment):
+            w, h = c.length + 2 * c.radius, 2 * c.radius
+        else:
+            t = np.radians(c.angle)
+            local = (np.asarray(c.points) - np.asarray(c.center)) @ np.array([[np.cos(t), -np.sin(t)],
+                                                                               [np.sin(t), np.cos(t)]])
+            w, h = np.ptp(local, axis=0)
+        rows.append([*c.center, w, h, c.angle])
+        outlines.append(np.asarray(c.outline(), dtype=np.float64))
+        if isinstance(c, Polygon) and c.holes:
+            holes[f"collider{j}_holes"] = _padded(c.holes)
+    n = len(colliders)
+    return {
+        "colliders": np.array(rows, dtype=np.float64).reshape(-1, 5),
+        "collider_kind": np.array([kinds.get(type(c), type(c).__name__.lower()) for c in colliders], dtype="U8"),
+        "collider_radius": np.array([getattr(c, "radius", np.nan) for c in colliders], dtype=np.float64),
+        "collider_velocity": np.array([c.velocity for c in colliders], dtype=np.float64).reshape(-1, 2),
+        "collider_angular_velocity": np.array([c.angular_velocity for c in colliders], dtype=np.float64),
+        "collider_outline": _padded(outlines) if outlines else np.zeros((0, 0, 2)),
+        "collider_pose": np.array(poses, dtype=np.float64).reshape(len(poses), n, 3),
+        **holes,
+    }
+
+
+def _padded(loops) -> np.ndarray:
+    """(L, K, 2) from loops of different lengths, NaN after each loop's last point."""
+    out = np.full((len(loops), max(len(p) for p in loops), 2), np.nan)
+    for k, p in enumerate(loops):
+        out[k, :len(p)] = p
+    return out
+
+
+def _save_states(path: str, world, scene, times, frames, poses) -> None:
     import tomli_w
 
     from .scene.schema import scene_to_dict
@@ -225,8 +271,7 @@ def _save_states(path: str, world, scene, times, frames) -> None:
         uv = getattr(b.mesh, "uv", None)
         if uv is not None:
             arrays[f"body{i}_uv"] = np.asarray(uv)
-    arrays["colliders"] = np.array([[*c.center, *c.size, c.angle] for c in world.colliders],
-                                   dtype=np.float64).reshape(-1, 5)
+    arrays.update(_collider_arrays(world.colliders, poses))
     arrays["scene_toml"] = np.array(tomli_w.dumps(scene_to_dict(scene, base_dir=Path(path).parent.resolve())))
     _write_atomic(Path(path), lambda f: np.savez_compressed(f, **arrays))
 
@@ -294,7 +339,7 @@ def _run_scene(a, watch, shown: dict) -> int:
             view.wireframe = True
 
     script = scenes.Script(scene, world)  # its [[event]] explosions and [[pull]] grabs
-    times, frames = [], []
+    times, frames, poses = [], [], []
     label = Path(a.scene).stem if a.scene.endswith(".toml") else a.scene
     bar = shown["bar"] = _progress(n_frames, not a.quiet, label)
     t_wall = time.perf_counter()
@@ -311,12 +356,13 @@ def _run_scene(a, watch, shown: dict) -> int:
             if a.states:
                 times.append(world.time)
                 frames.append([b.positions.copy() for b in world.bodies])
+                poses.append([(*c.center, c.angle) for c in world.colliders])
             if bar is not None:
                 bar.update(1)
         if writer is not None:
             writer.close()
         if a.states:
-            _save_states(a.states, world, scene, times, frames)
+            _save_states(a.states, world, scene, times, frames, poses)
     except SimulationUnstable as e:
         raise CliError(f"{a.scene}: simulation became unstable at t = {world.time:.3f} s: {e}; "
                        f"nothing was written", EXIT_UNSTABLE) from None

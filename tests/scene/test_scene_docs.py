@@ -28,7 +28,12 @@ SECTIONS = {
     schema.SceneInfo: "### `[scene]`", schema.RunSettings: "### `[run]`", schema.CameraSettings: "### `[camera]`",
     schema.PhysicsSettings: "### `[physics]`", schema.InteractionSettings: "### `[interaction]`",
     schema.BoxBody: '### `[[body]]` with `shape = "box"`', schema.ImageBody: '### `[[body]]` with `shape = "image"`',
-    schema.MeshBody: '### `[[body]]` with `shape = "mesh"`', schema.ColliderSpec: "### `[[collider]]`",
+    schema.MeshBody: '### `[[body]]` with `shape = "mesh"`',
+    schema.ColliderSpec: '### `[[collider]]` with `shape = "rect"`',
+    schema.CircleCollider: '### `[[collider]]` with `shape = "circle"`',
+    schema.PolygonCollider: '### `[[collider]]` with `shape = "polygon"`',
+    schema.SegmentCollider: '### `[[collider]]` with `shape = "segment"`',
+    schema.ImageCollider: '### `[[collider]]` with `shape = "image"`',
     schema.Event: "### `[[event]]`", schema.Pull: "### `[[pull]]`",
 }
 

@@ -70,6 +70,12 @@ def test_builtin_scene_round_trip_loses_nothing(tmp_path, name):
     first = scenes.load(name)
     path = deforma.scene.save_scene(first.build(), tmp_path / f"{name}.toml")
     again = scenes.load(path)
+    if any(c.shape == "image" for c in first.collider):
+        # an image collider is written as its pieces (polygons of the same colour): nothing lost
+        from dataclasses import replace
+
+        first = replace(first, collider=scenes.scene_of(first.build()).collider)
+        assert "image" not in {c.shape for c in again.collider}
     assert again == first
     # and writing it again gives the same bytes
     path2 = deforma.scene.save_scene(again.build(), tmp_path / "again.toml")

@@ -13,15 +13,17 @@ Examples
 True
 """
 
-from .assets import builtin_scenes, builtin_textures, load_texture
-from .build import body_specs, build, load, load_scene, make_mesh, save_scene, scene_of
-from .schema import (BoxBody, CameraSettings, ColliderSpec, Event, ImageBody, InteractionSettings, MeshBody,
-                     PhysicsSettings, Pull, RunSettings, Scene, SceneError, SceneInfo, parse_scene, with_springs)
+from .assets import builtin_levels, builtin_scenes, builtin_textures, load_texture
+from .build import body_specs, build, collider_spec, load, load_scene, make_colliders, make_mesh, save_scene, scene_of
+from .schema import (BoxBody, CameraSettings, CircleCollider, ColliderSpec, Event, ImageBody, ImageCollider,
+                     InteractionSettings, MeshBody, PhysicsSettings, PolygonCollider, Pull, RectCollider, RunSettings,
+                     Scene, SceneError, SceneInfo, SegmentCollider, parse_scene, with_springs)
 from .script import Script
 
 __all__ = [
-    "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
-    "PhysicsSettings", "Pull", "RunSettings", "Scene", "SceneError", "SceneInfo", "Script", "body_specs", "build",
-    "builtin_scenes", "builtin_textures", "load", "load_scene", "load_texture", "make_mesh", "parse_scene",
-    "save_scene", "scene_of", "with_springs",
+    "BoxBody", "CameraSettings", "CircleCollider", "ColliderSpec", "Event", "ImageBody", "ImageCollider",
+    "InteractionSettings", "MeshBody", "PhysicsSettings", "PolygonCollider", "Pull", "RectCollider", "RunSettings",
+    "Scene", "SceneError", "SceneInfo", "Script", "SegmentCollider", "body_specs", "build", "builtin_levels",
+    "builtin_scenes", "builtin_textures", "collider_spec", "load", "load_scene", "load_texture", "make_colliders",
+    "make_mesh", "parse_scene", "save_scene", "scene_of", "with_springs",
 ]

@@ -1,4 +1,4 @@
-"""Built-in scenes (package data under ``deforma/assets/``) and the textures scenes name.
+"""Built-in scenes (package data under ``deforma/assets/``) and the textures and level pictures scenes name.
 
 Pictures are read by one loader, :func:`deforma.mesh.image.load_rgba`, and the built-in
 textures are listed in one place, :func:`deforma.mesh.image.builtin_textures`; this module
@@ -15,8 +15,8 @@ import numpy as np
 
 from ..mesh.image import builtin_textures
 
-__all__ = ["builtin_scenes", "builtin_textures", "load_texture", "resolve_texture", "scene_path",
-           "texture_reference"]
+__all__ = ["builtin_levels", "builtin_scenes", "builtin_textures", "load_texture", "picture_file", "picture_reference",
+           "resolve_picture", "resolve_texture", "scene_path", "texture_reference"]
 
 
 def _assets() -> Path:
@@ -53,6 +53,39 @@ def scene_path(name_or_path) -> Path:
     raise ValueError(f"unknown scene {s!r}; {hint}built-in scenes: {', '.join(scenes)} (or give a path to a .toml file)")
 
 
+def builtin_levels() -> dict[str, Path]:
+    """Pictures of levels shipped in ``deforma/assets/levels`` for image colliders: name -> file.
+
+    Kept apart from the textures, which are pictures of bodies (the viewer offers those as
+    objects to drop).
+
+    Examples
+    --------
+    >>> "ramp" in builtin_levels()
+    True
+    """
+    folder = _assets() / "levels"
+    return {p.stem: p for p in sorted(folder.glob("*.png"))} if folder.is_dir() else {}
+
+
+def _resolve(value: str, names: dict, what: str, base_dir) -> str:
+    if value in names:
+        return value
+    p = Path(value).expanduser()
+    if not p.is_absolute():
+        p = Path(base_dir) / p
+    if p.is_file():
+        return str(p.resolve())
+    allowed = f"a built-in {what} ({', '.join(names) or 'none installed'}) or an image file"
+    if "/" not in value and "." not in value:
+        import difflib
+
+        close = difflib.get_close_matches(value, list(names), n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise ValueError(f"unknown {what} {value!r}; {hint}allowed: {allowed}")
+    raise ValueError(f"no such file {str(p)!r}; allowed: {allowed}")
+
+
 def resolve_texture(value: str, *, base_dir) -> str:
     """A built-in texture name as is, or an image path made absolute (relative to ``base_dir``).
 
@@ -61,22 +94,36 @@ def resolve_texture(value: str, *, base_dir) -> str:
     ValueError
         If it is neither a built-in name nor an existing image file.
     """
-    textures = builtin_textures()
-    if value in textures:
-        return value
-    p = Path(value).expanduser()
-    if not p.is_absolute():
-        p = Path(base_dir) / p
-    if p.is_file():
-        return str(p.resolve())
-    allowed = f"a built-in texture ({', '.join(textures) or 'none installed'}) or an image file"
-    if "/" not in value and "." not in value:
-        import difflib
+    return _resolve(value, builtin_textures(), "texture", base_dir)
 
-        close = difflib.get_close_matches(value, list(textures), n=1)
-        hint = f"did you mean {close[0]!r}? " if close else ""
-        raise ValueError(f"unknown texture {value!r}; {hint}allowed: {allowed}")
-    raise ValueError(f"no such file {str(p)!r}; allowed: {allowed}")
+
+def resolve_picture(value: str, *, base_dir) -> str:
+    """An image collider's source: a built-in level or texture name as is, or an image path made
+    absolute (relative to ``base_dir``).
+
+    Raises
+    ------
+    ValueError
+        If it is neither a built-in name nor an existing image file.
+
+    Examples
+    --------
+    >>> resolve_picture("ramp", base_dir=".")
+    'ramp'
+    """
+    return _resolve(value, {**builtin_levels(), **builtin_textures()}, "picture", base_dir)
+
+
+def picture_file(value: str) -> Path:
+    """The image file of a resolved picture reference (:func:`resolve_picture`)."""
+    return builtin_levels().get(value) or texture_file(value)
+
+
+def picture_reference(value: str, *, base_dir) -> str:
+    """What to write in a file for a resolved picture: the name, or a path relative to ``base_dir``."""
+    if value in builtin_levels():
+        return value
+    return texture_reference(value, base_dir=base_dir)
 
 
 def texture_reference(value: str, *, base_dir) -> str:

@@ -8,6 +8,7 @@ with what only the scene knows (mesh recipes, colours, camera, run length).
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import tempfile
@@ -17,31 +18,34 @@ from pathlib import Path
 
 import numpy as np
 
-from .assets import scene_path
-from .schema import (BEHAVIOUR_KEYS, MATERIAL_KEYS, BoxBody, ColliderSpec, ImageBody, InteractionSettings, MaterialKeyError,
-                     MeshBody, PhysicsSettings, Scene, SceneError, material_settings, parse_scene, scene_to_dict)
+from .assets import picture_file, scene_path
+from .schema import (BEHAVIOUR_KEYS, MATERIAL_KEYS, BoxBody, CircleCollider, ColliderSpec, ImageBody, ImageCollider,
+                     InteractionSettings, MaterialKeyError, MeshBody, PhysicsSettings, PolygonCollider, Scene,
+                     SceneError, SegmentCollider, material_settings, parse_scene, scene_to_dict)
 
 try:  # Python >= 3.11
     import tomllib
 except ImportError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["build", "load", "load_scene", "make_mesh", "pin_mask", "save_scene", "scene_of"]
+__all__ = ["build", "collider_spec", "load", "load_scene", "make_colliders", "make_mesh", "pin_mask", "save_scene",
+           "scene_of"]
 
 
 @dataclass
 class _Record:
     scene: Scene
     bodies: list      # [(weakref to Body, body spec)]
-    colliders: list   # [(Rect, ColliderSpec)]
+    colliders: list   # [(collider, its spec, (center, angle) as built)]; an image spec once per polygon
 
 
 _REGISTRY: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
-#: Deepest nesting of arrays and tables a scene needs (a mesh body's vertex list is
-#: [[body]] > vertices > [x, y]); only named when a file is nested past what the reader handles.
-SCENE_MAX_NESTING = 4
+#: Deepest nesting of arrays and tables a scene needs (a polygon collider's holes are
+#: [[collider]] > holes > [[x, y], ...] > [x, y]); only named when a file is nested past what
+#: the reader handles.
+SCENE_MAX_NESTING = 5
 
 
 def load(name_or_path) -> Scene:
@@ -169,7 +173,7 @@ def build(scene: Scene):
         If the world or a mesh rejects a value (e.g. a concave box); the message names the
         scene file and the body.
     """
-    from ..physics import Rect, World
+    from ..physics import World
 
     source = scene.path or "<scene>"
     p = scene.physics
@@ -209,12 +213,56 @@ def build(scene: Scene):
             b.pin(mask)
         bodies.append((weakref.ref(b), spec))
     colliders = []
-    for c in scene.collider:
-        r = world.add_collider(Rect(c.center, c.size, c.angle, friction=c.friction,
-                                    static_friction=c.static_friction))
-        colliders.append((r, c))
+    for i, c in enumerate(scene.collider):
+        try:
+            made = make_colliders(c)
+        except ValueError as e:  # the constructors' messages start with the key: "radius must be ..."
+            raise SceneError(f"{source}: collider[{i}]: {e}") from None
+        for r in made:
+            world.add_collider(r)
+            colliders.append((r, c, (r.center, r.angle)))
     _REGISTRY[world] = _Record(scene, bodies, colliders)
     return world
+
+
+def make_colliders(spec) -> list:
+    """The colliders a ``[[collider]]`` spec describes: one, or for ``shape = "image"`` one
+    :class:`deforma.Polygon` per connected piece of the picture.
+
+    Raises
+    ------
+    ValueError
+        What the collider's constructor refuses (a polygon that crosses itself, a picture
+        with no foreground), in one line.
+
+    Examples
+    --------
+    >>> from deforma.scene.schema import SegmentCollider
+    >>> make_colliders(SegmentCollider(a=(0.0, 0.0), b=(2.0, 0.0), radius=0.1, angular_velocity=90.0))
+    [Segment(a=(0.0, 0.0), b=(2.0, 0.0), radius=0.1, angular_velocity=90)]
+    """
+    from ..physics import Circle, Polygon, Rect, Segment, colliders_from_image
+
+    common = dict(friction=spec.friction, static_friction=spec.static_friction)
+    motion = dict(velocity=spec.velocity, angular_velocity=spec.angular_velocity)
+    if isinstance(spec, ColliderSpec):
+        return [Rect(spec.center, spec.size, spec.angle, **common, **motion)]
+    if isinstance(spec, CircleCollider):
+        return [Circle(spec.center, spec.radius, **common, **motion)]
+    if isinstance(spec, SegmentCollider):
+        return [Segment(spec.a, spec.b, spec.radius, **common, **motion)]
+    if isinstance(spec, PolygonCollider):
+        p = Polygon(spec.points, holes=spec.holes, **common, **motion)
+        p.angle = spec.angle  # about its centroid, the point it was built around
+        return [p]
+    if isinstance(spec, ImageCollider):
+        pieces = colliders_from_image(str(picture_file(spec.source)), scale=spec.scale, position=spec.position,
+                                      tolerance=spec.tolerance, background=spec.background,
+                                      threshold=spec.threshold, min_area=spec.min_area, **common)
+        for p in pieces:
+            p.velocity, p.angular_velocity = spec.velocity, spec.angular_velocity
+        return pieces
+    raise TypeError(f"not a collider spec: {spec!r}")
 
 
 def load_scene(name_or_path):
@@ -374,14 +422,59 @@ def scene_of(world) -> Scene:
             spec = replace(spec, **(dict.fromkeys(keys) or _body_material_keys(b.material)))
         pins = _pin_keys(spec, b)
         bodies.append(replace(spec, **pins) if pins else spec)
-    colour_of = {id(r): c for r, c in (rec.colliders if rec is not None else [])}
-    colliders = []
-    for r in world.colliders:
-        old = colour_of.get(id(r))
-        colliders.append(ColliderSpec(center=tuple(map(float, r.center)), size=tuple(map(float, r.size)),
-                                      angle=float(r.angle), friction=r.friction, static_friction=r.static_friction,
-                                      color=None if old is None else old.color))
-    return replace(scene, physics=physics, interaction=interaction, body=tuple(bodies), collider=tuple(colliders))
+    built = {id(r): (spec, pose) for r, spec, pose in (rec.colliders if rec is not None else [])}
+    colliders = tuple(collider_spec(r, *built.get(id(r), (None, None))) for r in world.colliders)
+    return replace(scene, physics=physics, interaction=interaction, body=tuple(bodies), collider=colliders)
+
+
+def _xy(p, digits=None) -> tuple:
+    return tuple(float(v) if digits is None else round(float(v), digits) for v in p)
+
+
+def _loop(points) -> tuple:
+    # nanometres: corners computed from a pose (or traced from pixels) carry float noise
+    # (3.1799999999999997) that would only make the file harder to read
+    return tuple(_xy(p, 9) for p in np.asarray(points).tolist())
+
+
+def collider_spec(collider, spec=None, pose=None):
+    """The ``[[collider]]`` spec of ``collider`` as it is now (pose, motion, friction).
+
+    One spec per collider: the pieces of an image collider are written as polygons (with the
+    image's colour), so that a saved file needs no picture and lists the colliders as the
+    world does. ``spec`` and ``pose`` (``(center, angle)`` when built) are what the scene said:
+    a segment or polygon that has not moved keeps the spec's own points (a polygon its ``angle``);
+    one that moved is written where it is now (a polygon with its corners turned, ``angle = 0``).
+
+    Examples
+    --------
+    >>> import deforma
+    >>> collider_spec(deforma.Circle((1.0, 2.0), 0.5, angular_velocity=30.0))
+    CircleCollider(velocity=(0.0, 0.0), angular_velocity=30.0, friction=None, static_friction=None, color=None, \
+shape='circle', center=(1.0, 2.0), radius=0.5)
+    """
+    from ..physics import Circle, Polygon, Rect, Segment
+
+    common = dict(velocity=_xy(collider.velocity), angular_velocity=float(collider.angular_velocity),
+                  friction=collider.friction, static_friction=collider.static_friction,
+                  color=None if spec is None else spec.color)
+    still = pose is not None and (collider.center, collider.angle) == pose
+    if isinstance(collider, Rect):
+        # a turning rect's angle grows without end; a file takes [-360, 360]
+        return ColliderSpec(center=_xy(collider.center), size=_xy(collider.size),
+                            angle=math.fmod(float(collider.angle), 360.0), **common)
+    if isinstance(collider, Circle):
+        return CircleCollider(center=_xy(collider.center), radius=float(collider.radius), **common)
+    if isinstance(collider, Segment):
+        if still and isinstance(spec, SegmentCollider):
+            return replace(spec, radius=float(collider.radius), **common)
+        return SegmentCollider(a=_xy(collider.a, 9), b=_xy(collider.b, 9), radius=float(collider.radius), **common)
+    if isinstance(collider, Polygon):
+        if still and isinstance(spec, PolygonCollider):
+            return replace(spec, **common)
+        return PolygonCollider(points=_loop(collider.points), holes=tuple(_loop(h) for h in collider.holes),
+                               **common)
+    raise TypeError(f"cannot write a collider of type {type(collider).__name__} to a scene")
 
 
 def body_specs(world) -> list:

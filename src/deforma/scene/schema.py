@@ -32,6 +32,17 @@ A file looks like::
     center = [0.0, 0.0]
     size = [8.0, 0.4]
 
+    [[collider]]
+    shape = "circle"
+    center = [1.5, 1.0]
+    radius = 0.3
+    angular_velocity = -90.0
+
+Colliders: ``shape`` is "rect" (the default), "circle", "polygon", "segment" or "image"; each
+has its own keys (:data:`COLLIDER_KINDS`) and they share ``velocity``, ``angular_velocity``,
+``friction``, ``static_friction`` and ``color`` (:class:`ColliderCommon`). An image collider is
+built as one polygon per piece of its picture, and written back as those polygons.
+
 Materials: ``[physics] material`` (with ``youngs_modulus``, ``poisson_ratio``, ``density``,
 ``material_damping`` and the behaviours ``tear_strain``, ``yield_strain``, ``plastic_rate``,
 ``max_stretch``) is the world's default; the same nine keys on a ``[[body]]`` give it its
@@ -53,7 +64,8 @@ from typing import Any
 from ..mesh.image import BACKGROUND_NAMES, check_background
 
 __all__ = [
-    "BodyPhysics", "BoxBody", "CameraSettings", "ColliderSpec", "Event", "ImageBody", "InteractionSettings", "MeshBody",
+    "BodyPhysics", "BoxBody", "CameraSettings", "CircleCollider", "ColliderCommon", "ColliderSpec", "Event", "ImageBody",
+    "ImageCollider", "InteractionSettings", "MeshBody", "PolygonCollider", "RectCollider", "SegmentCollider",
     "MaterialKeyError", "PhysicsSettings", "Pull", "RunSettings", "Scene", "SceneError", "SceneInfo", "material_settings",
     "parse_scene",
     "scene_to_dict",
@@ -93,8 +105,9 @@ def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, 
     """A dataclass field with what the validator and the docs need to know about it.
 
     ``kind`` is one of float, int, bool, str, vec2, size2, quad, color, colors2, file, points,
-    triangles, box2 (two corners of an axis-aligned box), indices (a list of integers >= 0),
-    background (one of ``choices`` or a colour '#rrggbb').
+    loops (a list of point lists), triangles, box2 (two corners of an axis-aligned box), indices
+    (a list of integers >= 0), background (one of ``choices`` or a colour '#rrggbb'), picture
+    (an image collider's source: a built-in level or texture name, or an image path).
     ``lo``/``hi`` bound numbers (``lo_open``/``hi_open`` make a bound exclusive).
     """
     meta = dict(kind=kind, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, choices=choices, unit=unit, doc=doc)
@@ -312,17 +325,107 @@ class MeshBody(BodyPhysics):
 BODY_KINDS = {"box": BoxBody, "image": ImageBody, "mesh": MeshBody}
 
 
-@dataclass(frozen=True)
-class ColliderSpec:
-    """``[[collider]]``: a fixed rotated rectangle (the original's Collision Settings)."""
+#: The values of a ``[[collider]]``'s ``shape`` key (the first, "rect", is the default).
+COLLIDER_SHAPES = ("rect", "circle", "polygon", "segment", "image")
 
-    center: tuple = spec("vec2", (0.0, 0.0), unit="m", doc="Centre of the rectangle.")
-    size: tuple = spec("size2", (10.0, 0.5), unit="m", doc="Width and height before rotation.")
-    angle: float = spec("float", 0.0, lo=-360.0, hi=360.0, unit="degrees", doc="Counter-clockwise rotation.")
+
+@dataclass(frozen=True)
+class ColliderCommon:
+    """The keys every ``[[collider]]`` shares: motion, friction and colour."""
+
+    velocity: tuple = spec("vec2", (0.0, 0.0), unit="m/s",
+                           doc="Kinematic motion: the collider moves by this every substep (a moving platform) "
+                               "and carries what rests on it by friction.")
+    angular_velocity: float = spec("float", 0.0, lo=-1e6, hi=1e6, unit="degrees/s",
+                                   doc="Kinematic rotation, counter-clockwise, about its centre (a polygon's "
+                                       "centroid, a segment's midpoint): a paddle, a roller.")
     friction: float | None = spec("float", None, lo=0.0, doc="Overrides physics.friction for this collider.")
     static_friction: float | None = spec("float", None, lo=0.0,
                                          doc="Overrides physics.static_friction for this collider.")
     color: str | None = spec("color", None, doc="Fill colour, '#rrggbb'.")
+
+
+@dataclass(frozen=True)
+class ColliderSpec(ColliderCommon):
+    """``[[collider]]`` with ``shape = "rect"`` (the default): a rotated rectangle (the original's
+    Collision Settings)."""
+
+    shape: str = spec("str", "rect", choices=COLLIDER_SHAPES, doc="Which kind of collider.")
+    center: tuple = spec("vec2", (0.0, 0.0), unit="m", doc="Centre of the rectangle.")
+    size: tuple = spec("size2", (10.0, 0.5), unit="m", doc="Width and height before rotation.")
+    angle: float = spec("float", 0.0, lo=-360.0, hi=360.0, unit="degrees", doc="Counter-clockwise rotation.")
+
+
+#: The rectangle's spec by the name of its shape (``ColliderSpec`` is its older name).
+RectCollider = ColliderSpec
+
+
+@dataclass(frozen=True)
+class CircleCollider(ColliderCommon):
+    """``[[collider]]`` with ``shape = "circle"``: a disc (turning, it is a roller or a wheel)."""
+
+    shape: str = spec("str", "circle", choices=COLLIDER_SHAPES, doc="Which kind of collider.")
+    center: tuple = spec("vec2", (0.0, 0.0), unit="m", doc="Centre of the disc.")
+    radius: float | None = spec("float", None, lo=0.0, hi=1e9, lo_open=True, unit="m", doc="Radius (required).")
+
+
+@dataclass(frozen=True)
+class PolygonCollider(ColliderCommon):
+    """``[[collider]]`` with ``shape = "polygon"``: any simple polygon, concave allowed, with holes
+    (what save_scene writes for the pieces of an image collider)."""
+
+    shape: str = spec("str", "polygon", choices=COLLIDER_SHAPES, doc="Which kind of collider.")
+    points: tuple = spec("points", (), unit="m",
+                         doc="The outline (required), [[x, y], ...], at least three corners in either order, "
+                             "not crossing itself.")
+    holes: tuple = spec("loops", (), unit="m", doc="Outlines of holes inside it, [[[x, y], ...], ...].")
+    angle: float = spec("float", 0.0, lo=-360.0, hi=360.0, unit="degrees",
+                        doc="Counter-clockwise rotation of points and holes about the polygon's centroid.")
+
+
+@dataclass(frozen=True)
+class SegmentCollider(ColliderCommon):
+    """``[[collider]]`` with ``shape = "segment"``: a capsule (a segment with a radius), or a wire
+    (radius 0) that bodies cannot cross."""
+
+    shape: str = spec("str", "segment", choices=COLLIDER_SHAPES, doc="Which kind of collider.")
+    a: tuple | None = spec("vec2", None, unit="m", doc="First end (required).")
+    b: tuple | None = spec("vec2", None, unit="m", doc="Second end (required).")
+    radius: float = spec("float", 0.0, lo=0.0, hi=1e9, unit="m", doc="Half the thickness; 0 is a wire.")
+
+
+@dataclass(frozen=True)
+class ImageCollider(ColliderCommon):
+    """``[[collider]]`` with ``shape = "image"``: a level drawn as a picture, its foreground made into
+    one polygon collider per connected piece (``deforma.colliders_from_image``)."""
+
+    shape: str = spec("str", "image", choices=COLLIDER_SHAPES, doc="Which kind of collider.")
+    source: str | None = spec("picture", None,
+                              doc="The picture (required): a built-in picture name (the levels, e.g. ramp, or the "
+                                  "textures) or an image path (relative to the scene file).")
+    scale: float = spec("float", 0.01, lo=0.0, hi=1000.0, lo_open=True, unit="m/px", doc="Metres per pixel.")
+    position: tuple = spec("vec2", (0.0, 0.0), unit="m", doc="Where the picture's centre goes (the centre of its foreground's bounding box).")
+    tolerance: float = spec("float", 1.0, lo=0.0, hi=1000.0, unit="px",
+                            doc="How far the simplified outline may stray from the traced one; larger gives fewer "
+                                "corners.")
+    background: str = spec("background", "black", choices=BACKGROUND_NAMES,
+                           doc="What the level is drawn on, as for an image body: black, white, auto or "
+                               "'#rrggbb'.")
+    threshold: float | None = spec("float", None, lo=0.0, hi=1.0, hi_open=True,
+                                   doc="How far a pixel must differ from the background to be solid, as for an "
+                                       "image body.")
+    min_area: float = spec("float", 4.0, lo=0.0, unit="px^2", doc="Pieces and holes smaller than this are dropped.")
+
+
+COLLIDER_KINDS = {"rect": ColliderSpec, "circle": CircleCollider, "polygon": PolygonCollider,
+                  "segment": SegmentCollider, "image": ImageCollider}
+# each shape's required keys and what to say when one is missing
+_COLLIDER_NEEDS = {
+    "circle": {"radius": "the disc's radius in metres"},
+    "polygon": {"points": "the outline [[x, y], ...] in metres"},
+    "segment": {"a": "the first end [x, y] in metres", "b": "the second end [x, y] in metres"},
+    "image": {"source": "a built-in picture name or an image path"},
+}
 
 
 @dataclass(frozen=True)
@@ -386,7 +489,7 @@ class Scene:
 
 SECTIONS = {"scene": SceneInfo, "run": RunSettings, "camera": CameraSettings, "physics": PhysicsSettings,
             "interaction": InteractionSettings}
-ARRAYS = {"body": None, "collider": ColliderSpec, "event": Event, "pull": Pull}
+ARRAYS = {"body": None, "collider": None, "event": Event, "pull": Pull}
 
 
 # -- validation --------------------------------------------------------------------------------
@@ -488,6 +591,10 @@ def _convert(value, meta, path, ctx):
         if not isinstance(value, list) or len(value) < 3:
             raise _Problem(path, f"expected at least three points [[x, y], ...], got {_show(value)}")
         return tuple(_pair(v, f"{path}[{i}]", "two numbers") for i, v in enumerate(value))
+    if kind == "loops":
+        if not isinstance(value, list):
+            raise _Problem(path, f"expected a list of outlines [[[x, y], ...], ...], got {_show(value)}")
+        return tuple(_convert(v, {**meta, "kind": "points"}, f"{path}[{i}]", ctx) for i, v in enumerate(value))
     if kind == "triangles":
         if not isinstance(value, list) or len(value) < 1:
             raise _Problem(path, f"expected triangles [[i, j, k], ...], got {_show(value)}")
@@ -535,6 +642,10 @@ def _convert(value, meta, path, ctx):
         if not isinstance(value, str) or not value:
             raise _Problem(path, f"expected a built-in texture name or an image path, got {_show(value)}")
         return ctx["resolve"](value, path)
+    if kind == "picture":
+        if not isinstance(value, str) or not value:
+            raise _Problem(path, f"expected a built-in picture name or an image path, got {_show(value)}")
+        return ctx["resolve_picture"](value, path)
     raise AssertionError(kind)  # pragma: no cover
 
 
@@ -552,15 +663,20 @@ def _table(cls, data, path, ctx, *, skip=()):
     return cls(**values)
 
 
-def _body(data, path, ctx):
+def _kind(data, path, kinds: dict, default: str):
+    """The shape a ``[[body]]`` or ``[[collider]]`` table names (``default`` if none) and its spec class."""
     if not isinstance(data, dict):
         raise _Problem(path, f"expected a table, got {_show(data)}")
-    shape = data.get("shape", "box")
-    if shape not in BODY_KINDS:
-        close = difflib.get_close_matches(str(shape), list(BODY_KINDS), n=1)
+    shape = data.get("shape", default)
+    if shape not in kinds:
+        close = difflib.get_close_matches(str(shape), list(kinds), n=1)
         hint = f"did you mean {close[0]!r}? " if close else ""
-        raise _Problem(f"{path}.shape", f"unknown value {shape!r}; {hint}allowed: {', '.join(BODY_KINDS)}")
-    cls = BODY_KINDS[shape]
+        raise _Problem(f"{path}.shape", f"unknown value {shape!r}; {hint}allowed: {', '.join(kinds)}")
+    return shape, kinds[shape]
+
+
+def _body(data, path, ctx):
+    _, cls = _kind(data, path, BODY_KINDS, "box")
     body = _table(cls, data, path, ctx)
     if isinstance(body, MeshBody):
         n = len(body.vertices)
@@ -572,6 +688,21 @@ def _body(data, path, ctx):
         if body.uv is not None and len(body.uv) != n:
             raise _Problem(f"{path}.uv", f"expected one (u, v) per vertex ({n}), got {len(body.uv)}")
     return body
+
+
+def _collider(data, path, ctx):
+    shape, cls = _kind(data, path, COLLIDER_KINDS, "rect")
+    shared = [f.name for f in fields(ColliderCommon)]
+    own = [f.name for f in fields(cls) if f.name not in shared] + shared
+    for key in data:
+        # a key of another shape is most likely a shape left out or mistyped: say whose it is not
+        if key not in own and any(key in {f.name for f in fields(other)} for other in COLLIDER_KINDS.values()):
+            raise _Problem(f"{path}.{key}", f'not a field of shape "{shape}"; its fields: {", ".join(own)}')
+    collider = _table(cls, data, path, ctx)
+    for key, what in _COLLIDER_NEEDS.get(shape, {}).items():
+        if getattr(collider, key) in (None, ()):
+            raise _Problem(f"{path}.{key}", f'missing: a "{shape}" collider needs {key}, {what}')
+    return collider
 
 
 class MaterialKeyError(ValueError):
@@ -758,17 +889,19 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
     ...
     deforma.scene.schema.SceneError: my.toml: physics.stifness: unknown key; did you mean 'stiffness'? allowed: dt, ...
     """
-    from .assets import resolve_texture
+    from .assets import resolve_picture, resolve_texture
 
     base = Path(base_dir) if base_dir is not None else Path.cwd()
 
-    def resolve(value, path):
-        try:
-            return resolve_texture(value, base_dir=base)
-        except ValueError as e:
-            raise _Problem(path, str(e)) from None
+    def resolver(function):
+        def resolve(value, path):
+            try:
+                return function(value, base_dir=base)
+            except ValueError as e:
+                raise _Problem(path, str(e)) from None
+        return resolve
 
-    ctx = {"resolve": resolve}
+    ctx = {"resolve": resolver(resolve_texture), "resolve_picture": resolver(resolve_picture)}
     try:
         if not isinstance(data, dict):
             raise _Problem("", f"expected a table, got {_show(data)}")
@@ -790,7 +923,12 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
                 out = []
                 for i, item in enumerate(items):
                     p = f"{name}[{i}]"
-                    out.append(_body(item, p, ctx) if name == "body" else _table(cls, item, p, ctx))
+                    if name == "body":
+                        out.append(_body(item, p, ctx))
+                    elif name == "collider":
+                        out.append(_collider(item, p, ctx))
+                    else:
+                        out.append(_table(cls, item, p, ctx))
                     if name == "pull":
                         _check_pull(out[-1], p)
                 values[name] = tuple(out)
@@ -809,7 +947,7 @@ def _plain(value):
 
 
 def _record(obj, *, base_dir, always=()) -> dict:
-    from .assets import texture_reference
+    from .assets import picture_reference, texture_reference
 
     out = {}
     defaults = type(obj)()
@@ -823,6 +961,8 @@ def _record(obj, *, base_dir, always=()) -> dict:
             continue
         if f.metadata["kind"] == "file":
             v = texture_reference(v, base_dir=base_dir)
+        elif f.metadata["kind"] == "picture":
+            v = picture_reference(v, base_dir=base_dir)
         out[f.name] = _plain(v)
     return out
 
@@ -849,8 +989,9 @@ def scene_to_dict(scene: Scene, *, base_dir=None, full: bool = True) -> dict:
             for it in items:
                 keep = [f.name for f in fields(it)] if full else ()
                 rec = _record(it, base_dir=base, always=keep)
-                if isinstance(it, BodyPhysics):  # shape, the kind's own keys, then the shared ones
-                    shared = [f.name for f in fields(BodyPhysics)]
+                common = next((c for c in (BodyPhysics, ColliderCommon) if isinstance(it, c)), None)
+                if common is not None:  # shape, the kind's own keys, then the shared ones
+                    shared = [f.name for f in fields(common)]
                     rec = {"shape": it.shape, **{k: v for k, v in rec.items() if k != "shape" and k not in shared},
                            **{k: rec[k] for k in shared if k in rec}}
                 recs.append(rec)
