@@ -47,13 +47,19 @@ import numpy as np
 from numba import njit
 
 from .friction import coulomb
-from .shapes import (CIRCLE, EDGE, EDGE_AX, EDGE_AY, EDGE_BX, EDGE_BY, EDGE_NX, EDGE_NY, KIND, OMEGA, POLYGON, RECT,
+from .shapes import (CIRCLE, COUNT, EDGE, EDGE_AX, EDGE_AY, EDGE_BX, EDGE_BY, EDGE_NX, EDGE_NY, KIND, OMEGA, POLYGON, RECT,
                      RECT_COLUMNS, RECT_CX, RECT_CY, RECT_FRICTION, RECT_HX, RECT_HY, RECT_REACH, RECT_SKIN,
                      RECT_STATIC_FRICTION, RECT_UX, RECT_UY, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, SEGMENT,
                      VEL_X, VEL_Y, Circle, Polygon, Rect, Segment, pack_colliders)
 
 __all__ = ["Circle", "Polygon", "Rect", "Segment", "collide_point", "contact_planes", "finish_position_step",
-           "pack_colliders", "path_hits", "push_edges_off_corners", "RECT_COLUMNS"]
+           "n_colliders", "pack_colliders", "path_hits", "push_edges_off_corners", "RECT_COLUMNS"]
+
+@njit(cache=True, inline="always")
+def n_colliders(rects):
+    """How many of the packed rows are colliders (the polygons' edge rows follow them)."""
+    return 0 if rects.shape[0] == 0 else np.int64(rects[0, COUNT])
+
 
 # Per vertex of a world, the last collider contact: written only when a vertex touches one.
 ColliderHits = namedtuple("ColliderHits", [
@@ -251,7 +257,7 @@ def jump_reach(rects):
     """Squared half-thickness (m^2) of the thinnest collider: a point that moves further in
     one substep may have jumped over it, and gets the swept test of :func:`collide_point`."""
     reach = np.inf
-    for r in range(rects.shape[0]):
+    for r in range(n_colliders(rects)):
         reach = min(reach, rects[r, RECT_REACH])
     return reach
 
@@ -354,7 +360,7 @@ def _swept_entry(x0, y0, px, py, rects):
     t_in = 0.0
     t_out = 0.0
     d2 = (px - x0) * (px - x0) + (py - y0) * (py - y0)
-    for r in range(rects.shape[0]):
+    for r in range(n_colliders(rects)):
         if d2 <= rects[r, RECT_REACH]:
             continue  # moved less than this collider's half-thickness: it cannot have jumped it
         if max(x0, px) <= rects[r, RECT_XMIN] or min(x0, px) >= rects[r, RECT_XMAX] \
@@ -382,7 +388,7 @@ def path_hits(x0, y0, px, py, rects):
     >>> path_hits(0.0, 0.05, 0.0, -0.05, thin), path_hits(0.0, 0.05, 0.0, 0.02, thin)
     (True, False)
     """
-    for r in range(rects.shape[0]):
+    for r in range(n_colliders(rects)):
         if _inside(rects, r, px, py):
             return True
     qx, qy = _swept_entry(x0, y0, px, py, rects)
@@ -436,12 +442,12 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
     # (rare), and decided inline: a call per point would cost reference counting on rects
     d2 = (px - x0) * (px - x0) + (py - y0) * (py - y0)
     jumpy = False
-    for r in range(rects.shape[0]):
+    for r in range(n_colliders(rects)):
         if d2 > rects[r, RECT_REACH]:
             jumpy = True
     if jumpy:
         inside = False
-        for r in range(rects.shape[0]):
+        for r in range(n_colliders(rects)):
             if _inside(rects, r, px, py):
                 inside = True
         if not inside:
@@ -453,7 +459,7 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
     last_depth = 0.0
     for _ in range(MAX_PASSES):
         hit = False
-        for r in range(rects.shape[0]):
+        for r in range(n_colliders(rects)):
             if not _inside(rects, r, px, py):
                 continue
             hit = True
@@ -483,7 +489,7 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
         if not hit:
             break
     if hit:
-        for r in range(rects.shape[0]):
+        for r in range(n_colliders(rects)):
             if _inside(rects, r, px, py):
                 # trapped between colliders: the original's answer, back to where it was
                 return x0, y0, 0.0, 0.0, last, hx_n, hy_n, last_depth
@@ -537,7 +543,7 @@ def contact_planes(x0, y, rects, planes, index, h):
     for i in range(y.shape[0]):
         px, py = y[i, 0], y[i, 1]
         best_depth = -np.inf
-        for r in range(rects.shape[0]):
+        for r in range(n_colliders(rects)):
             if not _inside(rects, r, px, py):
                 continue
             rx0, ry0 = _relative_start(rects, r, x0[i, 0], x0[i, 1], h)
@@ -573,7 +579,7 @@ def advance_colliders(rects, h):
     (True, [1.0, 0.0, 0.0, 1.0])
     """
     moved = False
-    for r in range(rects.shape[0]):
+    for r in range(n_colliders(rects)):
         kind = rects[r, KIND]
         if kind == EDGE:
             continue
@@ -668,6 +674,7 @@ def finish_position_step(x, v, x_prev, rects, hits, stamp, h, vmax2):
     # 4 s jelly comparison once took 27.6 s instead of 1.7 s while the other core was busy)
     inv_h = 1.0 / h
     reach2 = jump_reach(rects)
+    n_rects = n_colliders(rects)
     bad = 0
     for i in range(x.shape[0]):
         x0, y0 = x_prev[i, 0], x_prev[i, 1]
@@ -675,7 +682,7 @@ def finish_position_step(x, v, x_prev, rects, hits, stamp, h, vmax2):
         vx = (px - x0) * inv_h
         vy = (py - y0) * inv_h
         near = False
-        for r in range(rects.shape[0]):  # broad phase: bounding boxes
+        for r in range(n_rects):  # broad phase: bounding boxes
             if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                 near = True
         if near or (px - x0) ** 2 + (py - y0) ** 2 > reach2:
@@ -731,11 +738,12 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
     ([[-1.0, 1.414214], [1.0, 1.414214]], [[0.0, 0.0], [0.0, 0.0]])
     """
     moved = 0
+    n_rects = n_colliders(rects)
     for e in range(edge_a.shape[0]):
         ia = vertex[edge_a[e]]
         ib = vertex[edge_b[e]]
         ax, ay, bx, by = x[ia, 0], x[ia, 1], x[ib, 0], x[ib, 1]
-        for r in range(rects.shape[0]):
+        for r in range(n_rects):
             # bounding boxes first: most edges are nowhere near a collider
             if max(ax, bx) <= rects[r, RECT_XMIN] or min(ax, bx) >= rects[r, RECT_XMAX] \
                     or max(ay, by) <= rects[r, RECT_YMIN] or min(ay, by) >= rects[r, RECT_YMAX]:
@@ -796,7 +804,7 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
             # collider (an end resting on the face next to the corner, nudged through it by
             # the push's normal) is not made; the corner stays that little way in the edge
             blocked = False
-            for q in range(rects.shape[0]):
+            for q in range(n_rects):
                 if _inside(rects, q, qax, qay) or _inside(rects, q, qbx, qby):
                     blocked = True
             if blocked:

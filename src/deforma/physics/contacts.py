@@ -98,7 +98,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .colliders import (RECT_FRICTION, RECT_STATIC_FRICTION, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN,
+from .colliders import (RECT_FRICTION, RECT_STATIC_FRICTION, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, n_colliders,
                         collide_point, jump_reach, path_hits, record_hit)
 from .friction import coulomb, mix
 
@@ -701,7 +701,7 @@ def _keep_out(x, v, i, x0, y0, rects, reach2, h):
     # velocity rule and friction), after the same cheap tests as in the integrators' pass.
     px, py = x[i, 0], x[i, 1]
     near = (px - x0) * (px - x0) + (py - y0) * (py - y0) > reach2
-    for r in range(rects.shape[0]):
+    for r in range(n_colliders(rects)):
         if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
             near = True
     if near:
@@ -951,6 +951,7 @@ def _collider_pass(x, v, topo, scr, rects, hits, h):
     as moved for the next check."""
     cv, xp = topo.cv_vertex, scr.xp
     reach2 = jump_reach(rects)
+    n_rects = n_colliders(rects)
     status = scr.status
     dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
     moved = 0
@@ -959,7 +960,7 @@ def _collider_pass(x, v, topo, scr, rects, hits, h):
         i = cv[k]
         px, py = x[i, 0], x[i, 1]
         near = (px - xp[k, 0]) * (px - xp[k, 0]) + (py - xp[k, 1]) * (py - xp[k, 1]) > reach2
-        for r in range(rects.shape[0]):  # the integrators' cheap tests first
+        for r in range(n_rects):  # the integrators' cheap tests first
             if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                 near = True
         if near and path_hits(xp[k, 0], xp[k, 1], px, py, rects):

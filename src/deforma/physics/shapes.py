@@ -9,8 +9,8 @@ and coefficients can be set at any time; the world notices at its next step.
 
 The kernels read all colliders from one packed float64 array (:func:`pack_colliders`):
 one row per collider (its kind, pose, motion, bounding box and size), then one row per
-polygon edge, whose bounding box is empty so that every loop over rows that tests boxes
-first (all of them) passes over them. :mod:`~deforma.physics.colliders` holds the
+polygon edge. Loops over colliders run over the first ``COUNT`` rows only (the edge rows
+also have empty bounding boxes, so a test that reads them as colliders rejects them). :mod:`~deforma.physics.colliders` holds the
 closest-feature and inside tests per kind and the response.
 
 Units: m, m/s, degrees, degrees/s; radians only inside the packed array.
@@ -34,7 +34,8 @@ RECT_XMIN, RECT_XMAX, RECT_YMIN, RECT_YMAX, RECT_SKIN = 8, 9, 10, 11, 12
 RECT_REACH = 13   # squared half-thickness: a vertex moving further per substep may jump it
 KIND = 14
 VEL_X, VEL_Y, OMEGA = 15, 16, 17   # m/s, m/s, rad/s
-RECT_COLUMNS = 18
+COUNT = 18        # the number of collider rows (the edge rows follow them), in every row
+RECT_COLUMNS = 19
 # Edge rows (KIND = EDGE): ends a, b in columns 0-3, outward unit normal in 4-5.
 EDGE_AX, EDGE_AY, EDGE_BX, EDGE_BY, EDGE_NX, EDGE_NY = 0, 1, 2, 3, 4, 5
 
@@ -574,10 +575,10 @@ def pack_colliders(colliders, *, friction: float, static_friction: float) -> np.
     Examples
     --------
     >>> pack_colliders([Rect((0, 0), (2, 1), 0.0)], friction=0.3, static_friction=0.5).shape
-    (1, 18)
+    (1, 19)
     >>> a = pack_colliders([Polygon([[0, 0], [1, 0], [0, 1]])], friction=0.3, static_friction=0.5)
     >>> a.shape, int(a[0, KIND]), int(a[0, RECT_HX]), int(a[0, RECT_HY])  # 3 edge rows from row 1
-    ((4, 18), 2, 1, 3)
+    ((4, 19), 2, 1, 3)
     """
     rows = []
     edges = []
@@ -592,6 +593,7 @@ def pack_colliders(colliders, *, friction: float, static_friction: float) -> np.
         row[RECT_STATIC_FRICTION] = static_friction if c.static_friction is None else c.static_friction
         row[VEL_X], row[VEL_Y] = c.velocity
         row[OMEGA] = math.radians(c.angular_velocity)
+        row[COUNT] = n
         if c.kind == RECT:
             row[RECT_HX], row[RECT_HY] = c.size[0] / 2, c.size[1] / 2
             reach = min(row[RECT_HX], row[RECT_HY])

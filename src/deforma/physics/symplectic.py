@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit, prange
 
 from .colliders import (RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, advance_colliders, collide_point, is_bad,
-                        jump_reach, push_edges_off_corners, record_hit)
+                        jump_reach, n_colliders, push_edges_off_corners, record_hit)
 from .contacts import ST_STAMP, contact_stage, gather_start
 from .elements import element_forces
 from .forces import spring_force
@@ -109,6 +109,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
     """
     n_chunks = chunk_ptr.shape[0] - 1
     reach2 = jump_reach(rects)
+    n_rects = n_colliders(rects)
     for sub in range(substeps):
         advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
         gather_start(x, ctopo, cscr)
@@ -150,7 +151,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
                 continue
             px, py, vx, vy = _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass[i], gx, gy, keep, h)
             near = False
-            for r in range(rects.shape[0]):  # broad phase: bounding boxes (a helper for these
+            for r in range(n_rects):  # broad phase: bounding boxes (a helper for these
                 # lines, even inlined, costs reference counting on rects per vertex: 2.5x slower)
                 if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                     near = True

@@ -125,7 +125,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     ...                     np.zeros(2, np.int32), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
     ...                     np.zeros(1), *no_elements, 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
-    ...                     np.zeros((0, 18)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
+    ...                     np.zeros((0, 19)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
     ...                     0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
     1.0
