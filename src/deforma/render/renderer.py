@@ -709,6 +709,8 @@ class Renderer:
         """
         for h in list(self._meshes):
             self.remove_mesh(h)
+        self._coll_cache = {}   # it holds the colliders last drawn
+        self._coll_key = None
         for obj in (self._img_tex, self._img_vao, self._img_prog, self._coll_vao, self._coll_vbo,
                     self._grid_vao, self._grid_vbo, self._bg_vao, self._bg_prog, self._body_prog,
                     self._flat_prog, self._coll_prog):
