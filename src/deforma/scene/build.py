@@ -461,8 +461,9 @@ shape='circle', center=(1.0, 2.0), radius=0.5)
     still = pose is not None and (collider.center, collider.angle) == pose
     if isinstance(collider, Rect):
         # a turning rect's angle grows without end; a file takes [-360, 360]
+        angle = float(collider.angle)
         return ColliderSpec(center=_xy(collider.center), size=_xy(collider.size),
-                            angle=math.fmod(float(collider.angle), 360.0), **common)
+                            angle=angle if abs(angle) <= 360 else math.fmod(angle, 360.0), **common)
     if isinstance(collider, Circle):
         return CircleCollider(center=_xy(collider.center), radius=float(collider.radius), **common)
     if isinstance(collider, Segment):
