@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import deforma
 from deforma.mesh import picture
@@ -31,6 +33,8 @@ def star_with_hole():
     [[(0, 0), (10, 0), (10, 10), (0, 10)]]                                             # holes in a row
     + [[(x + 0.2, 1.2), (x + 0.5, 1.8), (x + 0.8, 1.2)] for x in range(1, 9)],
     star_with_hole(),
+    [[(0, 0), (6, 0), (6, 6), (0, 6)], [(1, 1), (5, 1), (5, 5), (1, 5)],                # an island in a hole
+     [(2, 2), (4, 2), (4, 4), (2, 4)]],
 ])
 def test_fill_triangles_cover_the_polygon_exactly(loops):
     poly = deforma.Polygon(loops[0], holes=loops[1:])
@@ -39,8 +43,30 @@ def test_fill_triangles_cover_the_polygon_exactly(loops):
     e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
     area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
     assert (area > 0).all()                                   # counter-clockwise, none flat
-    assert area.sum() == pytest.approx(poly.area, rel=1e-9)   # no gap, no overlap
+    # even-odd: a loop inside an odd number of others is a hole, else it bounds solid (an island)
+    rings = [deforma.Polygon(p) for p in loops]
+    depth = [sum(bool(r.contains([p[0]])[0]) for j, r in enumerate(rings) if j != k) for k, p in enumerate(loops)]
+    solid = sum(r.area * (-1) ** d for r, d in zip(rings, depth))
+    assert area.sum() == pytest.approx(solid, rel=1e-9)       # no gap, no overlap
     assert poly.contains(corners.mean(axis=1)).all()          # none in a hole or a notch
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(0.3, 3.0), min_size=3, max_size=40), st.booleans())
+def test_fill_triangles_of_random_star_polygons(radii, hole):
+    # star-shaped about the origin: simple whatever the radii; a hole inside the inner radius
+    t = np.linspace(0, 2 * np.pi, len(radii), endpoint=False)
+    outer = np.c_[np.cos(t), np.sin(t)] * np.array(radii)[:, None]
+    loops = [outer] + ([0.2 * np.c_[np.cos(-t[:6]), np.sin(-t[:6])]] if hole and len(radii) >= 6 else [])
+    try:
+        poly = deforma.Polygon(loops[0], holes=loops[1:])
+    except ValueError:  # collinear or crossing after rounding: not a polygon to fill
+        return
+    tris = fill_triangles(loops)
+    corners = np.concatenate(loops)[tris]
+    e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    assert (area > 0).all() and area.sum() == pytest.approx(poly.area, rel=1e-9)
 
 
 def every_shape():

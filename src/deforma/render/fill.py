@@ -30,11 +30,12 @@ def _signed_area(p: np.ndarray) -> float:
 def _crossings(a, b, c, d) -> np.ndarray:
     """Whether segment a-b touches or crosses each segment c[k]-d[k] (touching counts)."""
     def orient(p, q, r):
-        return np.sign((q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1]) - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0]))
+        return np.sign((q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1])
+                       - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0]))
 
     def on(o, p, q, r):  # r on p-q when collinear: within its box
-        return (o == 0) & (np.minimum(p[..., 0], q[..., 0]) <= r[..., 0]) & (r[..., 0] <= np.maximum(p[..., 0], q[..., 0])) \
-            & (np.minimum(p[..., 1], q[..., 1]) <= r[..., 1]) & (r[..., 1] <= np.maximum(p[..., 1], q[..., 1]))
+        lo, hi = np.minimum(p, q), np.maximum(p, q)
+        return (o == 0) & np.all((lo <= r) & (r <= hi), axis=-1)
     a, b = np.broadcast_to(a, c.shape), np.broadcast_to(b, c.shape)
     o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
     return ((o1 * o2 < 0) & (o3 * o4 < 0)) | on(o1, a, b, c) | on(o2, a, b, d) | on(o3, c, d, a) | on(o4, c, d, b)
@@ -165,6 +166,9 @@ def _walk(nxt, start, count):
 def fill_triangles(loops) -> np.ndarray:
     """Triangles that fill the region inside ``loops[0]`` and outside ``loops[1:]``.
 
+    Inside and outside are even-odd, as :meth:`deforma.Polygon.contains` has them: a loop
+    within a hole is an island, filled again.
+
     Parameters
     ----------
     loops : sequence of (K, 2) array_like
@@ -196,21 +200,28 @@ def fill_triangles(loops) -> np.ndarray:
         return np.zeros((0, 3), np.int32)
     offsets = np.cumsum([0] + [len(p) for p in loops])
     pts = np.concatenate(loops)
-    ring = list(range(len(loops[0])))
-    if _signed_area(loops[0]) < 0:
-        ring.reverse()
-    holes = []
-    for k, p in enumerate(loops[1:], start=1):
-        h = list(range(offsets[k], offsets[k + 1]))
-        if _signed_area(p) > 0:
-            h.reverse()  # holes run clockwise, so the bridged ring stays one counter-clockwise loop
-        holes.append(h)
-    # rightmost holes first: each then sees the outer boundary or a hole joined before it
-    holes.sort(key=lambda h: -pts[h, 0].max())
-    for k, h in enumerate(holes):
-        others = [pts[o] for o in holes[k + 1:]]
-        ring = _bridge(ring, pts, h, others, loops)
-    return np.asarray(_ear_clip(pts, ring), dtype=np.int32).reshape(-1, 3)
+    # even-odd, as the colliders' inside test: a loop inside an odd number of others is a
+    # hole, one inside an even number bounds solid (the outer loop, or an island in a hole)
+    inside = [[j != k and _inside(loops[k][0], [loops[j]]) for j in range(len(loops))] for k in range(len(loops))]
+    depth = [sum(row) for row in inside]
+    tris = []
+    for k in (k for k in range(len(loops)) if depth[k] % 2 == 0):
+        ring = list(range(offsets[k], offsets[k + 1]))
+        if _signed_area(loops[k]) < 0:
+            ring.reverse()
+        holes = []
+        for j in range(len(loops)):
+            if depth[j] == depth[k] + 1 and inside[j][k]:   # a hole right inside this loop
+                h = list(range(offsets[j], offsets[j + 1]))
+                if _signed_area(loops[j]) > 0:
+                    h.reverse()  # holes run clockwise, so the bridged ring stays one counter-clockwise loop
+                holes.append(h)
+        # rightmost holes first: each then sees the outer boundary or a hole joined before it
+        holes.sort(key=lambda h: -pts[h, 0].max())
+        for i, h in enumerate(holes):
+            ring = _bridge(ring, pts, h, [pts[o] for o in holes[i + 1:]], loops)
+        tris += _ear_clip(pts, ring)
+    return np.asarray(tris, dtype=np.int32).reshape(-1, 3)
 
 
 def triangles_still_fit(points: np.ndarray, triangles: np.ndarray, area: float) -> bool:
