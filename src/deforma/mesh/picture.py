@@ -158,17 +158,21 @@ class _Canvas:
         if len(px) == 1 and len(px[0]) == 2:
             self.draw.line([tuple(p) for p in px[0].tolist()], fill=edge, width=2 * _SUPERSAMPLE)
             return
-        # the fill through a mask of the shape's box: holes are cut out of it, so whatever
-        # was drawn before shows through them (another collider, the background)
+        # the fill through a mask of the shape's box, even-odd as a collider's inside test
+        # (a hole is cut out, an island in it filled again), so whatever was drawn before
+        # shows through the holes (another collider, the background)
         lo = np.floor(np.concatenate(px).min(axis=0)).astype(int) - 1
         hi = np.ceil(np.concatenate(px).max(axis=0)).astype(int) + 2
         lo = np.maximum(lo, 0)
         hi = np.minimum(hi, self.image.size)
         if np.all(hi > lo):
-            mask = Image.new("L", tuple(int(v) for v in hi - lo), 0)
-            pen = ImageDraw.Draw(mask)
-            for k, p in enumerate(px):
-                pen.polygon([tuple(q) for q in (p - lo).tolist()], fill=255 if k == 0 else 0)
+            box = tuple(int(v) for v in hi - lo)
+            solid = np.zeros(box[::-1], bool)
+            for p in px:
+                ring = Image.new("L", box, 0)
+                ImageDraw.Draw(ring).polygon([tuple(q) for q in (p - lo).tolist()], fill=255)
+                solid ^= np.asarray(ring) > 0
+            mask = Image.fromarray(solid.astype(np.uint8) * 255)
             self.image.paste(fill, (int(lo[0]), int(lo[1]), int(hi[0]), int(hi[1])), mask)
         for p in px:
             ring = [tuple(q) for q in p.tolist()]

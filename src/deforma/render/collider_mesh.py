@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .fill import fill_triangles, loops_area, triangles_still_fit
+from .fill import fill_triangles, loop_depths, loops_area, triangles_still_fit
 
 __all__ = ["COLLIDER_EDGE_PIXELS", "CURVE_SEGMENTS", "WIRE_PIXELS", "ColliderGeometry", "ColliderShape",
            "collider_corners", "collider_shape"]
@@ -161,11 +161,12 @@ class ColliderGeometry:
             self.border_pos, self.border_off = _band(line, False, WIRE_PIXELS, caps=True)
             self.core_pos, self.core_off = _band(line, False, WIRE_PIXELS - COLLIDER_EDGE_PIXELS, caps=True)
             return
-        # the outer loop counter-clockwise and holes clockwise: the solid is then left of every
-        # edge, which is where the border goes
-        loops = [p if (_area(p) >= 0) == (k == 0) else p[::-1] for k, p in enumerate(loops)]
+        # boundaries of solid counter-clockwise and holes clockwise: the solid is then left of
+        # every edge, which is where the border goes
+        depths = loop_depths(loops) if len(loops) > 1 else [0]
+        loops = [p if (_area(p) >= 0) == (d % 2 == 0) else p[::-1] for p, d in zip(loops, depths)]
         pts = np.concatenate(loops)
-        area = loops_area(loops)
+        area = loops_area(loops, depths)
         if triangles is None or len(triangles) == 0 or triangles.max() >= len(pts) \
                 or not triangles_still_fit(pts, triangles, area):
             triangles = fill_triangles(loops)

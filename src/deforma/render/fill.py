@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["fill_triangles", "triangles_still_fit"]
+__all__ = ["fill_triangles", "loop_depths", "loops_area", "triangles_still_fit"]
 
 
 def _cross(o, a, b) -> float:
@@ -200,9 +200,7 @@ def fill_triangles(loops) -> np.ndarray:
         return np.zeros((0, 3), np.int32)
     offsets = np.cumsum([0] + [len(p) for p in loops])
     pts = np.concatenate(loops)
-    # even-odd, as the colliders' inside test: a loop inside an odd number of others is a
-    # hole, one inside an even number bounds solid (the outer loop, or an island in a hole)
-    inside = [[j != k and _inside(loops[k][0], [loops[j]]) for j in range(len(loops))] for k in range(len(loops))]
+    inside = _nesting(loops)
     depth = [sum(row) for row in inside]
     tris = []
     for k in (k for k in range(len(loops)) if depth[k] % 2 == 0):
@@ -224,6 +222,19 @@ def fill_triangles(loops) -> np.ndarray:
     return np.asarray(tris, dtype=np.int32).reshape(-1, 3)
 
 
+def _nesting(loops) -> list[list[bool]]:
+    """``[k][j]``: whether loop k lies inside loop j (k != j; loops do not cross, so one
+    vertex tells)."""
+    return [[j != k and _inside(loops[k][0], [loops[j]]) for j in range(len(loops))] for k in range(len(loops))]
+
+
+def loop_depths(loops) -> list[int]:
+    """How many other loops each loop lies in. Even-odd, as the colliders' inside test: a
+    loop at an odd depth is a hole, one at an even depth bounds solid (the outer boundary,
+    or an island in a hole)."""
+    return [sum(row) for row in _nesting(loops)]
+
+
 def triangles_still_fit(points: np.ndarray, triangles: np.ndarray, area: float) -> bool:
     """Whether ``triangles`` made for a shape still fill it after it moved or changed size:
     every triangle still counter-clockwise and their areas still adding up to ``area``.
@@ -237,7 +248,7 @@ def triangles_still_fit(points: np.ndarray, triangles: np.ndarray, area: float) 
     return bool(len(a)) and bool(np.all(a > 0)) and abs(float(a.sum()) - area) <= 1e-6 * abs(area)
 
 
-def loops_area(loops) -> float:
-    """Area of the region inside the first loop and outside the others (either orientation)."""
-    areas = [abs(_signed_area(np.asarray(p, np.float64))) for p in loops]
-    return areas[0] - sum(areas[1:])
+def loops_area(loops, depths=None) -> float:
+    """Area of the solid the loops bound (either orientation; even-odd, see :func:`loop_depths`)."""
+    depths = loop_depths(loops) if depths is None else depths
+    return sum(abs(_signed_area(np.asarray(p, np.float64))) * (-1) ** d for p, d in zip(loops, depths))
