@@ -40,7 +40,8 @@ def test_session_adds_edits_turns_and_removes_each_shape(session, shape):
     own = set(s.collider_params())
     assert {"collider_x", "collider_y", "collider_angle", "collider_vx", "collider_vy", "collider_angular_velocity",
             "collider_friction", "collider_static_friction"} <= own
-    assert ("collider_width" in own) == (shape == "rect") and ("collider_radius" in own) == (shape in ("circle", "segment"))
+    assert ("collider_width" in own) == (shape == "rect")
+    assert ("collider_radius" in own) == (shape in ("circle", "segment"))
     for name in set(COLLIDER_FIELDS) - own:
         assert s.get_param(name) is None
     # every value the shape has, set and read back
