@@ -155,6 +155,14 @@ def test_a_moving_collider_that_traps_a_body_is_reported_and_everything_is_put_b
     assert 0.0 < center[1] < 0.3
 
 
+def test_moving_colliders_move_in_a_world_without_bodies():
+    w = deforma.World(dt=0.01)
+    c = w.add_collider(deforma.Circle((0, 0), 1.0, velocity=(1.0, 0.0), angular_velocity=90.0))
+    for _ in range(100):
+        w.step()
+    assert c.center == pytest.approx((1.0, 0.0)) and c.angle == pytest.approx(90.0)
+
+
 def test_colliders_refuse_bad_input_in_one_line():
     bad = [
         lambda: deforma.Circle((0, 0), 0.0),
@@ -163,6 +171,8 @@ def test_colliders_refuse_bad_input_in_one_line():
         lambda: deforma.Polygon([[0, 0], [1, 1], [1, 0], [0, 1]]),  # a bow tie
         lambda: deforma.Polygon([[0, 0], [1, 0], [2, 0]]),  # no area
         lambda: deforma.Polygon([[0, 0], [1, 0], [0, 1]], holes=[[[5, 5], [6, 5], [5, 6]]]),
+        lambda: deforma.Polygon([[0, 0], [9, 0], [9, 9], [0, 9]],  # an island in a hole
+                                holes=[[[1, 1], [8, 1], [8, 8], [1, 8]], [[2, 2], [7, 2], [7, 7], [2, 7]]]),
         lambda: deforma.Segment((1, 1), (1, 1)),
         lambda: deforma.Segment((0, 0), (1, 0), radius=-0.1),
         lambda: deforma.Rect((0, 0), (1, 1), velocity=(np.nan, 0)),

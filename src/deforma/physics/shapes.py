@@ -513,6 +513,10 @@ class Polygon(Collider):
                 hole = hole[::-1]
             if not _inside_loops(hole[:1], [outer])[0]:
                 raise ValueError(f"holes[{k}] must lie inside the polygon")
+            for j, other in enumerate(loops[1:]):
+                if _inside_loops(hole[:1], [other])[0] or _inside_loops(other[:1], [hole])[0]:
+                    raise ValueError(f"holes[{k}] and holes[{j}] are nested: an island in a hole is a polygon of "
+                                     f"its own")
             loops.append(hole)
         _check_simple(loops, "a polygon")
         area = sum(_signed_area(p) for p in loops)
@@ -526,6 +530,7 @@ class Polygon(Collider):
         c = np.array([round(cx / area, 6), round(cy / area, 6)])
         self._area = area
         self._local_loops = [p - c for p in loops]
+        self._reach = _polygon_reach(self._local_loops)  # the same in any pose
         super().__init__(tuple(float(v) for v in c), 0.0, friction, static_friction, velocity, angular_velocity)
 
     @property
@@ -609,24 +614,23 @@ def pack_colliders(colliders, *, friction: float, static_friction: float) -> np.
             box = np.concatenate([box - row[RECT_HY], box + row[RECT_HY]])
         elif c.kind == POLYGON:
             loops = c.loops
-            first = n + len(edges)
-            for p in loops:
-                q = np.roll(p, -1, axis=0)
-                d = q - p
-                length = np.hypot(d[:, 0], d[:, 1])
-                for k in range(len(p)):
-                    e = np.zeros(RECT_COLUMNS)
-                    e[EDGE_AX], e[EDGE_AY], e[EDGE_BX], e[EDGE_BY] = p[k, 0], p[k, 1], q[k, 0], q[k, 1]
-                    # outward: the solid lies left of a counter-clockwise outer loop and of a
-                    # clockwise hole alike, so outward is the right-hand normal
-                    e[EDGE_NX], e[EDGE_NY] = d[k, 1] / length[k], -d[k, 0] / length[k]
-                    e[RECT_XMIN], e[RECT_XMAX], e[RECT_YMIN], e[RECT_YMAX] = np.inf, -np.inf, np.inf, -np.inf
-                    e[RECT_REACH] = np.inf
-                    e[KIND] = EDGE
-                    edges.append(e)
-            row[RECT_HX], row[RECT_HY] = first, n + len(edges) - first
-            reach = _polygon_reach(loops)
-            box = np.concatenate(loops)
+            p = np.concatenate(loops)
+            q = np.concatenate([np.roll(lp, -1, axis=0) for lp in loops])
+            d = q - p
+            length = np.hypot(d[:, 0], d[:, 1])
+            e = np.zeros((len(p), RECT_COLUMNS))
+            e[:, EDGE_AX], e[:, EDGE_AY], e[:, EDGE_BX], e[:, EDGE_BY] = p[:, 0], p[:, 1], q[:, 0], q[:, 1]
+            # outward: the solid lies left of a counter-clockwise outer loop and of a clockwise
+            # hole alike, so outward is the right-hand normal
+            e[:, EDGE_NX], e[:, EDGE_NY] = d[:, 1] / length, -d[:, 0] / length
+            e[:, RECT_XMIN], e[:, RECT_XMAX], e[:, RECT_YMIN], e[:, RECT_YMAX] = np.inf, -np.inf, np.inf, -np.inf
+            e[:, RECT_REACH] = np.inf
+            e[:, KIND] = EDGE
+            e[:, COUNT] = n
+            row[RECT_HX], row[RECT_HY] = n + sum(len(b) for b in edges), len(p)
+            edges.append(e)
+            reach = c._reach
+            box = p
         else:
             raise ValueError(f"colliders must be deforma.Rect, Circle, Polygon or Segment, found {type(c).__name__}")
         lo, hi = box.min(axis=0), box.max(axis=0)
@@ -636,8 +640,9 @@ def pack_colliders(colliders, *, friction: float, static_friction: float) -> np.
         row[RECT_SKIN] = 1e-9 + 1e-13 * scale  # strictly outside after rounding back to world coordinates
         row[RECT_REACH] = reach * reach
         rows.append(row)
-    out = np.array(rows + edges) if rows else np.zeros((0, RECT_COLUMNS))
-    return out.reshape(-1, RECT_COLUMNS)
+    if not rows:
+        return np.zeros((0, RECT_COLUMNS))
+    return np.concatenate([np.array(rows)] + edges)
 
 
 def _polygon_reach(loops: list[np.ndarray]) -> float:

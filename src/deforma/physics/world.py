@@ -41,6 +41,7 @@ AUTO_THICKNESS = 0.05
 # falls below this share of its rest area; checked every SHAPE_CHECK_EVERY steps.
 LOST_STRETCH = 10.0
 LOST_AREA = 0.1
+REPACK_EVERY = 64  # steps: moving colliders are packed again from their objects this often
 SHAPE_CHECK_EVERY = 16
 
 
@@ -731,9 +732,13 @@ class World:
             back to what it was before this step.
         """
         moving = any(c.moving for c in self._colliders)
-        moved = self._colliders_changed() or moving
+        moved = self._colliders_changed()
         if moved:
             self._pack_colliders()
+        if moving:
+            # the kernels move the packed copies: until the objects follow (at the end of a
+            # step that succeeds), the packed array is not theirs
+            self._packed_colliders = None
         if self._grabs_dirty:
             self._rebuild_grabs()
         if self._model.n_vertices:
@@ -770,10 +775,17 @@ class World:
                     for c, center, angle in poses:  # the step is undone: so is their motion
                         c.center, c.angle = center, angle
                     raise
+            if poses and self.step_count % REPACK_EVERY:
+                # the packed copies are where the objects now are (up to rounding, which a
+                # repack every REPACK_EVERY steps clears): no repack next step
+                self._packed_colliders = tuple((id(c), c._version) for c in self._colliders)
             _behaviours.limit_and_yield(self._model, self._state, self._dt)
             self._tear()
             if self.step_count % SHAPE_CHECK_EVERY == 0:
                 self._check_shape()
+        else:  # no body: moving colliders still move
+            for c in self._colliders:
+                c.advance(self._dt)
         self.time += self._dt
         self.step_count += 1
 
@@ -853,8 +865,10 @@ class World:
         room left, squeezed between colliders closer than the body can fit, stays inside.
         """
         x = self._state.x
-        for c, rect in enumerate(self._colliders):
-            inside = np.flatnonzero(rect.contains(x))
+        for c, collider in enumerate(self._colliders):
+            x0, y0, x1, y1 = collider.bounds()
+            near = np.flatnonzero((x[:, 0] > x0) & (x[:, 0] < x1) & (x[:, 1] > y0) & (x[:, 1] < y1))
+            inside = near[collider.contains(x[near])] if len(near) else near
             if len(inside):
                 b = int(np.searchsorted(self._model.body_vertex_offsets, inside[0], side="right") - 1)
                 self._state.restore()
