@@ -69,22 +69,28 @@ def test_polygon_angle_turns_it_about_its_centroid():
     np.testing.assert_allclose(sorted(map(tuple, p.points.round(9))), [(0, 0), (0, 2), (2, 0), (2, 2)], atol=1e-9)
 
 
-def test_moved_colliders_are_saved_where_they_are(tmp_path):
+def test_moving_colliders_are_saved_where_they_started_and_set_ones_where_they_were_put(tmp_path):
     s = scene_with({"shape": "segment", "a": [0, 0], "b": [2, 0], "angular_velocity": 45},
                    {"shape": "polygon", "points": L_SHAPE, "velocity": [1, 0], "angular_velocity": 30},
                    {"size": [1, 1], "angular_velocity": 720})
     w = s.build()
-    # a body far away: a world without vertices does not step its colliders either
-    w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=1), position=(50, 50))
+    start = [c.outline() for c in w.colliders]
     for _ in range(int(round(0.6 / w.dt))):
         w.step()
+    assert not np.allclose(w.colliders[1].outline(), start[1])  # it moved
     spec = scenes.scene_of(w).collider
-    assert spec[1].angle == 0 and spec[1].points != s.collider[1].points  # the corners turned and moved
-    assert -360 <= spec[2].angle <= 360  # 432 degrees turned: written as 72
+    assert spec[0] == s.collider[0] and spec[1] == s.collider[1]  # a scene is a setup: where they started
     w2 = scenes.load(deforma.save_scene(w, tmp_path / "moved.toml")).build()
-    for a, b in zip(w.colliders, w2.colliders):
-        np.testing.assert_allclose(a.outline(), b.outline(), atol=1e-7)
+    for a, b, s0 in zip(w.colliders, w2.colliders, start):
+        np.testing.assert_allclose(b.outline(), s0, atol=1e-7)
         assert b.angular_velocity == a.angular_velocity and b.velocity == a.velocity
+    w.colliders[2].angle = 432.0  # put there by hand (the viewer's keys): written so, within +-360
+    w.colliders[1].center = (5.0, 5.0)
+    spec = scenes.scene_of(w).collider
+    assert spec[2].angle == pytest.approx(72.0)
+    assert spec[1].angle == 0 and spec[1].points != s.collider[1].points  # the corners moved
+    w3 = scenes.load(deforma.save_scene(w, tmp_path / "set.toml")).build()
+    assert w3.colliders[1].center == pytest.approx((5.0, 5.0))
 
 
 def test_colliders_made_in_code_are_written_by_their_shape(tmp_path):

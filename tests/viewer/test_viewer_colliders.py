@@ -163,3 +163,15 @@ def test_a_moving_collider_moves_in_the_window(demo):
     selected = np.array([int(SELECTED_COLLIDER_COLOR[k:k + 2], 16) for k in (1, 3, 5)])
     assert np.abs(img[world_pixel(demo, (c.center[0], c.center[1] + 0.25))] - selected).max() < 40
     assert np.abs(img[world_pixel(demo, (start[0], start[1] + 0.25))] - selected).max() > 40
+
+
+def test_reset_puts_a_moving_collider_back_where_it_started(session):
+    c = session.add_collider("circle")
+    c.velocity = (1.0, 0.0)
+    start = c.center
+    for _ in range(60):
+        session.world.step()
+    assert session.world.colliders[-1].center[0] > start[0] + 0.05
+    session.reset()
+    moved_back = session.world.colliders[-1]
+    assert moved_back.center == pytest.approx(start) and moved_back.velocity == (1.0, 0.0)

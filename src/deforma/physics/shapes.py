@@ -18,6 +18,7 @@ Units: m, m/s, degrees, degrees/s; radians only inside the packed array.
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -163,9 +164,10 @@ class Collider:
 
     @center.setter
     def center(self, value):
-        self._center = _pair(value, "center")
-        if max(abs(self._center[0]), abs(self._center[1])) > 1e9:
+        c = _pair(value, "center")
+        if max(abs(c[0]), abs(c[1])) > 1e9:
             raise ValueError(f"center must lie within +-1e9 m, got {value!r}")
+        self._center = self._origin_center = c
         self._changed()
 
     @property
@@ -175,8 +177,25 @@ class Collider:
 
     @angle.setter
     def angle(self, value):
-        self._angle = _finite(value, "angle")
+        self._angle = self._origin_angle = _finite(value, "angle")
         self._changed()
+
+    @property
+    def origin(self) -> tuple[tuple[float, float], float]:
+        """``(center, angle)`` where it was put (made, or last given a centre or angle), before
+        its own motion moved it: where a saved scene puts it, and where a reset starts it."""
+        return self._origin_center, self._origin_angle
+
+    def _set_pose(self, center, angle) -> None:
+        """Put it at a pose reached by its motion (the origin stays)."""
+        self._center, self._angle = center, angle
+        self._changed()
+
+    def at_origin(self) -> "Collider":
+        """A copy of it at its :attr:`origin`, with the same motion and friction."""
+        twin = copy.copy(self)
+        twin._center, twin._angle = self.origin
+        return twin
 
     @property
     def velocity(self) -> tuple[float, float]:
@@ -236,9 +255,8 @@ class Collider:
     def advance(self, dt: float) -> None:
         """Move by the velocity and turn by the angular velocity over ``dt`` seconds."""
         if self.moving:
-            self._center = (self._center[0] + self._velocity[0] * dt, self._center[1] + self._velocity[1] * dt)
-            self._angle = self._angle + self._angular_velocity * dt
-            self._changed()
+            self._set_pose((self._center[0] + self._velocity[0] * dt, self._center[1] + self._velocity[1] * dt),
+                           self._angle + self._angular_velocity * dt)
 
     def contains(self, points) -> np.ndarray:
         """Whether each point (N, 2) lies strictly inside, as (N,) bool."""

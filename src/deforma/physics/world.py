@@ -773,7 +773,7 @@ class World:
                     self._check_not_trapped()
                 except SimulationUnstable:
                     for c, center, angle in poses:  # the step is undone: so is their motion
-                        c.center, c.angle = center, angle
+                        c._set_pose(center, angle)
                     raise
             if poses and self.step_count % REPACK_EVERY:
                 # the packed copies are where the objects now are (up to rounding, which a

@@ -438,13 +438,15 @@ def _loop(points) -> tuple:
 
 
 def collider_spec(collider, spec=None, pose=None):
-    """The ``[[collider]]`` spec of ``collider`` as it is now (pose, motion, friction).
+    """The ``[[collider]]`` spec of ``collider``: its motion and friction now, at its
+    :attr:`~deforma.physics.shapes.Collider.origin` (where it was put, before its own motion
+    moved it: a saved moving collider starts where it started, as bodies do).
 
     One spec per collider: the pieces of an image collider are written as polygons (with the
     image's colour), so that a saved file needs no picture and lists the colliders as the
     world does. ``spec`` and ``pose`` (``(center, angle)`` when built) are what the scene said:
-    a segment or polygon that has not moved keeps the spec's own points (a polygon its ``angle``);
-    one that moved is written where it is now (a polygon with its corners turned, ``angle = 0``).
+    a segment or polygon still at the pose it was built at keeps the spec's own points (a polygon
+    its ``angle``); one given another pose is written there (corners turned, ``angle = 0``).
 
     Examples
     --------
@@ -455,6 +457,7 @@ shape='circle', center=(1.0, 2.0), radius=0.5)
     """
     from ..physics import Circle, Polygon, Rect, Segment
 
+    collider = collider.at_origin()
     common = dict(velocity=_xy(collider.velocity), angular_velocity=float(collider.angular_velocity),
                   friction=collider.friction, static_friction=collider.static_friction,
                   color=None if spec is None else spec.color)
