@@ -175,3 +175,19 @@ def test_reset_puts_a_moving_collider_back_where_it_started(session):
     session.reset()
     moved_back = session.world.colliders[-1]
     assert moved_back.center == pytest.approx(start) and moved_back.velocity == (1.0, 0.0)
+
+
+def test_an_image_collider_of_several_pieces_keeps_the_colours_of_the_colliders_after_it(tmp_path):
+    import deforma
+    from deforma.scene import load
+
+    picture = np.zeros((20, 40), np.uint8)
+    picture[10:, :15] = picture[10:, 25:] = 255  # two pieces
+    from PIL import Image
+    Image.fromarray(picture).save(tmp_path / "two.png")
+    (tmp_path / "s.toml").write_text(
+        '[[collider]]\nshape = "image"\nsource = "two.png"\nscale = 0.05\ncolor = "#111111"\n\n'
+        '[[collider]]\ncenter = [0.0, -3.0]\nsize = [4.0, 0.5]\ncolor = "#222222"\n')
+    s = Session(load(tmp_path / "s.toml"))
+    assert len(s.world.colliders) == 3 and isinstance(s.world.colliders[2], deforma.Rect)
+    assert s.collider_colors == ["#111111", "#111111", "#222222"]

@@ -185,8 +185,9 @@ class Session:
         self.camera_center = tuple(scene.camera.center)
         self.camera_size = tuple(scene.camera.size)
         self.wireframe = bool(scene.camera.wireframe)
-        self.collider_colors = [c.color for c in scene.collider]
-        self.collider_index = 0 if scene.collider else None
+        # one colour per collider of the world (an image collider is several polygons)
+        self.collider_colors = [c.color for c in scene_of(self.world).collider]
+        self.collider_index = 0 if self.world.colliders else None
         #: True once a collider was picked, added or edited: the window then highlights it.
         self.collider_active = False
         self.body_index = 0
