@@ -402,6 +402,10 @@ class Circle(Collider):
         t = np.linspace(0.0, 2 * np.pi, max(int(segments), 8), endpoint=False) + math.radians(self._angle)
         return np.column_stack([self._center[0] + self._radius * np.cos(t), self._center[1] + self._radius * np.sin(t)])
 
+    def bounds(self) -> tuple[float, float, float, float]:
+        (x, y), r = self._center, self._radius
+        return x - r, y - r, x + r, y + r
+
     def __repr__(self):
         return f"Circle(center={self._center}, radius={self._radius:g}{self._motion_repr()})"
 
@@ -486,6 +490,10 @@ class Segment(Collider):
         left = np.column_stack([-self._half - r * np.cos(t), -r * np.sin(t)])
         local = np.concatenate([right, left]) if r > 0 else np.array([[self._half, 0.0], [-self._half, 0.0]])
         return local @ _rotation(self._angle).T + np.array(self._center)
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        (ax, ay), (bx, by), r = self.a, self.b, self._radius
+        return min(ax, bx) - r, min(ay, by) - r, max(ax, bx) + r, max(ay, by) + r
 
     def __repr__(self):
         return f"Segment(a={self.a}, b={self.b}, radius={self._radius:g}{self._motion_repr()})"
