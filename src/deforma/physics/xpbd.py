@@ -73,9 +73,9 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         Scratch: positions at the start of the current substep.
     lam : (E,) float64
         Scratch: accumulated multipliers (N s^2).
-    planes, touch : (N, 6) float64, (N,) int32
+    planes, touch : (N, 8) float64, (N,) int32
         Scratch: the collider contacts of the substep
-        (:func:`~deforma.physics.colliders.contact_planes`; column 5: 1 stuck, 0 sliding).
+        (:func:`~deforma.physics.colliders.contact_planes`; column 7: 1 stuck, 0 sliding).
     inv_mass : (N,) float64
         1/kg.
     spring_i, spring_j : (E,) int32
@@ -121,7 +121,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
     >>> no_elements = (np.zeros((0, 3), np.int32), np.zeros((0, 4)), *[np.zeros(0)] * 4,
     ...                np.zeros(0, np.int32), np.zeros((0, 2)))
-    >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.zeros((2, 6)),
+    >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.zeros((2, 8)),
     ...                     np.zeros(2, np.int32), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
     ...                     np.zeros(1), *no_elements, 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
