@@ -12,10 +12,15 @@ Examples
 (2, 3)
 """
 
-from . import mesh
-from .mesh.delaunay import delaunay
-from .physics import Circle, Material, Polygon, Rect, Segment, SimulationUnstable, World, colliders_from_image
-from .scene import load_scene, save_scene
+from . import kernel_cache as _kernel_cache
+
+_kernel_cache.use_source_keyed_cache()  # before any kernel is defined: see deforma.kernel_cache
+
+from . import mesh  # noqa: E402
+from .mesh.delaunay import delaunay  # noqa: E402
+from .physics import (Circle, Material, Polygon, Rect, Segment, SimulationUnstable, World,  # noqa: E402
+                      colliders_from_image)
+from .scene import load_scene, save_scene  # noqa: E402
 
 __all__ = ["Circle", "Material", "Polygon", "Rect", "Segment", "SimulationUnstable", "World", "colliders_from_image",
            "delaunay", "load_scene", "mesh", "save_scene", "show"]
