@@ -4,6 +4,7 @@
 ``deforma mesh bunny -o mesh.png``  a picture of a triangulation with its figures
 ``deforma scenes``                  the built-in scenes and textures
 ``deforma view demo``               a window: watch, pull, blow up and edit a scene live
+``deforma sweep S.toml -o OUT``     many runs of a scene with varied parameters, on Ray (docs/sweeps.md)
 
 User mistakes (unknown scene, invalid file, output folder missing, unstable simulation) give
 one line on stderr and a non-zero exit code; ``--debug`` shows the traceback instead.
@@ -166,6 +167,22 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--paused", action="store_true", help="start paused")
     v.add_argument("--springs", action="store_true",
                    help="make every body of the original's springs instead of its material (finite elements)")
+
+    w = sub.add_parser("sweep", help="many runs of one scene with varied parameters, on a Ray cluster",
+                       description="Run every run of a sweep file (TOML: scene, seconds, mode, [parameters]; see "
+                                   "docs/sweeps.md) on Ray and add one row per run to OUTDIR/results.parquet. "
+                                   "Runs already in the table are skipped. Needs the sweep extra: "
+                                   "pip install 'deforma[sweep]'.")
+    w.add_argument("spec", metavar="SPEC.toml", help="the sweep file")
+    w.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="folder for results.parquet and states/")
+    w.add_argument("--workers", type=_positive(int, hi=4096), metavar="N",
+                   help="CPUs of the local Ray cluster (default: every core); ignored with --address")
+    w.add_argument("--address", metavar="ADDR", help="a running Ray cluster: HOST:PORT (from `ray start --head`), "
+                                                     "ray://HOST:PORT or auto")
+    w.add_argument("--states", action="store_true", help="also write each ok run's states to OUTDIR/states/ID.npz")
+    w.add_argument("--retry-failed", action="store_true", help="run again the runs that were unstable or failed")
+    w.add_argument("--force", action="store_true", help="add rows to a table that holds a different sweep's runs")
+    w.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
 
 
@@ -543,6 +560,34 @@ def cmd_scenes(a) -> int:
     return 0
 
 
+# -- sweep --------------------------------------------------------------------------------------------
+def cmd_sweep(a) -> int:
+    from . import sweep as sweeps
+
+    bar = {}
+
+    def progress(done, total, failures):
+        b = bar.get("bar")
+        if b is None:
+            b = bar["bar"] = _progress(total, not a.quiet, Path(a.spec).stem)
+            if b is None:
+                return
+            b.unit = "run"
+        b.n = done
+        b.set_postfix(failures=failures, refresh=False)
+        b.refresh()
+
+    try:
+        r = sweeps.sweep(a.spec, a.output, workers=a.workers, address=a.address, states=a.states,
+                         retry_failed=a.retry_failed, force=a.force, progress=progress)
+    finally:
+        if bar.get("bar") is not None:
+            bar["bar"].close()
+    print(f"{Path(a.spec).name}: {r.total} runs, {r.skipped} already in the table, {r.ran} run now "
+          f"({r.ok} ok, {r.unstable} unstable, {r.error} error) -> {r.table}")
+    return 0
+
+
 # -- view ---------------------------------------------------------------------------------------------
 def cmd_view(a) -> int:
     if a.screenshot and a.frames is None:
@@ -580,7 +625,7 @@ def main(argv=None) -> int:
     parser = _parser()
     a = parser.parse_args(argv)
     a.started = started
-    commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view}
+    commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view, "sweep": cmd_sweep}
     restore_signals = _stop_on_signals()
     try:
         return commands[a.command](a)

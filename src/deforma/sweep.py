@@ -1,0 +1,662 @@
+r"""Parameter sweeps: many runs of one scene with varied parameters, spread over a Ray cluster.
+
+A sweep file (TOML) names a base scene, the simulated seconds and the scene keys to vary::
+
+    scene = "sample"                   # a built-in name, or a .toml path relative to this file
+    seconds = 2.0
+    mode = "grid"                      # every combination; "random": `samples` draws
+    seed = 0                           # random mode only
+
+    [parameters]
+    "physics.stiffness" = [500, 1000, 2000]
+    "body[0].position" = [[0, 2], [1, 2]]
+    # random mode: { min = 0.1, max = 0.9 } draws uniformly (vectors too: min = [0, 2], max = [1, 3])
+
+Every run's scene is the base scene's TOML with the run's values set at their key paths, read
+by the scene loader's own validation (:func:`deforma.scene.parse_scene`) before anything
+runs. Each run gets a stable id, a status (``ok``, ``unstable`` with the hint, ``error`` with
+the message), metrics, and one row in ``OUTDIR/results.parquet``, a folder of Parquet parts
+(one per finished run, written atomically) that pyarrow and pandas read as one table.
+
+``docs/sweeps.md`` describes the table and how to point a sweep at a cluster.
+
+Examples
+--------
+>>> from pathlib import Path
+>>> from deforma.sweep import load_spec, plan
+>>> _ = Path("drop.toml").write_text('scene = "sample"\nseconds = 1.0\n[parameters]\n'
+...                                  '"physics.friction" = [0.1, 0.5]\n"body[0].position" = [[0, 2], [1, 2]]\n')
+>>> runs = plan(load_spec("drop.toml"))
+>>> [(r.parameters["physics.friction"], r.parameters["body[0].position"]) for r in runs]
+[(0.1, [0, 2]), (0.1, [1, 2]), (0.5, [0, 2]), (0.5, [1, 2])]
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import hashlib
+import itertools
+import json
+import math
+import os
+import re
+import socket
+import sys
+import time
+import types
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+__all__ = ["Run", "SweepError", "SweepResult", "SweepSpec", "connect", "load_spec", "plan", "sweep"]
+
+#: The keys a sweep file may have at its top level.
+SPEC_KEYS = ("scene", "seconds", "mode", "samples", "seed", "parameters")
+MODES = ("grid", "random")
+#: Largest number of runs one sweep file may plan (a typo like 1e9 samples must not hang the planner).
+MAX_RUNS = 1_000_000
+#: How long to wait for a TCP answer from ``--address`` before saying it is unreachable (Ray
+#: itself retries an unreachable head for minutes).
+CONNECT_TIMEOUT = 10.0
+RESULTS_NAME = "results.parquet"
+STATES_FOLDER = "states"
+
+_KEY_PATH = re.compile(r"^([A-Za-z_]\w*)(?:\[(\d+)\])?\.([A-Za-z_]\w*)$")
+
+
+class SweepError(ValueError):
+    """A sweep that cannot run as given: one line naming the file, the key path or run, and what is allowed."""
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated sweep file."""
+
+    path: Path
+    scene: str                 # the base scene as written (built-in name or path)
+    scene_file: Path           # the scene file it names
+    scene_data: dict           # the base scene's TOML, as read
+    seconds: float
+    mode: str
+    samples: int | None
+    seed: int
+    parameters: dict           # key path -> list of values, or {"min": ..., "max": ...}
+
+    @property
+    def fingerprint(self) -> str:
+        """What makes two tables comparable: the base scene's content, the seconds and the key paths varied."""
+        text = json.dumps([self.scene_data, self.seconds, sorted(self.parameters)], sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of a sweep: its id and the values it sets."""
+
+    run_id: str
+    index: int
+    parameters: dict
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """What :func:`sweep` did: runs planned, skipped (already in the table), run now, by status."""
+
+    total: int
+    skipped: int
+    ran: int
+    ok: int
+    unstable: int
+    error: int
+    table: Path
+
+
+# -- the sweep file -------------------------------------------------------------------------------
+def _read_toml(path: Path, what: str) -> dict:
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python < 3.11
+        import tomli as tomllib
+    try:
+        return tomllib.loads(path.read_bytes().decode("utf-8"))
+    except OSError as e:
+        raise SweepError(f"{path}: cannot read the {what} ({e.strerror or e})") from None
+    except UnicodeDecodeError:
+        raise SweepError(f"{path}: not a text file (a {what} is TOML in UTF-8)") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SweepError(f"{path}: invalid TOML: {e}") from None
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def load_spec(path) -> SweepSpec:
+    """Read and check a sweep file: its own keys, the base scene, and every key path and value.
+
+    Raises
+    ------
+    SweepError
+        One line: an unknown key or key path (with "did you mean"), an empty parameter list, a
+        bad range, or a value the scene loader refuses (with its key path and the run).
+    """
+    from .scene.assets import scene_path
+
+    path = Path(path)
+    name = path.name
+    data = _read_toml(path, "sweep file")
+    for key in data:
+        if key not in SPEC_KEYS:
+            close = difflib.get_close_matches(key, SPEC_KEYS, n=1)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise SweepError(f"{name}: {key}: unknown key; {hint}allowed: {', '.join(SPEC_KEYS)}")
+    if not isinstance(data.get("scene"), str) or not data["scene"]:
+        raise SweepError(f"{name}: scene: missing; give a built-in scene name or a .toml path relative to "
+                         f"this file")
+    scene = data["scene"]
+    from .scene.assets import builtin_scenes
+
+    ref = scene if scene in builtin_scenes() else str((path.parent / scene))
+    try:
+        scene_file = scene_path(ref)
+    except ValueError as e:
+        raise SweepError(f"{name}: scene: {e}") from None
+    scene_data = _read_toml(scene_file, "scene file")
+
+    seconds = data.get("seconds")
+    if seconds is None:
+        raise SweepError(f"{name}: seconds: missing; give the simulated time of each run in seconds")
+    if not _is_number(seconds) or not (0 < seconds <= 3600) or not math.isfinite(seconds):
+        raise SweepError(f"{name}: seconds: expected a number in (0, 3600], got {seconds!r}")
+    mode = data.get("mode", "grid")
+    if mode not in MODES:
+        raise SweepError(f"{name}: mode: unknown value {mode!r}; allowed: {', '.join(MODES)}")
+    samples = data.get("samples")
+    if mode == "random":
+        if not isinstance(samples, int) or isinstance(samples, bool) or not 1 <= samples <= MAX_RUNS:
+            raise SweepError(f"{name}: samples: random mode needs a whole number of runs in [1, {MAX_RUNS}], "
+                             f"got {samples!r}")
+    elif samples is not None:
+        raise SweepError(f"{name}: samples: only for mode = \"random\" (grid runs every combination)")
+    seed = data.get("seed", 0)
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise SweepError(f"{name}: seed: expected a whole number >= 0, got {seed!r}")
+
+    params = data.get("parameters")
+    if not isinstance(params, dict) or not params:
+        raise SweepError(f"{name}: [parameters]: missing or empty; give at least one scene key path, like "
+                         f"\"physics.stiffness\" = [500, 1000]")
+    for key, values in params.items():
+        where = f'{name}: [parameters] "{key}"'
+        if isinstance(values, dict):
+            if mode != "random":
+                raise SweepError(f"{where}: a range {{ min, max }} needs mode = \"random\"; in grid mode give a "
+                                 f"list of values")
+            if set(values) != {"min", "max"}:
+                raise SweepError(f"{where}: a range has exactly the keys min and max, got {', '.join(values)}")
+            lo, hi = values["min"], values["max"]
+            if _is_number(lo) and _is_number(hi):
+                ok = lo <= hi
+            elif isinstance(lo, list) and isinstance(hi, list) and len(lo) == len(hi) and lo:
+                ok = all(_is_number(a) and _is_number(b) and a <= b for a, b in zip(lo, hi))
+            else:
+                ok = False
+            if not ok:
+                raise SweepError(f"{where}: a range needs numbers (or equally long lists of numbers) with "
+                                 f"min <= max, got min = {lo!r}, max = {hi!r}")
+        elif isinstance(values, list):
+            if not values:
+                raise SweepError(f"{where}: empty list; give at least one value")
+        else:
+            raise SweepError(f"{where}: expected a list of values"
+                             + (" or a range { min, max }" if mode == "random" else "") + f", got {values!r}")
+
+    spec = SweepSpec(path=path, scene=scene, scene_file=Path(scene_file), scene_data=scene_data,
+                     seconds=float(seconds), mode=mode, samples=samples, seed=seed, parameters=params)
+    # each key path with its first value, so a typo is named once, by its key path
+    for key, values in params.items():
+        first = values[0] if isinstance(values, list) else values["min"]
+        scene_for(spec, {key: first}, source=f"{name}: [parameters]")
+    runs = plan(spec)
+    for run in runs:
+        scene_for(spec, run.parameters, source=f"{name}: run {run.index} ({run.run_id})")
+    return spec
+
+
+def _set_key(data: dict, key: str, value, source: str) -> None:
+    """Set ``value`` at the key path ``key`` (``section.key`` or ``array[i].key``) of a scene dict."""
+    from .scene.schema import ARRAYS, SECTIONS
+
+    m = _KEY_PATH.match(key)
+    tables = list(SECTIONS) + [f"{a}[i]" for a in ARRAYS]
+    if not m:
+        raise SweepError(f"{source}: {key}: not a key path; write section.key (like physics.stiffness) or "
+                         f"array[index].key (like body[0].position)")
+    table, index, name = m.group(1), m.group(2), m.group(3)
+    if table in ARRAYS:
+        items = data.get(table)
+        if index is None:
+            raise SweepError(f"{source}: {key}: [[{table}]] is an array of tables; say which one, like {table}[0].{name}")
+        count = len(items) if isinstance(items, list) else 0
+        if int(index) >= count:
+            raise SweepError(f"{source}: {key}: the scene has {count} [[{table}]] table{'s' if count != 1 else ''}"
+                             + (f" (indices 0 to {count - 1})" if count else ""))
+        items[int(index)][name] = value
+    elif table in SECTIONS:
+        if index is not None:
+            raise SweepError(f"{source}: {key}: [{table}] is a table, not an array; write {table}.{name}")
+        data.setdefault(table, {})[name] = value
+    else:
+        close = difflib.get_close_matches(table, list(SECTIONS) + list(ARRAYS), n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise SweepError(f"{source}: {key}: unknown table {table!r}; {hint}allowed: {', '.join(tables)}")
+
+
+def scene_for(spec: SweepSpec, parameters: dict, *, source: str):
+    """The base scene with ``parameters`` set, validated by the scene loader; raises SweepError."""
+    from .scene.schema import parse_scene
+
+    data = copy.deepcopy(spec.scene_data)
+    for key, value in parameters.items():
+        _set_key(data, key, value, source)
+    data.setdefault("run", {})["seconds"] = spec.seconds
+    try:
+        scene = parse_scene(data, source=source, base_dir=spec.scene_file.resolve().parent)
+    except ValueError as e:
+        raise SweepError(str(e)) from None
+    return replace(scene, path=str(spec.scene_file.resolve()))
+
+
+def _plain(value):
+    """A value as JSON would keep it: tuples as lists, integral floats of ints left alone."""
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def run_id(spec: SweepSpec, parameters: dict) -> str:
+    """A run's stable id: a hash of the spec's fingerprint and the run's values."""
+    text = json.dumps([spec.fingerprint, {k: _plain(v) for k, v in sorted(parameters.items())}], sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def plan(spec: SweepSpec) -> list[Run]:
+    """The runs of a sweep, in order: every combination (grid) or ``samples`` draws (random)."""
+    keys = list(spec.parameters)
+    if spec.mode == "grid":
+        count = math.prod(len(spec.parameters[k]) for k in keys)
+        if count > MAX_RUNS:
+            raise SweepError(f"{spec.path.name}: [parameters]: {count} combinations; at most {MAX_RUNS}")
+        combos = [dict(zip(keys, values)) for values in itertools.product(*(spec.parameters[k] for k in keys))]
+    else:
+        import numpy as np
+
+        rng = np.random.default_rng(spec.seed)
+        combos = []
+        for _ in range(spec.samples):
+            combo = {}
+            for k in keys:
+                v = spec.parameters[k]
+                if isinstance(v, dict):
+                    drawn = rng.uniform(v["min"], v["max"])
+                    combo[k] = drawn.tolist() if isinstance(v["min"], list) else float(drawn)
+                else:
+                    combo[k] = v[int(rng.integers(len(v)))]
+            combos.append(combo)
+    runs, seen = [], set()
+    for i, combo in enumerate(combos):
+        rid = run_id(spec, combo)
+        if rid in seen:  # the same values twice (a list with a repeat): one run
+            continue
+        seen.add(rid)
+        runs.append(Run(run_id=rid, index=i, parameters=combo))
+    return runs
+
+
+# -- one run (on a Ray worker) -------------------------------------------------------------------
+def _largest_spring_strain(world) -> float:
+    import numpy as np
+
+    largest = 0.0
+    for b in world.bodies:
+        springs = np.asarray(b.springs)
+        if len(springs) == 0:
+            continue
+        x, rest = b.positions, np.asarray(b.topology.rest_positions)
+        now = np.linalg.norm(x[springs[:, 1]] - x[springs[:, 0]], axis=1)
+        was = np.linalg.norm(rest[springs[:, 1]] - rest[springs[:, 0]], axis=1)
+        ok = was > 0
+        if ok.any():
+            largest = max(largest, float(np.max(np.abs(now[ok] / was[ok] - 1.0))))
+    return largest
+
+
+def simulate(scene, *, states: bool = False) -> dict:
+    """Run one scene for its ``run.seconds``; the row's status, message and metrics (and the states NPZ bytes).
+
+    Never raises for the simulation's sake: an unstable world is ``status = "unstable"`` with its
+    hint, any other exception ``status = "error"`` with its message.
+    """
+    import numpy as np
+
+    from .physics import SimulationUnstable
+    from .scene import Script
+
+    t0 = time.perf_counter()
+    row = {"status": "ok", "message": "", "hint": "", "steps": 0, "simulated_s": 0.0, "final_energy_j": math.nan,
+           "max_spring_strain": math.nan, "centroid": [], "worker": socket.gethostname(), "states": None}
+    world = None
+    try:
+        world = scene.build()
+        fps = scene.run.fps
+        n_frames = max(1, int(round(scene.run.seconds * fps)))
+        script = Script(scene, world)
+        times, frames, poses = [], [], []
+        strain = 0.0
+        for k in range(n_frames + 1):  # frame k at k / fps, the last one at the end of the run
+            script.advance(k / fps)
+            strain = max(strain, _largest_spring_strain(world))
+            if states:
+                times.append(world.time)
+                frames.append([b.positions.copy() for b in world.bodies])
+                poses.append([(*c.center, c.angle) for c in world.colliders])
+        row["max_spring_strain"] = strain
+        row["final_energy_j"] = float(world.energy().total)
+        row["centroid"] = [[float(v) for v in np.mean(b.positions, axis=0)] for b in world.bodies]
+        if states:
+            row["states"] = _states_bytes(world, scene, times, frames, poses)
+    except SimulationUnstable as e:
+        row.update(status="unstable", message=str(e), hint=e.hint)
+    except Exception as e:  # noqa: BLE001 - a run's failure is a row, never the sweep's crash
+        row.update(status="error", message=f"{type(e).__name__}: {e}")
+    if world is not None:
+        row["steps"] = int(world.step_count)
+        row["simulated_s"] = float(world.time)
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def _states_bytes(world, scene, times, frames, poses) -> bytes:
+    """The ``deforma run --states`` NPZ, written by the same function, as bytes (the worker may be
+    on another machine than the sweep's folder)."""
+    import tempfile
+
+    from .cli import _save_states
+
+    with tempfile.TemporaryDirectory(prefix="deforma-sweep-") as folder:
+        path = Path(folder) / "states.npz"
+        _save_states(str(path), world, scene, times, frames, poses)
+        return path.read_bytes()
+
+
+def _worker_run(scene, states: bool) -> dict:
+    # one thread per run: a worker is one of `workers` processes on the node's cores (the runtime
+    # environment sets it too; this covers a cluster started without it)
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+    return simulate(scene, states=states)
+
+
+# -- Ray -------------------------------------------------------------------------------------------
+def _check_reachable(address: str) -> None:
+    """Fail within :data:`CONNECT_TIMEOUT` when nothing listens at ``address`` (Ray would retry for minutes)."""
+    if address == "auto":
+        return
+    hostport = address.split("://", 1)[-1].rstrip("/")
+    host, _, port = hostport.rpartition(":")
+    if not host or not port.isdigit():
+        raise SweepError(f"--address {address}: expected HOST:PORT (what `ray start --head` prints), "
+                         f"ray://HOST:PORT or auto")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=CONNECT_TIMEOUT):
+            pass
+    except OSError as e:
+        raise SweepError(f"cannot reach a Ray cluster at {address} ({e.strerror or e}); start one with "
+                         f"`ray start --head`, or leave out the address for a local cluster") from None
+
+
+def connect(*, workers: int | None = None, address: str | None = None) -> bool:
+    """Start a local Ray cluster (``workers`` CPUs) or connect to ``address``; True if this call did it.
+
+    Nothing happens (False) when Ray is already initialised in this process: that cluster is used.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise SweepError("sweeps need Ray and pyarrow: pip install 'deforma[sweep]'") from None
+    if ray.is_initialized():
+        return False
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise SweepError(f"workers: expected a whole number >= 1, got {workers!r}")
+    if address:
+        _check_reachable(address)
+    import logging
+
+    kwargs = dict(include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR,
+                  runtime_env={"env_vars": {"NUMBA_NUM_THREADS": "1"}})
+    if not address:  # num_cpus is refused when joining an existing cluster: it has its own
+        kwargs["num_cpus"] = workers or os.cpu_count() or 1
+    try:
+        ray.init(address=address or None, **kwargs)
+    except (ConnectionError, RuntimeError, ValueError) as e:
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise SweepError(f"cannot start or join a Ray cluster{f' at {address}' if address else ''}: {first}") from None
+    return True
+
+
+# -- the table -------------------------------------------------------------------------------------
+def _column_type(values):
+    """The Arrow type of a parameter's column, from every value the spec allows for it."""
+    import pyarrow as pa
+
+    if isinstance(values, dict):
+        values = [values["min"], values["max"]]
+        return pa.list_(pa.float64()) if isinstance(values[0], list) else pa.float64()
+    if all(isinstance(v, int) and not isinstance(v, bool) for v in values):
+        return pa.int64()
+    if all(_is_number(v) for v in values):
+        return pa.float64()
+    if all(isinstance(v, bool) for v in values):
+        return pa.bool_()
+    if all(isinstance(v, list) and all(_is_number(x) for x in v) for v in values):
+        return pa.list_(pa.float64())
+    return pa.string()  # anything else (strings, nested tables) as JSON text
+
+
+def _schema(spec: SweepSpec):
+    import pyarrow as pa
+
+    fields = [
+        ("run_id", pa.string()), ("run_index", pa.int64()), ("spec_fingerprint", pa.string()),
+        ("status", pa.string()), ("message", pa.string()), ("hint", pa.string()),
+        ("wall_s", pa.float64()), ("steps", pa.int64()), ("simulated_s", pa.float64()),
+        ("final_energy_j", pa.float64()), ("max_spring_strain", pa.float64()),
+        ("centroid", pa.list_(pa.list_(pa.float64()))), ("states_path", pa.string()), ("worker", pa.string()),
+        ("finished_at", pa.timestamp("s", tz="UTC")), ("parameters", pa.string()),
+    ]
+    fields += [(k, _column_type(v)) for k, v in spec.parameters.items()]
+    return pa.schema(fields)
+
+
+def _row_table(spec: SweepSpec, run: Run, row: dict, states_path: str | None):
+    import datetime
+
+    import pyarrow as pa
+
+    schema = _schema(spec)
+    record = {
+        "run_id": run.run_id, "run_index": run.index, "spec_fingerprint": spec.fingerprint,
+        "status": row["status"], "message": row["message"], "hint": row["hint"], "wall_s": row["wall_s"],
+        "steps": row["steps"], "simulated_s": row["simulated_s"], "final_energy_j": row["final_energy_j"],
+        "max_spring_strain": row["max_spring_strain"], "centroid": row["centroid"], "states_path": states_path,
+        "worker": row["worker"], "finished_at": datetime.datetime.now(datetime.timezone.utc),
+        "parameters": json.dumps(run.parameters, sort_keys=True),
+    }
+    for k, v in run.parameters.items():
+        record[k] = json.dumps(v) if schema.field(k).type == pa.string() else v
+    return pa.Table.from_pylist([record], schema=schema)
+
+
+def read_results(outdir):
+    """The sweep table in ``outdir`` (a pyarrow Table), or None when there is none yet."""
+    import pyarrow.parquet as pq
+
+    folder = Path(outdir) / RESULTS_NAME
+    if not folder.is_dir() or not any(folder.glob("part-*.parquet")):
+        return None
+    # parts written by different specs (--force) may have different parameter columns
+    import pyarrow as pa
+
+    tables = [pq.read_table(p) for p in sorted(folder.glob("part-*.parquet"))]
+    return pa.concat_tables(tables, promote_options="default")
+
+
+def _done(outdir: Path, spec: SweepSpec, *, retry_failed: bool, force: bool) -> dict:
+    """run_id -> status of the runs already in the table; refuses another spec's table unless ``force``."""
+    table = read_results(outdir)
+    if table is None:
+        return {}
+    fingerprints = set(table.column("spec_fingerprint").to_pylist())
+    if fingerprints - {spec.fingerprint} and not force:
+        raise SweepError(f"{outdir / RESULTS_NAME}: holds runs of a different sweep (another base scene, seconds "
+                         f"or parameter keys); use another output folder, or --force to add this sweep's rows "
+                         f"beside them")
+    done = dict(zip(table.column("run_id").to_pylist(), table.column("status").to_pylist()))
+    if retry_failed:
+        done = {k: s for k, s in done.items() if s == "ok"}
+    return done
+
+
+# -- the sweep -------------------------------------------------------------------------------------
+def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None = None, states: bool = False,
+          retry_failed: bool = False, force: bool = False, progress=None) -> SweepResult:
+    r"""Run every run of a sweep file on Ray; one row per run in ``outdir/results.parquet``.
+
+    Parameters
+    ----------
+    spec_path : path
+        The sweep file (TOML; see this module's docstring and ``docs/sweeps.md``).
+    outdir : path
+        Folder for ``results.parquet`` (a folder of one Parquet part per run) and ``states/``;
+        made if missing.
+    workers : int, keyword-only
+        CPUs of the local cluster Ray starts (default: every core); ignored with ``address``.
+    address : str, keyword-only
+        A running Ray cluster (``HOST:PORT`` from ``ray start --head``, ``ray://HOST:PORT`` or
+        ``auto``). An unreachable address fails within about 10 s.
+    states : bool, keyword-only
+        Also write each ok run's ``deforma run --states`` NPZ to ``outdir/states/RUN_ID.npz``.
+    retry_failed : bool, keyword-only
+        Run again the runs whose rows say ``unstable`` or ``error`` (their rows are replaced).
+    force : bool, keyword-only
+        Add rows to a table that holds runs of a different sweep (nothing is deleted).
+    progress : callable, keyword-only
+        ``progress(done, total, failures)`` after each finished run (the CLI's bar).
+
+    Returns
+    -------
+    SweepResult
+        Counts of the runs planned, skipped (already in the table) and run now, by status.
+
+    Raises
+    ------
+    SweepError
+        A bad sweep file (before anything runs), another sweep's table, Ray missing or unreachable.
+
+    Examples
+    --------
+    A sweep starts a local Ray cluster (about 10 s) unless given one::
+
+        import deforma.sweep
+        result = deforma.sweep("examples/friction_sweep.toml", "out", workers=2)
+        print(result.ok, result.unstable, result.error)
+
+    The file is checked before Ray starts, so a typo costs nothing:
+
+    >>> from pathlib import Path
+    >>> import deforma.sweep
+    >>> _ = Path("typo.toml").write_text('scene = "sample"\nseconds = 1.0\n[parameters]\n'
+    ...                                  '"physics.stifness" = [500, 1000]\n')
+    >>> deforma.sweep("typo.toml", "out")
+    Traceback (most recent call last):
+    ...
+    deforma.sweep.SweepError: typo.toml: [parameters]: physics.stifness: unknown key; did you mean 'stiffness'? ...
+    """
+    spec = load_spec(spec_path)
+    runs = plan(spec)
+    outdir = Path(outdir)
+    if outdir.exists() and not outdir.is_dir():
+        raise SweepError(f"{outdir}: exists and is not a folder")
+    done = _done(outdir, spec, retry_failed=retry_failed, force=force)
+    todo = [r for r in runs if r.run_id not in done]
+    counts = {"ok": 0, "unstable": 0, "error": 0}
+    result = lambda: SweepResult(total=len(runs), skipped=len(runs) - len(todo), ran=sum(counts.values()),  # noqa: E731
+                                 table=outdir / RESULTS_NAME, **counts)
+    if progress is not None:
+        progress(len(runs) - len(todo), len(runs), 0)
+    if not todo:
+        return result()
+    try:
+        import pyarrow  # noqa: F401 - checked before the cluster starts
+    except ImportError:
+        raise SweepError("sweeps need Ray and pyarrow: pip install 'deforma[sweep]'") from None
+    (outdir / RESULTS_NAME).mkdir(parents=True, exist_ok=True)
+    if states:
+        (outdir / STATES_FOLDER).mkdir(exist_ok=True)
+    started = connect(workers=workers, address=address)
+    import ray
+
+    from .cli import _write_atomic
+
+    remote = ray.remote(num_cpus=1, max_retries=0)(_worker_run)
+    pending = {}
+    try:
+        for run in todo:
+            scene = scene_for(spec, run.parameters, source=f"{spec.path.name}: run {run.index} ({run.run_id})")
+            pending[remote.remote(scene, states)] = run
+        finished = len(runs) - len(todo)
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1)
+            run = pending.pop(ready[0])
+            try:
+                row = ray.get(ready[0])
+            except Exception as e:  # noqa: BLE001 - a worker that died: the run's error, not the sweep's
+                first = (str(e).strip().splitlines() or [type(e).__name__])[-1]
+                row = {"status": "error", "message": f"{type(e).__name__}: {first}", "hint": "", "steps": 0,
+                       "simulated_s": 0.0, "final_energy_j": math.nan, "max_spring_strain": math.nan,
+                       "centroid": [], "worker": "", "wall_s": math.nan, "states": None}
+            states_path = None
+            if row.get("states") is not None:
+                target = outdir / STATES_FOLDER / f"{run.run_id}.npz"
+                _write_atomic(target, lambda f, data=row["states"]: f.write(data))
+                states_path = f"{STATES_FOLDER}/{run.run_id}.npz"
+            table = _row_table(spec, run, row, states_path)
+            _write_part(outdir / RESULTS_NAME / f"part-{run.run_id}.parquet", table, _write_atomic)
+            counts[row["status"]] += 1
+            finished += 1
+            if progress is not None:
+                progress(finished, len(runs), counts["unstable"] + counts["error"])
+    finally:
+        for ref in pending:  # Ctrl-C or a failure here: what is done stays, the rest is dropped
+            try:
+                ray.cancel(ref, force=True)
+            except Exception:  # noqa: BLE001 - already finished or gone
+                pass
+        if started:
+            ray.shutdown()
+    return result()
+
+
+def _write_part(path: Path, table, write_atomic) -> None:
+    import pyarrow.parquet as pq
+
+    write_atomic(path, lambda f: pq.write_table(table, f))
+
+
+# ``import deforma.sweep; deforma.sweep(spec, outdir)``: the module is callable as the function
+class _CallableModule(types.ModuleType):
+    def __call__(self, *args, **kwargs):
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

@@ -1,0 +1,201 @@
+"""deforma sweep: six short runs of a tiny scene on one local Ray cluster shared by the module.
+
+Ray's start-up (about 10 s here) dominates, so every test uses the same cluster (2 CPUs).
+"""
+
+import socket
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("ray")
+pytest.importorskip("pyarrow")
+
+import deforma.sweep as sweeps  # noqa: E402
+from deforma.cli import main  # noqa: E402
+
+TINY_SCENE = """
+[run]
+seconds = 0.3
+fps = 10
+
+[physics]
+dt = 0.002
+integrator = "symplectic-euler"
+material = "springs"
+stiffness = 1000.0
+damping = 1.0
+mass = 1.0
+
+[[body]]
+shape = "box"
+corners = [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]]
+detail = 2
+position = [0.0, 1.0]
+
+[[collider]]
+center = [0.0, 0.0]
+size = [6.0, 0.4]
+"""
+
+# 3 stiffnesses x 2 positions; 1e9 N/m with symplectic Euler at dt = 2 ms blows up
+SWEEP = """
+scene = "tiny.toml"
+seconds = 0.3
+
+[parameters]
+"physics.stiffness" = [500, 1000, 1e9]
+"body[0].position" = [[0, 1], [1, 1]]
+"""
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    import ray
+
+    started = sweeps.connect(workers=2)
+    yield
+    if started:
+        ray.shutdown()
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    d = tmp_path_factory.mktemp("sweep")
+    (d / "tiny.toml").write_text(TINY_SCENE)
+    return d
+
+
+def _spec(folder, name, text):
+    p = folder / name
+    p.write_text(text)
+    return p
+
+
+def _rows(outdir):
+    return sweeps.read_results(outdir).to_pylist()
+
+
+@pytest.fixture(scope="module")
+def done(cluster, folder):
+    """The six runs, with states, swept once for the tests that read the table."""
+    spec = _spec(folder, "sweep.toml", SWEEP)
+    out = folder / "out"
+    result = sweeps.sweep(spec, out, states=True)
+    return spec, out, result
+
+
+def test_one_row_per_run_unstable_marked_with_hint(done):
+    spec, out, result = done
+    assert (result.total, result.ran, result.ok, result.unstable, result.error) == (6, 6, 4, 2, 0)
+    rows = _rows(out)
+    assert len(rows) == 6 and len({r["run_id"] for r in rows}) == 6
+    for r in rows:
+        if r["physics.stiffness"] == 1e9:
+            assert r["status"] == "unstable"
+            assert "dt" in r["hint"] and r["states_path"] is None
+        else:
+            assert r["status"] == "ok", r["message"]
+            assert r["steps"] == 150 and r["simulated_s"] == pytest.approx(0.3)
+            assert np.isfinite(r["final_energy_j"]) and 0 <= r["max_spring_strain"] < 1
+            # the box starts at the x of its position and falls onto the ground
+            (cx, cy), = r["centroid"]
+            assert cx == pytest.approx(r["body[0].position"][0], abs=0.05) and cy < 1.0
+
+
+def test_states_reload(done):
+    spec, out, _ = done
+    for r in _rows(out):
+        if r["status"] == "ok":
+            with np.load(out / r["states_path"]) as z:
+                positions = z["body0_positions"]
+                assert positions.shape[0] == 4 and np.isfinite(positions).all()  # frames at 0, 0.1, 0.2, 0.3 s
+                assert "physics.stiffness" not in str(z["scene_toml"])
+                assert f"stiffness = {r['physics.stiffness']}" in str(z["scene_toml"])
+
+
+def test_second_invocation_runs_nothing(done):
+    spec, out, _ = done
+    t0 = time.perf_counter()
+    again = sweeps.sweep(spec, out)
+    assert (again.total, again.skipped, again.ran) == (6, 6, 0)
+    assert len(_rows(out)) == 6
+    assert time.perf_counter() - t0 < 5
+
+
+def test_retry_failed_replaces_the_failed_rows(done):
+    spec, out, _ = done
+    again = sweeps.sweep(spec, out, retry_failed=True)
+    assert (again.ran, again.unstable) == (2, 2)
+    rows = _rows(out)
+    assert len(rows) == 6 and sorted(r["status"] for r in rows).count("unstable") == 2
+
+
+def test_a_sweep_cut_short_completes_without_duplicates(cluster, folder):
+    spec = _spec(folder, "cut.toml", SWEEP)
+    out = folder / "cut"
+    sweeps.sweep(spec, out)
+    parts = sorted((out / "results.parquet").glob("part-*.parquet"))
+    for p in parts[:3]:  # as if the sweep had been killed with three runs in flight
+        p.unlink()
+    (out / "results.parquet" / ".part-x.123.partial.parquet").write_bytes(b"half a file")
+    again = sweeps.sweep(spec, out)
+    assert (again.skipped, again.ran) == (3, 3)
+    rows = _rows(out)
+    assert len(rows) == 6 and len({r["run_id"] for r in rows}) == 6
+
+
+def test_other_spec_refused_unless_force(done, folder):
+    _, out, _ = done
+    other = _spec(folder, "other.toml", SWEEP.replace("seconds = 0.3", "seconds = 0.2"))
+    with pytest.raises(sweeps.SweepError, match="different sweep.*--force"):
+        sweeps.sweep(other, out)
+    assert len(_rows(out)) == 6  # nothing lost
+
+
+@pytest.mark.parametrize("parameters, message", [
+    ('"physics.stifness" = [1, 2]', r"physics\.stifness: unknown key; did you mean 'stiffness'"),
+    ('"phyiscs.stiffness" = [1, 2]', r"phyiscs\.stiffness: unknown table 'phyiscs'; did you mean 'physics'"),
+    ('"body[3].position" = [[0, 1]]', r"the scene has 1 \[\[body\]\] table"),
+    ('"physics.stiffness" = []', r'"physics.stiffness": empty list'),
+    ('"physics.stiffness" = [100, -5]', r"run 1 \(\w+\): physics\.stiffness: .*-5"),
+    ('"physics.stiffness" = { min = 1, max = 2 }', r"range .* needs mode = \"random\""),
+])
+def test_bad_parameters_named_before_anything_runs(folder, parameters, message):
+    spec = _spec(folder, "bad.toml", f'scene = "tiny.toml"\nseconds = 0.3\n[parameters]\n{parameters}\n')
+    with pytest.raises(sweeps.SweepError, match=message) as e:
+        sweeps.sweep(spec, folder / "never")
+    assert "\n" not in str(e.value)
+    assert not (folder / "never").exists()
+
+
+def test_random_mode_is_reproducible(folder):
+    text = ('scene = "tiny.toml"\nseconds = 0.3\nmode = "random"\nsamples = 5\nseed = 7\n[parameters]\n'
+            '"physics.friction" = { min = 0.1, max = 0.9 }\n"body[0].position" = { min = [-1, 1], max = [1, 2] }\n'
+            '"physics.stiffness" = [500, 1000]\n')
+    spec = sweeps.load_spec(_spec(folder, "random.toml", text))
+    runs = sweeps.plan(spec)
+    assert [r.parameters for r in runs] == [r.parameters for r in sweeps.plan(spec)]
+    assert len(runs) == 5 and all(0.1 <= r.parameters["physics.friction"] <= 0.9 for r in runs)
+    assert all(r.parameters["physics.stiffness"] in (500, 1000) for r in runs)
+
+
+def test_unreachable_address_fails_fast():
+    with socket.socket() as s:  # a port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    t0 = time.perf_counter()
+    with pytest.raises(sweeps.SweepError, match=f"cannot reach a Ray cluster at 127.0.0.1:{port}"):
+        sweeps._check_reachable(f"127.0.0.1:{port}")
+    assert time.perf_counter() - t0 < 30
+
+
+def test_cli(done, folder, capsys):
+    spec, out, _ = done
+    assert main(["sweep", str(spec), "-o", str(out), "--quiet"]) == 0
+    assert "6 runs, 6 already in the table, 0 run now" in capsys.readouterr().out
+    bad = _spec(folder, "bad_cli.toml", 'scene = "tiny.toml"\nseconds = 0.3\n[parameters]\n"physics.stifness" = [1]\n')
+    assert main(["sweep", str(bad), "-o", str(folder / "never")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("deforma: error: ") and "did you mean 'stiffness'" in err and err.count("\n") == 1
