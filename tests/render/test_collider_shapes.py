@@ -75,7 +75,7 @@ def every_shape():
         deforma.Polygon(CUP * 2 + (2.8, 1.0)),
         deforma.Polygon([(-3.8, -1.8), (-1.8, -1.8), (-1.8, 0.2), (-3.8, 0.2)],
                         holes=[[(-3.3, -1.3), (-2.3, -1.3), (-2.3, -0.3), (-3.3, -0.3)]]),
-        deforma.Segment((0.0, -1.0), (2.0, -0.5), 0.2),
+        deforma.Segment((0.0, -1.0), (2.0, -0.5), radius=0.2),
         deforma.Segment((0.0, -1.7), (3.0, -1.5)),     # a wire
     ]
 
@@ -131,7 +131,7 @@ def test_a_moving_collider_is_drawn_at_its_new_pose(renderer):
     # a body far out of view: a world without bodies does not step its colliders (yet)
     world.add_body(deforma.mesh.box(((0, 0), (0.2, 0), (0.2, 0.2), (0, 0.2)), detail=0), position=(0, 50))
     slab = world.add_collider(deforma.Rect((-2.5, 0.0), (1.0, 0.4), velocity=(4.0, 0.0)))
-    arm = world.add_collider(deforma.Segment((1.5, 0.0), (3.5, 0.0), 0.1, angular_velocity=180.0))
+    arm = world.add_collider(deforma.Segment((1.5, 0.0), (3.5, 0.0), radius=0.1, angular_velocity=180.0))
     uploads = []
     original = renderer._upload_colliders
     renderer._upload_colliders = lambda *a: (uploads.append(1), original(*a))

@@ -434,7 +434,7 @@ class Segment(Collider):
 
     kind = SEGMENT
 
-    def __init__(self, a, b, radius=0.0, *, friction=None, static_friction=None, velocity=(0.0, 0.0),
+    def __init__(self, a, b, *, radius=0.0, friction=None, static_friction=None, velocity=(0.0, 0.0),
                  angular_velocity=0.0):
         pa, pb = np.array(_pair(a, "a")), np.array(_pair(b, "b"))
         d = pb - pa

@@ -556,7 +556,7 @@ class World:
         >>> w = deforma.World()
         >>> w.add_collider(deforma.Rect((0, 0), (10, 0.5), 15.0)).angle
         15.0
-        >>> paddle = w.add_collider(deforma.Segment((-1, 2), (1, 2), 0.05, angular_velocity=90.0))
+        >>> paddle = w.add_collider(deforma.Segment((-1, 2), (1, 2), radius=0.05, angular_velocity=90.0))
         >>> len(w.colliders)
         2
         """

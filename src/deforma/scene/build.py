@@ -250,7 +250,7 @@ def make_colliders(spec) -> list:
     if isinstance(spec, CircleCollider):
         return [Circle(spec.center, spec.radius, **common, **motion)]
     if isinstance(spec, SegmentCollider):
-        return [Segment(spec.a, spec.b, spec.radius, **common, **motion)]
+        return [Segment(spec.a, spec.b, radius=spec.radius, **common, **motion)]
     if isinstance(spec, PolygonCollider):
         p = Polygon(spec.points, holes=spec.holes, **common, **motion)
         p.angle = spec.angle  # about its centroid, the point it was built around

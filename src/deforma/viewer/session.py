@@ -645,7 +645,7 @@ class Session:
         elif shape == "polygon":
             c = Polygon(np.asarray(CUP) + (cx, cy))
         else:
-            c = Segment((cx - 1.0, cy), (cx + 1.0, cy), 0.05 if radius is None else radius)
+            c = Segment((cx - 1.0, cy), (cx + 1.0, cy), radius=0.05 if radius is None else radius)
         if shape != "rect" and angle:
             c.angle = c.angle + angle
         if shape == "polygon":
