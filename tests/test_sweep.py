@@ -199,3 +199,64 @@ def test_cli(done, folder, capsys):
     assert main(["sweep", str(bad), "-o", str(folder / "never")]) == 1
     err = capsys.readouterr().err
     assert err.startswith("deforma: error: ") and "did you mean 'stiffness'" in err and err.count("\n") == 1
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_sweep_on_a_cluster_started_with_ray_start(folder):
+    """`ray start --head` on a free port, then `deforma sweep --address` in its own process
+    (this process already holds the module's local cluster)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    port = _free_port()
+    ray_exe = Path(sys.executable).with_name("ray")
+    head = subprocess.Popen([str(ray_exe), "start", "--head", f"--port={port}", "--node-ip-address=127.0.0.1",
+                             "--num-cpus=2", "--include-dashboard=false", "--disable-usage-stats", "--block"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.perf_counter() + 30
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=1).close()
+                break
+            except OSError:
+                assert time.perf_counter() < deadline, "ray start --head did not listen within 30 s"
+                assert head.poll() is None, "ray start --head exited"
+                time.sleep(0.2)
+        env = dict(os.environ)
+        if (Path.home() / ".ray" / "auth_token").exists():  # Ray >= 2.59 turns on token auth for `ray start`
+            env.setdefault("RAY_AUTH_MODE", "token")
+        spec = _spec(folder, "remote.toml", SWEEP)
+        out = folder / "remote"
+        r = subprocess.run([sys.executable, "-m", "deforma.cli", "sweep", str(spec), "-o", str(out), "--address",
+                            f"127.0.0.1:{port}", "--states"], capture_output=True, text=True, env=env, timeout=180)
+        assert r.returncode == 0, r.stderr
+        assert "6 runs, 0 already in the table, 6 run now (4 ok, 2 unstable, 0 error)" in r.stdout
+        rows = _rows(out)
+        assert len(rows) == 6
+        assert all(r["status"] == ("unstable" if r["physics.stiffness"] == 1e9 else "ok") for r in rows)
+        for row in rows:
+            if row["status"] == "ok":
+                with np.load(out / row["states_path"]) as z:
+                    assert np.isfinite(z["body0_positions"]).all()
+    finally:
+        # the head and everything it started are in the session this test made: end that group
+        # (a graceful stop waits on a drain that can time out, so the group is killed after 3 s)
+        try:
+            os.killpg(head.pid, signal.SIGTERM)
+            try:
+                head.wait(timeout=3)
+            except subprocess.TimeoutExpired:
+                pass
+            os.killpg(head.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        head.wait(timeout=10)

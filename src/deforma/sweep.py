@@ -426,6 +426,7 @@ def connect(*, workers: int | None = None, address: str | None = None) -> bool:
         raise SweepError("sweeps need Ray and pyarrow: pip install 'deforma[sweep]'") from None
     if ray.is_initialized():
         return False
+    address = address or os.environ.get("RAY_ADDRESS") or None
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise SweepError(f"workers: expected a whole number >= 1, got {workers!r}")
     if address:
@@ -437,10 +438,15 @@ def connect(*, workers: int | None = None, address: str | None = None) -> bool:
     if not address:  # num_cpus is refused when joining an existing cluster: it has its own
         kwargs["num_cpus"] = workers or os.cpu_count() or 1
     try:
-        ray.init(address=address or None, **kwargs)
+        # "local": a new cluster of `workers` CPUs; None would join the last `ray start` cluster
+        # of this machine, if any (Ray's auto-detection), and then refuse num_cpus
+        ray.init(address=address or "local", **kwargs)
     except (ConnectionError, RuntimeError, ValueError) as e:
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise SweepError(f"cannot start or join a Ray cluster{f' at {address}' if address else ''}: {first}") from None
+        hint = ("; a cluster with token authentication (Ray >= 2.59 turns it on for `ray start`) also needs "
+                "RAY_AUTH_MODE=token and its token here (RAY_AUTH_TOKEN or ~/.ray/auth_token)") if address else ""
+        raise SweepError(f"cannot start or join a Ray cluster{f' at {address}' if address else ''}: {first}"
+                         f"{hint}") from None
     return True
 
 
