@@ -84,20 +84,28 @@ def crossings(world, *, exact=False):
 
 
 @njit(cache=True)
-def _inside_counts(x, seg, seg_body, vertex_body, box):
-    """For every vertex, whether it lies inside (even-odd over its outline) any other body."""
+def _inside_counts(x, seg, seg_start, vertex_body, nb):
+    """For every vertex, whether it lies inside (even-odd over its outline) any other body.
+
+    ``seg`` is grouped by body: body b's outline is ``seg[seg_start[b]:seg_start[b + 1]]``."""
     n = x.shape[0]
+    box = np.empty((nb, 4))
+    box[:, :2] = np.inf
+    box[:, 2:] = -np.inf
+    for i in range(n):
+        b = vertex_body[i]
+        box[b, 0] = min(box[b, 0], x[i, 0])
+        box[b, 1] = min(box[b, 1], x[i, 1])
+        box[b, 2] = max(box[b, 2], x[i, 0])
+        box[b, 3] = max(box[b, 3], x[i, 1])
     inside = np.zeros(n, np.int64)
-    nb = box.shape[0]
     for i in range(n):
         px, py = x[i, 0], x[i, 1]
         for b in range(nb):
             if b == vertex_body[i] or px < box[b, 0] or px > box[b, 2] or py < box[b, 1] or py > box[b, 3]:
                 continue
             odd = False
-            for s in range(seg.shape[0]):
-                if seg_body[s] != b:
-                    continue
+            for s in range(seg_start[b], seg_start[b + 1]):
                 ax, ay = x[seg[s, 0], 0], x[seg[s, 0], 1]
                 bx, by = x[seg[s, 1], 0], x[seg[s, 1], 1]
                 if (ay > py) != (by > py):
@@ -112,10 +120,11 @@ def vertices_inside_other_bodies(world):
     """Indices of vertices (any vertex, not only outline ones) inside another body's outline."""
     seg, owner = outline_segments(world)
     x = world._state.x
-    vb = np.zeros(len(x), np.int64)
-    box = np.full((len(world.bodies), 4), np.nan)
+    nb = len(world.bodies)
+    vb = np.full(len(x), -1, np.int64)
     for b in world.bodies:
         vb[b.vertex_slice] = b.index
-        p = b.positions
-        box[b.index] = (*p.min(axis=0), *p.max(axis=0))
-    return np.flatnonzero(_inside_counts(x, seg, owner, vb, box))
+    assert (vb >= 0).all() and (vb < nb).all()
+    order = np.argsort(owner, kind="stable")  # already grouped by body; made sure of here
+    seg_start = np.searchsorted(owner[order], np.arange(nb + 1))
+    return np.flatnonzero(_inside_counts(x, seg[order], seg_start, vb, nb))
