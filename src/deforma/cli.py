@@ -567,19 +567,27 @@ def cmd_sweep(a) -> int:
     bar = {}
 
     def progress(done, total, failures):
+        bar["done"] = done
         b = bar.get("bar")
         if b is None:
             b = bar["bar"] = _progress(total, not a.quiet, Path(a.spec).stem)
             if b is None:
                 return
             b.unit = "run"
-        b.n = done
+            b.n = b.last_print_n = done  # runs already in the table: not part of the rate
         b.set_postfix(failures=failures, refresh=False)
-        b.refresh()
+        b.update(done - b.n)
 
     try:
         r = sweeps.sweep(a.spec, a.output, workers=a.workers, address=a.address, states=a.states,
                          retry_failed=a.retry_failed, force=a.force, progress=progress)
+    except KeyboardInterrupt:
+        if a.debug:
+            raise
+        # not main()'s "no partial output": every finished run is in the table, on purpose
+        print(f"deforma: interrupted; {bar.get('done', 0)} finished runs are in {Path(a.output) / 'results.parquet'}"
+              f" (the same command carries on)", file=sys.stderr)
+        return EXIT_INTERRUPTED
     finally:
         if bar.get("bar") is not None:
             bar["bar"].close()
