@@ -304,15 +304,26 @@ def test_view_runs_at_the_smallest_window_with_an_unstable_scene(tmp_path):
 
     unstable = "[physics]\ndt = 0.02\nstiffness = 50000.0\n[[body]]\ndetail = 4\nposition = [0.0, 1.0]\n" \
                "[[collider]]\ncenter = [0.0, 0.0]\nsize = [5.0, 0.5]\n"
-    (tmp_path / "boom.toml").write_text(unstable)
     w, h = MIN_WINDOW_SIZE
     env = dict(os.environ, SDL_VIDEODRIVER="offscreen")
-    for scene in ("sample", "boom.toml"):
-        r = subprocess.run([sys.executable, "-m", "deforma.cli", "view", scene, "--frames", "30", "--size", f"{w}x{h}",
-                            "--screenshot", "s.png"], capture_output=True, text=True, env=env, timeout=120,
-                           cwd=tmp_path)
-        assert r.returncode == 0, r.stderr
-        assert Image.open(tmp_path / "s.png").size == (w, h)
+    runs = {}
+    for scene in ("sample", "boom.toml"):  # the two viewers at once, each in a folder of its own
+        cwd = tmp_path / scene.replace(".", "_")
+        cwd.mkdir()
+        (cwd / "boom.toml").write_text(unstable)
+        runs[cwd] = subprocess.Popen([sys.executable, "-m", "deforma.cli", "view", scene, "--frames", "30", "--size",
+                                      f"{w}x{h}", "--screenshot", "s.png"], stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True, env=env, cwd=cwd)
+    try:
+        for cwd, p in runs.items():
+            _, err = p.communicate(timeout=120)
+            assert p.returncode == 0, err
+            assert Image.open(cwd / "s.png").size == (w, h)
+    finally:
+        for p in runs.values():
+            if p.poll() is None:
+                p.kill()
+                p.wait()
 
 
 def test_deeply_nested_toml_names_the_file(tmp_path, capsys):
