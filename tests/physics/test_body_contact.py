@@ -218,6 +218,13 @@ def test_pile_scene_never_crosses_and_no_vertex_enters_another_body():
         assert len(inside) == 0, (k, inside[:5].tolist())
         if k % 200 == 0:  # exact orientation signs at sampled steps
             assert crossings(w, exact=True)[1] == 0, k
+        if k % 20 == 0 or k == steps - 1:  # tests/scene/test_builtin_scenes.py's check, for the pile
+            for b in w.bodies:
+                x = b.positions
+                assert np.isfinite(x).all() and np.isfinite(b.velocities).all()
+                for c in w.colliders:
+                    inside = c.contains(x)
+                    assert not inside.any(), (k, c, x[inside][:3])
     heights = [b.center_of_mass[1] for b in w.bodies]
     assert max(heights) < 2.5  # poured in and settled into a heap, not stuck in the air
     assert max(np.abs(b.velocities).max() for b in w.bodies) < 0.05
