@@ -214,6 +214,7 @@ def test_sweep_on_a_cluster_started_with_ray_start(folder):
     import signal
     import subprocess
     import sys
+    import tempfile
     from pathlib import Path
 
     port = _free_port()
@@ -260,3 +261,7 @@ def test_sweep_on_a_cluster_started_with_ray_start(folder):
         except ProcessLookupError:
             pass
         head.wait(timeout=10)
+        # what `ray stop` would do: forget the killed head, so a later bare ray.init() does not try it
+        current = Path(tempfile.gettempdir()) / "ray" / "ray_current_cluster"
+        if current.exists() and current.read_text().strip().endswith(f":{port}"):
+            current.unlink()

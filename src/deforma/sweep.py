@@ -47,7 +47,6 @@ import time
 import types
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 __all__ = ["Run", "SweepError", "SweepResult", "SweepSpec", "connect", "load_spec", "plan", "sweep"]
 
