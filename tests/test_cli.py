@@ -10,6 +10,7 @@ from PIL import Image
 
 from deforma import scene as scenes
 from deforma.cli import EXIT_ERROR, EXIT_INTERRUPTED, EXIT_UNSTABLE, main
+from signal_runs import kill_leftovers, signal_when_under_way
 
 SMALL = ["--size", "96x64", "--quiet"]
 
@@ -236,29 +237,32 @@ def test_the_installed_command_prints_one_line_and_no_traceback(tmp_path):
     assert r.returncode != 0 and "Traceback" in r.stderr
 
 
-@pytest.mark.parametrize("name", ["out.mp4", "out.gif"])
-def test_ctrl_c_on_a_real_run_leaves_no_file(tmp_path, name):
+def test_ctrl_c_on_a_real_run_leaves_no_file(tmp_path):
     import signal
-    import time
 
-    exe = os.path.join(os.path.dirname(sys.executable), "deforma")
-    # a new session, so the signal goes to the whole group as Ctrl-C does (ffmpeg included)
-    p = subprocess.Popen([exe, "run", "sample", "--seconds", "120", "--size", "64x48", "-o", name,
-                          "--states", "s.npz", "--quiet"], cwd=tmp_path, stderr=subprocess.PIPE, text=True,
-                         start_new_session=True)
-    deadline = time.time() + 60
-    # wait until the run is under way: the writer's temporary file exists
-    while time.time() < deadline and not any(".partial" in f for f in os.listdir(tmp_path)):
-        time.sleep(0.05)
-    time.sleep(0.5)
-    os.killpg(p.pid, signal.SIGINT)
-    _, err = p.communicate(timeout=60)
-    assert p.returncode == EXIT_INTERRUPTED, err
-    # on a cold Numba cache (a fresh checkout, a changed kernel) the run first says it compiles
     from deforma.startup import COMPILE_MESSAGE
 
-    assert err.replace(COMPILE_MESSAGE + "\n", "", 1) == "deforma: interrupted; no partial output was left\n"
-    assert os.listdir(tmp_path) == []
+    exe = os.path.join(os.path.dirname(sys.executable), "deforma")
+    # an MP4 and a GIF run at once, each in a folder of its own and signalled on its own clock
+    # once under way (tests/signal_runs.py); a new session each, so the signal goes to the whole
+    # group as Ctrl-C does (ffmpeg included)
+    runs = []
+    for name in ("out.mp4", "out.gif"):
+        cwd = tmp_path / name.replace(".", "_")
+        cwd.mkdir()
+        runs.append((name, cwd, subprocess.Popen([exe, "run", "sample", "--seconds", "120", "--size", "64x48", "-o",
+                                                  name, "--states", "s.npz", "--quiet"], cwd=cwd,
+                                                 stderr=subprocess.PIPE, text=True, start_new_session=True)))
+    try:
+        signal_when_under_way([(cwd, p) for _, cwd, p in runs], lambda p: os.killpg(p.pid, signal.SIGINT))
+        for name, cwd, p in runs:
+            _, err = p.communicate(timeout=60)
+            assert p.returncode == EXIT_INTERRUPTED, (name, err)
+            # on a cold Numba cache (a fresh checkout, a changed kernel) the run first says it compiles
+            assert err.replace(COMPILE_MESSAGE + "\n", "", 1) == "deforma: interrupted; no partial output was left\n"
+            assert os.listdir(cwd) == [], name
+    finally:
+        kill_leftovers([p for _, _, p in runs])
 
 
 def test_mesh_picture_of_a_builtin_texture(tmp_path, capsys):

@@ -9,6 +9,7 @@ import pytest
 from PIL import Image
 
 from deforma.cli import EXIT_ERROR, MESH_PICTURE_MAX_SIDE, main
+from signal_runs import kill_leftovers, signal_when_under_way
 
 
 def run(capsys, *args):
@@ -110,34 +111,33 @@ def _dead_pid():
     return p.pid
 
 
-@pytest.mark.parametrize("signame, output", [("SIGTERM", "big.mp4"), ("SIGHUP", "big.mp4"), ("SIGTERM", "frames/")])
-def test_sigterm_and_sighup_clean_up_like_ctrl_c(tmp_path, signame, output):
+def test_sigterm_and_sighup_clean_up_like_ctrl_c(tmp_path):
+    # three runs at once (SIGTERM and SIGHUP into an MP4, SIGTERM into a PNG folder), each in a
+    # folder of its own and signalled on its own clock (tests/signal_runs.py)
     import os
     import signal
     import subprocess
-    import time
 
     from deforma.startup import COMPILE_MESSAGE
 
-    signum = getattr(signal, signame)
-    p = subprocess.Popen([_exe(), "run", "sample", "--seconds", "120", "--size", "64x48", "-o", output, "--quiet"],
-                         cwd=tmp_path, stderr=subprocess.PIPE, text=True, start_new_session=True)
-
-    def partials():
-        found = []
-        for root, dirs, files in os.walk(tmp_path):
-            found += [f for f in dirs + files if ".partial" in f]
-        return found
-
-    deadline = time.time() + 60
-    while time.time() < deadline and not partials():
-        time.sleep(0.05)
-    time.sleep(0.5)
-    os.kill(p.pid, signum)  # the process alone (a service manager's stop, a closed terminal's hang-up)
-    _, err = p.communicate(timeout=30)
-    assert p.returncode == 128 + signum, err
-    assert err.replace(COMPILE_MESSAGE + "\n", "", 1) == f"deforma: stopped by {signame}; no partial output was left\n"
-    assert os.listdir(tmp_path) == []
+    runs = []
+    for k, (signame, output) in enumerate([("SIGTERM", "big.mp4"), ("SIGHUP", "big.mp4"), ("SIGTERM", "frames/")]):
+        cwd = tmp_path / f"{k}-{signame}"
+        cwd.mkdir()
+        p = subprocess.Popen([_exe(), "run", "sample", "--seconds", "120", "--size", "64x48", "-o", output, "--quiet"],
+                             cwd=cwd, stderr=subprocess.PIPE, text=True, start_new_session=True)
+        runs.append((signame, cwd, p))
+    names = {p: signame for signame, _, p in runs}
+    try:
+        # the process alone (a service manager's stop, a closed terminal's hang-up)
+        signal_when_under_way([(cwd, p) for _, cwd, p in runs], lambda p: os.kill(p.pid, getattr(signal, names[p])))
+        for signame, cwd, p in runs:
+            _, err = p.communicate(timeout=30)
+            assert p.returncode == 128 + getattr(signal, signame), (signame, err)
+            assert err.replace(COMPILE_MESSAGE + "\n", "", 1) == f"deforma: stopped by {signame}; no partial output was left\n"
+            assert os.listdir(cwd) == [], signame
+    finally:
+        kill_leftovers([p for _, _, p in runs])
 
 
 def test_ctrl_c_in_a_png_folder_run_leaves_no_frames(tmp_path, capsys, monkeypatch):
@@ -320,10 +320,7 @@ def test_view_runs_at_the_smallest_window_with_an_unstable_scene(tmp_path):
             assert p.returncode == 0, err
             assert Image.open(cwd / "s.png").size == (w, h)
     finally:
-        for p in runs.values():
-            if p.poll() is None:
-                p.kill()
-                p.wait()
+        kill_leftovers(runs.values())
 
 
 def test_deeply_nested_toml_names_the_file(tmp_path, capsys):
