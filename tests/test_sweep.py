@@ -12,7 +12,7 @@ import pytest
 pytest.importorskip("ray")
 pytest.importorskip("pyarrow")
 
-import deforma.sweep as sweeps  # noqa: E402
+import deforma.sweeps as sweeps  # noqa: E402
 from deforma.cli import main  # noqa: E402
 
 TINY_SCENE = """

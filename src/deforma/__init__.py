@@ -23,7 +23,7 @@ from .physics import (Circle, Material, Polygon, Rect, Segment, SimulationUnstab
 from .scene import load_scene, save_scene  # noqa: E402
 
 __all__ = ["Circle", "Material", "Polygon", "Rect", "Segment", "SimulationUnstable", "World", "colliders_from_image",
-           "delaunay", "load_scene", "mesh", "save_scene", "show"]
+           "delaunay", "load_scene", "mesh", "save_scene", "show", "sweep"]
 __version__ = "0.1.0"
 
 
@@ -35,8 +35,13 @@ def __getattr__(name):
 
         globals()["show"] = show  # found directly from now on
         return show
+    if name == "sweep":  # the sweeps module needs no Ray to import; running a sweep does
+        from .sweeps import sweep
+
+        globals()["sweep"] = sweep
+        return sweep
     raise AttributeError(f"module 'deforma' has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(set(globals()) | {"show"})
+    return sorted(set(globals()) | {"show", "sweep"})

@@ -562,7 +562,7 @@ def cmd_scenes(a) -> int:
 
 # -- sweep --------------------------------------------------------------------------------------------
 def cmd_sweep(a) -> int:
-    from . import sweep as sweeps
+    from . import sweeps
 
     bar = {}
 

@@ -23,7 +23,7 @@ the message), metrics, and one row in ``OUTDIR/results.parquet``, a folder of Pa
 Examples
 --------
 >>> from pathlib import Path
->>> from deforma.sweep import load_spec, plan
+>>> from deforma.sweeps import load_spec, plan
 >>> _ = Path("drop.toml").write_text('scene = "sample"\nseconds = 1.0\n[parameters]\n'
 ...                                  '"physics.friction" = [0.1, 0.5]\n"body[0].position" = [[0, 2], [1, 2]]\n')
 >>> runs = plan(load_spec("drop.toml"))
@@ -42,9 +42,7 @@ import math
 import os
 import re
 import socket
-import sys
 import time
-import types
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -572,20 +570,20 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     --------
     A sweep starts a local Ray cluster (about 10 s) unless given one::
 
-        import deforma.sweep
+        import deforma
         result = deforma.sweep("examples/friction_sweep.toml", "out", workers=2)
         print(result.ok, result.unstable, result.error)
 
     The file is checked before Ray starts, so a typo costs nothing:
 
     >>> from pathlib import Path
-    >>> import deforma.sweep
+    >>> import deforma
     >>> _ = Path("typo.toml").write_text('scene = "sample"\nseconds = 1.0\n[parameters]\n'
     ...                                  '"physics.stifness" = [500, 1000]\n')
     >>> deforma.sweep("typo.toml", "out")
     Traceback (most recent call last):
     ...
-    deforma.sweep.SweepError: typo.toml: [parameters]: physics.stifness: unknown key; did you mean 'stiffness'? ...
+    deforma.sweeps.SweepError: typo.toml: [parameters]: physics.stifness: unknown key; did you mean 'stiffness'? ...
     """
     spec = load_spec(spec_path)
     runs = plan(spec)
@@ -657,11 +655,3 @@ def _write_part(path: Path, table, write_atomic) -> None:
 
     write_atomic(path, lambda f: pq.write_table(table, f))
 
-
-# ``import deforma.sweep; deforma.sweep(spec, outdir)``: the module is callable as the function
-class _CallableModule(types.ModuleType):
-    def __call__(self, *args, **kwargs):
-        return sweep(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
