@@ -136,3 +136,9 @@ def test_row_keys_order_rows_lexicographically(n):
     assert (np.diff(keys[order]) >= 0).all()  # lexicographic order is key order
     same = (rows[:, None, :] == rows[None, :, :]).all(axis=2)
     assert np.array_equal(same, keys[:, None] == keys[None, :])  # equal rows <=> equal keys
+
+
+def test_texture_coordinates_are_given_by_keyword():
+    with pytest.raises(TypeError):
+        Mesh(SQUARE, [[0, 1, 2]], np.full((4, 2), 0.5))  # noqa: the positional uv is refused
+    assert Mesh(SQUARE, [[0, 1, 2]], uv=np.full((4, 2), 0.5)).uv.shape == (4, 2)

@@ -98,7 +98,7 @@ def box(corners, *, detail=8, edges=True) -> Mesh:
             flat |= on_side[tris, k].all(axis=1)
         tris = tris[~flat]
         tris = _symmetric_ties(points, uv, tris, n)
-    return Mesh(points, tris, uv)
+    return Mesh(points, tris, uv=uv)
 
 
 def _symmetric_ties(points, uv, tris, n):

@@ -275,7 +275,7 @@ def from_image(
     cx, cy = 0.5 * (lo + hi)
     vertices = np.c_[(points[:, 0] - cx) * scale, (cy - points[:, 1]) * scale]
     uv = np.clip(np.c_[points[:, 0] / w, 1.0 - points[:, 1] / h], 0.0, 1.0)
-    return Mesh(vertices, tris, uv, texture=_with_alpha(pic, None if by_alpha else mask))
+    return Mesh(vertices, tris, uv=uv, texture=_with_alpha(pic, None if by_alpha else mask))
 
 
 def foreground_mask(source, *, background="black", threshold=None) -> np.ndarray:

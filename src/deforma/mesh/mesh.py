@@ -24,7 +24,7 @@ class Mesh:
         stored triangle is counter-clockwise. A triangle whose corners are collinear or
         coincide (see :func:`deforma.mesh.quality.degenerate_triangles`), a triangle listed
         twice, and an edge shared by more than two triangles are rejected.
-    uv : (N, 2) array_like of float, optional
+    uv : (N, 2) array_like of float, optional, keyword-only
         Texture coordinates in [0, 1], ``u`` to the right and ``v`` up (v = 0 is the bottom
         row of the picture, as in OpenGL). By default the vertices' positions normalised to
         their bounding box.
@@ -55,7 +55,7 @@ class Mesh:
     (45.0, 1)
     """
 
-    def __init__(self, vertices, triangles, uv=None, *, texture=None):
+    def __init__(self, vertices, triangles, *, uv=None, texture=None):
         v = np.array(vertices, dtype=np.float64, copy=True)
         if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3:
             raise ValueError(f"vertices must be an (N, 2) array with N >= 3, got shape {v.shape}")

@@ -104,7 +104,7 @@ def make_mesh(spec):
                                  threshold=spec.threshold)
     if isinstance(spec, MeshBody):
         return meshes.Mesh(np.array(spec.vertices, float), np.array(spec.triangles, np.int32),
-                           None if spec.uv is None else np.array(spec.uv, float))
+                           uv=None if spec.uv is None else np.array(spec.uv, float))
     raise TypeError(f"not a body spec: {spec!r}")
 
 
