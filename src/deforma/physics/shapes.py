@@ -25,6 +25,7 @@ import numpy as np
 
 from ..checks import coefficient as _coefficient
 from ..checks import pair as _pair
+from ..mesh.polygons import inside_loops, segments_meet, signed_area
 
 # Columns of the packed array. Collider rows:
 RECT_CX, RECT_CY, RECT_UX, RECT_UY = 0, 1, 2, 3   # centre; unit x axis of the shape's frame
@@ -82,28 +83,6 @@ def _points(value, name, *, minimum: int) -> np.ndarray:
     return p
 
 
-def _signed_area(p: np.ndarray) -> float:
-    q = np.roll(p, -1, axis=0)
-    return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
-
-
-def _segments_cross(a, b, c, d) -> np.ndarray:
-    """For segment arrays a-b (N, 2) against c-d (M, 2): (N, M) whether they intersect
-    (touching counts: an end on the other segment), by orientation signs."""
-    def orient(p, q, r):
-        return np.sign((q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1])
-                       - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0]))
-
-    def on(o, p, q, r):  # r on segment p-q: collinear and within its box
-        return (o == 0) & (np.minimum(p[..., 0], q[..., 0]) <= r[..., 0]) & (r[..., 0] <= np.maximum(p[..., 0], q[..., 0])) \
-            & (np.minimum(p[..., 1], q[..., 1]) <= r[..., 1]) & (r[..., 1] <= np.maximum(p[..., 1], q[..., 1]))
-    a, b = a[:, None], b[:, None]
-    c, d = c[None], d[None]
-    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
-    proper = (o1 * o2 < 0) & (o3 * o4 < 0)
-    return proper | on(o1, a, b, c) | on(o2, a, b, d) | on(o3, c, d, a) | on(o4, c, d, b)
-
-
 def _check_simple(loops: list[np.ndarray], name: str) -> None:
     """Refuse loops that cross themselves or each other (edges sharing an end excepted)."""
     a = np.concatenate(loops)
@@ -114,27 +93,13 @@ def _check_simple(loops: list[np.ndarray], name: str) -> None:
     ids = np.concatenate([np.arange(len(p)) + off for p, off in zip(loops, np.cumsum([0] + [len(p) for p in loops]))])
     nxt = np.concatenate([np.roll(np.arange(len(p)), -1) + off
                           for p, off in zip(loops, np.cumsum([0] + [len(p) for p in loops]))])
-    hit = _segments_cross(a, b, a, b)
+    hit = segments_meet(a[:, None], b[:, None], a[None], b[None])
     share = (ids[:, None] == ids[None]) | (ids[:, None] == nxt[None]) | (nxt[:, None] == ids[None]) \
         | (nxt[:, None] == nxt[None])
     hit &= ~share
     if hit.any():
         i, j = np.argwhere(hit)[0]
         raise ValueError(f"{name} must be simple: edge {i} crosses edge {j} (edges may meet only at shared ends)")
-
-
-def _inside_loops(points: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
-    """Even-odd test of (N, 2) points against a set of loops."""
-    inside = np.zeros(len(points), bool)
-    px, py = points[:, 0][:, None], points[:, 1][:, None]
-    for p in loops:
-        q = np.roll(p, -1, axis=0)
-        ax, ay, bx, by = p[:, 0][None], p[:, 1][None], q[:, 0][None], q[:, 1][None]
-        crosses = (ay > py) != (by > py)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xs = ax + (py - ay) * (bx - ax) / (by - ay)
-        inside ^= (np.sum(crosses & (px < xs), axis=1) % 2).astype(bool)
-    return inside
 
 
 class Collider:
@@ -528,24 +493,24 @@ class Polygon(Collider):
     def __init__(self, points, *, holes=(), friction=None, static_friction=None, velocity=(0.0, 0.0),
                  angular_velocity=0.0):
         outer = _points(points, "points", minimum=3)
-        if abs(_signed_area(outer)) <= 1e-12 * max(1.0, float(np.ptp(outer, axis=0).max()) ** 2):
+        if abs(signed_area(outer)) <= 1e-12 * max(1.0, float(np.ptp(outer, axis=0).max()) ** 2):
             raise ValueError("a polygon's points must enclose an area (they are collinear or repeated)")
-        if _signed_area(outer) < 0:
+        if signed_area(outer) < 0:
             outer = outer[::-1]
         loops = [outer]
         for k, h in enumerate(holes):
             hole = _points(h, f"holes[{k}]", minimum=3)
-            if _signed_area(hole) > 0:
+            if signed_area(hole) > 0:
                 hole = hole[::-1]
-            if not _inside_loops(hole[:1], [outer])[0]:
+            if not inside_loops(hole[:1], [outer])[0]:
                 raise ValueError(f"holes[{k}] must lie inside the polygon")
             for j, other in enumerate(loops[1:]):
-                if _inside_loops(hole[:1], [other])[0] or _inside_loops(other[:1], [hole])[0]:
+                if inside_loops(hole[:1], [other])[0] or inside_loops(other[:1], [hole])[0]:
                     raise ValueError(f"holes[{k}] and holes[{j}] are nested: an island in a hole is a polygon of "
                                      f"its own")
             loops.append(hole)
         _check_simple(loops, "a polygon")
-        area = sum(_signed_area(p) for p in loops)
+        area = sum(signed_area(p) for p in loops)
         # the centroid of the solid (outer minus holes): the point it turns about
         cx = cy = 0.0
         for p in loops:
@@ -584,7 +549,7 @@ class Polygon(Collider):
 
     def contains(self, points) -> np.ndarray:
         q = self._local(points)
-        return _inside_loops(q, self._local_loops)
+        return inside_loops(q, self._local_loops)
 
     def outline(self, segments: int = 48) -> np.ndarray:
         return self.points

@@ -15,43 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..mesh.polygons import inside_loops, segments_meet, signed_area
+
 __all__ = ["fill_triangles", "loop_depths", "loops_area", "triangles_still_fit"]
 
 
 def _cross(o, a, b) -> float:
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-
-def _signed_area(p: np.ndarray) -> float:
-    q = np.roll(p, -1, axis=0)
-    return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
-
-
-def _crossings(a, b, c, d) -> np.ndarray:
-    """Whether segment a-b touches or crosses each segment c[k]-d[k] (touching counts)."""
-    def orient(p, q, r):
-        return np.sign((q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1])
-                       - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0]))
-
-    def on(o, p, q, r):  # r on p-q when collinear: within its box
-        lo, hi = np.minimum(p, q), np.maximum(p, q)
-        return (o == 0) & np.all((lo <= r) & (r <= hi), axis=-1)
-    a, b = np.broadcast_to(a, c.shape), np.broadcast_to(b, c.shape)
-    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
-    return ((o1 * o2 < 0) & (o3 * o4 < 0)) | on(o1, a, b, c) | on(o2, a, b, d) | on(o3, c, d, a) | on(o4, c, d, b)
-
-
-def _inside(point, loops) -> bool:
-    """Even-odd test of one point against loops."""
-    x, y = point
-    inside = False
-    for p in loops:
-        q = np.roll(p, -1, axis=0)
-        crosses = (p[:, 1] > y) != (q[:, 1] > y)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xs = p[:, 0] + (y - p[:, 1]) * (q[:, 0] - p[:, 0]) / (q[:, 1] - p[:, 1])
-        inside ^= bool(np.sum(crosses & (x < xs)) % 2)
-    return inside
 
 
 def _in_wedge(v, prev, nxt, d) -> bool:
@@ -81,12 +51,12 @@ def _bridge(ring: list[int], pts: np.ndarray, hole: list[int], others: list[np.n
         if not _in_wedge(v, ring_a[(k - 1) % n], ring_a[(k + 1) % n], m - v):
             continue
         # no wall may touch the bridge except where it ends (walls at v or at m are allowed)
-        hits = _crossings(m, v, walls_a, walls_b)
+        hits = segments_meet(m, v, walls_a, walls_b)
         at_end = np.all(walls_a == v, axis=1) | np.all(walls_b == v, axis=1) \
             | np.all(walls_a == m, axis=1) | np.all(walls_b == m, axis=1)
         if np.any(hits & ~at_end):
             continue
-        if not _inside((m + v) / 2, loops):
+        if not inside_loops([(m + v) / 2], loops)[0]:
             continue
         spliced = hole[h:] + hole[:h + 1]     # around the hole, back to its start
         return ring[:k + 1] + spliced + ring[k:]   # ... v, m, ..., m, v, ...
@@ -205,13 +175,13 @@ def fill_triangles(loops) -> np.ndarray:
     tris = []
     for k in (k for k in range(len(loops)) if depth[k] % 2 == 0):
         ring = list(range(offsets[k], offsets[k + 1]))
-        if _signed_area(loops[k]) < 0:
+        if signed_area(loops[k]) < 0:
             ring.reverse()
         holes = []
         for j in range(len(loops)):
             if depth[j] == depth[k] + 1 and inside[j][k]:   # a hole right inside this loop
                 h = list(range(offsets[j], offsets[j + 1]))
-                if _signed_area(loops[j]) > 0:
+                if signed_area(loops[j]) > 0:
                     h.reverse()  # holes run clockwise, so the bridged ring stays one counter-clockwise loop
                 holes.append(h)
         # rightmost holes first: each then sees the outer boundary or a hole joined before it
@@ -225,7 +195,7 @@ def fill_triangles(loops) -> np.ndarray:
 def _nesting(loops) -> list[list[bool]]:
     """``[k][j]``: whether loop k lies inside loop j (k != j; loops do not cross, so one
     vertex tells)."""
-    return [[j != k and _inside(loops[k][0], [loops[j]]) for j in range(len(loops))] for k in range(len(loops))]
+    return [[j != k and inside_loops(loops[k][:1], [loops[j]])[0] for j in range(len(loops))] for k in range(len(loops))]
 
 
 def loop_depths(loops) -> list[int]:
@@ -251,4 +221,4 @@ def triangles_still_fit(points: np.ndarray, triangles: np.ndarray, area: float) 
 def loops_area(loops, depths=None) -> float:
     """Area of the solid the loops bound (either orientation; even-odd, see :func:`loop_depths`)."""
     depths = loop_depths(loops) if depths is None else depths
-    return sum(abs(_signed_area(np.asarray(p, np.float64))) * (-1) ** d for p, d in zip(loops, depths))
+    return sum(abs(signed_area(np.asarray(p, np.float64))) * (-1) ** d for p, d in zip(loops, depths))
