@@ -299,41 +299,36 @@ def _path_interval(x0, y0, px, py, rects, r):
         return max((-qb - root) / (2.0 * qa), 0.0), min((-qb + root) / (2.0 * qa), 1.0)
     if kind == SEGMENT:
         # the path's point nearest the core segment, if within the radius (a capsule is thin:
-        # one point of the path inside it stands for the chord)
-        best, t_best = np.inf, 2.0
-        for k in range(33):
-            t = k / 32.0
-            qx, qy = x0 + t * dx - cx, y0 + t * dy - cy
-            s = min(max(qx * ux + qy * uy, -hx), hx)
-            ex, ey = qx - s * ux, qy - s * uy
-            d2 = ex * ex + ey * ey
-            if d2 < best:
-                best, t_best = d2, t
-        # refine around the best sample: the distance along a line is convex in t
-        lo, hi = max(t_best - 1.0 / 32.0, 0.0), min(t_best + 1.0 / 32.0, 1.0)
-        for _ in range(40):
-            m1 = lo + (hi - lo) / 3.0
-            m2 = hi - (hi - lo) / 3.0
-            d1 = 0.0
-            d2 = 0.0
-            for m, which in ((m1, 0), (m2, 1)):
-                qx, qy = x0 + m * dx - cx, y0 + m * dy - cy
-                s = min(max(qx * ux + qy * uy, -hx), hx)
-                ex, ey = qx - s * ux, qy - s * uy
-                if which == 0:
-                    d1 = ex * ex + ey * ey
-                else:
-                    d2 = ex * ex + ey * ey
-            if d1 < d2:
-                hi = m2
-            else:
-                lo = m1
-        t = 0.5 * (lo + hi)
-        qx, qy = x0 + t * dx - cx, y0 + t * dy - cy
-        s = min(max(qx * ux + qy * uy, -hx), hx)
-        ex, ey = qx - s * ux, qy - s * uy
-        if ex * ex + ey * ey < hy * hy:
-            return t, t
+        # one point of the path inside it stands for the chord). Closest points of two
+        # segments (Ericson, Real-Time Collision Detection, 5.1.9): s along the path, t along
+        # the core from one end to the other.
+        qx, qy = cx - hx * ux, cy - hx * uy
+        ex, ey = 2.0 * hx * ux, 2.0 * hx * uy
+        rx, ry = x0 - qx, y0 - qy
+        a = dx * dx + dy * dy
+        e = ex * ex + ey * ey
+        f = ex * rx + ey * ry
+        c = dx * rx + dy * ry
+        if a == 0.0:
+            return 2.0, 0.0  # no motion: nothing to sweep
+        if e == 0.0:  # a disc: no core length
+            s = min(max(-c / a, 0.0), 1.0)
+            t = 0.0
+        else:
+            b = dx * ex + dy * ey
+            den = a * e - b * b
+            s = min(max((b * f - c * e) / den, 0.0), 1.0) if den > 0.0 else 0.0
+            t = (b * s + f) / e
+            if t < 0.0:
+                t = 0.0
+                s = min(max(-c / a, 0.0), 1.0)
+            elif t > 1.0:
+                t = 1.0
+                s = min(max((b - c) / a, 0.0), 1.0)
+        gx = x0 + s * dx - (qx + t * ex)
+        gy = y0 + s * dy - (qy + t * ey)
+        if gx * gx + gy * gy < hy * hy:
+            return s, s
         return 2.0, 0.0
     # polygon: the first two crossings of its boundary
     t1 = np.inf
