@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from ..checks import coefficient as _coefficient
+from ..checks import number as _number
 from ..checks import pair as _pair
 from ..mesh.polygons import inside_loops, segments_meet, signed_area
 
@@ -57,13 +58,9 @@ def _rotation(angle_deg: float) -> np.ndarray:
 
 
 def _finite(value, name, *, bound=None, positive=False, non_negative=False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v) or (bound is not None and abs(v) > bound):
-        limit = f" within +-{bound:g}" if bound is not None else ""
-        raise ValueError(f"{name} must be a finite number{limit}, got {value!r}")
+    v = _number(value, name)
+    if bound is not None and abs(v) > bound:
+        raise ValueError(f"{name} must be a finite number within +-{bound:g}, got {value!r}")
     if positive and not v > 0:
         raise ValueError(f"{name} must be > 0, got {value!r}")
     if non_negative and v < 0:
@@ -129,10 +126,7 @@ class Collider:
 
     @center.setter
     def center(self, value):
-        c = _pair(value, "center")
-        if max(abs(c[0]), abs(c[1])) > 1e9:
-            raise ValueError(f"center must lie within +-1e9 m, got {value!r}")
-        self._center = self._origin_center = c
+        self._center = self._origin_center = _pair(value, "center")  # within +-1e9 m
         self._changed()
 
     @property
@@ -292,9 +286,7 @@ class Rect(Collider):
 
     @size.setter
     def size(self, value):
-        self._size = _pair(value, "size", positive=True)
-        if max(self._size) > 1e9:
-            raise ValueError(f"size must be at most 1e9 m, got {value!r}")
+        self._size = _pair(value, "size", positive=True)  # at most 1e9 m
         if hasattr(self, "_version"):
             self._changed()
 
