@@ -122,6 +122,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", metavar="OUT", help="out.mp4, out.gif, or a folder/ for PNG frames")
     r.add_argument("--states", metavar="OUT.npz", help="save positions per frame, meshes and parameters")
     r.add_argument("--wireframe", action="store_true", help="draw the springs over the bodies")
+    r.add_argument("--overlay", action="store_true",
+                   help="write the simulated time (top left) and a scale bar (bottom left) on every frame")
     r.add_argument("--samples", type=int, default=4, choices=(0, 4), help="multisampling for smooth edges (default 4)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--springs", action="store_true",
@@ -351,7 +353,7 @@ def _run_scene(a, watch, shown: dict) -> int:
             renderer = Renderer.headless(a.size, samples=a.samples)
         except RuntimeError as e:
             raise CliError(str(e), EXIT_NO_GL) from None
-        view = WorldView(renderer, world)
+        view = WorldView(renderer, world, overlay=a.overlay)
         if a.wireframe:
             view.wireframe = True
 

@@ -254,7 +254,7 @@ def _picture_size(width, height, camera) -> tuple[int, int]:
     return width, height
 
 
-def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None) -> Animation:
+def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, overlay=False) -> Animation:
     """Simulate a scene or a world and return an animation that plays inline in a notebook.
 
     Parameters
@@ -276,6 +276,9 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None) -> A
     format : {"mp4", "gif"}, optional
         ``"mp4"`` (H.264, small, an HTML5 video) when imageio-ffmpeg is installed, else
         ``"gif"`` (larger, but an image any viewer animates).
+    overlay : bool, optional
+        Write the simulated time (``t = 1.25 s``, top left) and a scale bar (bottom left) on
+        every frame, as ``deforma run --overlay`` does. Default off.
 
     Returns
     -------
@@ -335,7 +338,7 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None) -> A
 
     renderer = Renderer.headless(picture, samples=4)
     try:
-        view = WorldView(renderer, world, replace(scene, camera=camera))
+        view = WorldView(renderer, world, replace(scene, camera=camera), overlay=bool(overlay))
         # the scene's explosions and pulls that are still ahead of the world's clock
         script = Script(scene, world)
         start = world.time

@@ -75,6 +75,17 @@ class Camera:
             vh = vw / aspect
         return (vw / 2.0, vh / 2.0)
 
+    def metres_per_pixel(self, viewport: tuple[int, int]) -> float:
+        """The picture's scale in a ``viewport`` of pixels: metres per pixel (pixels are square).
+
+        Examples
+        --------
+        >>> Camera(center=(0.0, 2.0), size=(16.0, 9.0)).metres_per_pixel((1280, 720))
+        0.0125
+        """
+        hx, _ = self.extent(viewport)
+        return 2.0 * hx / viewport[0]
+
     def world_to_pixel(self, points, viewport: tuple[int, int]) -> np.ndarray:
         """Map world points (..., 2) in metres to pixel coordinates (column, row), row 0 on top."""
         p = np.asarray(points, dtype=np.float64)

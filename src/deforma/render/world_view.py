@@ -24,6 +24,10 @@ class WorldView:
     scene : deforma.scene.Scene, optional
         Camera, background, wireframe and each body's colour/texture. Default: the scene the
         world was built from (``deforma.scene.scene_of(world)``).
+    overlay : bool, optional
+        Write the simulated time and a scale bar onto every picture :meth:`draw` reads
+        (see :func:`deforma.render.overlay.draw_overlay`). Default off; the ``overlay``
+        attribute turns it on or off later.
 
     Examples
     --------
@@ -33,10 +37,13 @@ class WorldView:
     >>> view = WorldView(Renderer.headless((320, 180)), world)
     >>> view.draw().shape
     (180, 320, 3)
+    >>> view.overlay = True                     # "t = 0.00 s" and a 1 m bar in the corners
+    >>> view.draw().shape
+    (180, 320, 3)
     >>> view.renderer.release()
     """
 
-    def __init__(self, renderer: Renderer, world, scene=None):
+    def __init__(self, renderer: Renderer, world, scene=None, *, overlay: bool = False):
         from ..scene import scene_of
 
         self.renderer = renderer
@@ -47,6 +54,7 @@ class WorldView:
         renderer.background_top = _as_rgba(cam.background[0])[:3]
         renderer.background_bottom = _as_rgba(cam.background[1])[:3]
         self.wireframe = cam.wireframe
+        self.overlay = bool(overlay)
         self.collider_colors = None
         self._handles = []
         self._bodies = []
@@ -93,7 +101,11 @@ class WorldView:
         self._topologies = [b.topology for b in bodies]
 
     def draw(self, *, read: bool = True):
-        """Paint the world's current state; returns the picture (H, W, 3) uint8 when ``read``."""
+        """Paint the world's current state; returns the picture (H, W, 3) uint8 when ``read``.
+
+        With :attr:`overlay` on, the picture returned carries the time and scale overlay (it is
+        written onto the read-back pixels, so the framebuffer itself has none).
+        """
         bodies = self.world.bodies
         if len(bodies) != len(self._bodies) or any(a is not b or a.topology is not t
                                                    for a, b, t in zip(bodies, self._bodies, self._topologies)) \
@@ -102,4 +114,11 @@ class WorldView:
         r = self.renderer
         r.render([(h, b.positions) for h, b in zip(self._handles, self._bodies)], self.world.colliders,
                  wireframe=self.wireframe, collider_colors=self.collider_colors)
-        return r.read() if read else None
+        if not read:
+            return None
+        frame = r.read()
+        if self.overlay:
+            from .overlay import draw_overlay
+
+            draw_overlay(frame, time=self.world.time, metres_per_pixel=r.camera.metres_per_pixel(r.size))
+        return frame

@@ -1,0 +1,126 @@
+"""The time/scale overlay: where it draws, how long the bar is, and that it is off unless asked."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import deforma
+from deforma.cli import main
+from deforma.render import Renderer, WorldView
+from deforma.render.overlay import draw_overlay, format_length, scale_bar_length
+
+BACKGROUND = (200, 210, 220)
+
+
+def changed(a, b):
+    return (a != b).any(axis=2)
+
+
+def blank(h=180, w=320):
+    return np.full((h, w, 3), BACKGROUND, np.uint8)
+
+
+def test_overlay_draws_only_in_the_left_corners():
+    frame = blank()
+    out = draw_overlay(frame, time=1.25, metres_per_pixel=8.0 / 320)
+    assert out is frame
+    diff = changed(frame, blank())
+    h, w = diff.shape
+    assert diff[: h // 5, : w // 2].any()          # the time, top left
+    assert diff[-h // 5 :, : w // 2].any()         # the scale bar, bottom left
+    assert not diff[h // 5 : -h // 5].any()        # the middle band is untouched
+    assert not diff[:, w // 2 :].any()             # and so is the right half
+
+
+def test_the_time_text_follows_the_time():
+    a, b = blank(), blank()
+    draw_overlay(a, time=0.0, metres_per_pixel=0.025)
+    draw_overlay(b, time=3.5, metres_per_pixel=0.025)
+    diff = changed(a, b)
+    assert diff[:36].any() and not diff[36:].any()  # only the time's corner differs
+
+
+def test_scale_bar_has_the_length_it_names():
+    frame = blank(200, 800)
+    mpp = 8.0 / 800                                 # 100 px per metre: a 1 m bar (<= 1.6 m)
+    draw_overlay(frame, time=0.0, metres_per_pixel=mpp)
+    assert scale_bar_length(mpp, 800) == 1.0
+    dark = frame.sum(axis=2) < 200
+    # the bar's rows: the longest dark run in the bottom fifth, from the left margin on
+    runs = [np.flatnonzero(row) for row in dark[-40:, :400]]
+    longest = max((r[-1] - r[0] + 1 for r in runs if len(r) and np.all(np.diff(r) == 1)), default=0)
+    assert longest == pytest.approx(100, abs=1)
+
+
+@pytest.mark.parametrize("mpp, width, length, label", [
+    (0.01, 800, 1.0, "1 m"), (0.05, 1280, 10.0, "10 m"), (0.0004, 640, 0.05, "5 cm"),
+    (0.025, 320, 1.0, "1 m"), (0.02, 320, 1.0, "1 m"), (0.1, 1280, 20.0, "20 m"),
+    (1e-5, 1000, 0.002, "2 mm"), (10.0, 1000, 2000.0, "2 km"),
+])
+def test_scale_bar_lengths_are_round_and_fit(mpp, width, length, label):
+    got = scale_bar_length(mpp, width)
+    assert got == pytest.approx(length) and format_length(got) == label
+    assert got / mpp <= 0.2 * width + 1e-6
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"frame": np.zeros((10, 10), np.uint8)}, "frame must be an (H, W, 3) uint8 array"),
+    ({"frame": np.zeros((10, 10, 3), np.float32)}, "frame must be an (H, W, 3) uint8 array"),
+    ({"time": float("nan")}, "time must be a finite number"),
+    ({"metres_per_pixel": 0.0}, "metres_per_pixel must be a finite number > 0"),
+])
+def test_bad_input_is_one_clear_error(kwargs, message):
+    args = {"frame": blank(), "time": 1.0, "metres_per_pixel": 0.01, **kwargs}
+    frame = args.pop("frame")
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        draw_overlay(frame, **args)
+
+
+def test_world_view_overlay_is_off_by_default_and_only_touches_the_corners(gl_ctx):
+    world = deforma.load_scene("sample")
+    view = WorldView(Renderer(gl_ctx, (320, 180), samples=0), world)
+    try:
+        plain = view.draw()
+        view.overlay = True
+        marked = view.draw()
+        view.overlay = False
+        again = view.draw()
+    finally:
+        view.renderer.release()
+    assert np.array_equal(plain, again)            # off: the frame is exactly the renderer's
+    diff = changed(plain, marked)
+    assert diff[:36, :160].any() and diff[-36:, :160].any()
+    assert not diff[36:-36].any() and not diff[:, 160:].any()
+
+
+def read_frames(folder):
+    return [np.asarray(Image.open(p).convert("RGB")) for p in sorted(folder.glob("frame_*.png"))]
+
+
+def test_deforma_run_overlay_flag(tmp_path, capsys):
+    args = ["run", "sample", "--seconds", "0.1", "--fps", "20", "--size", "320x180", "--samples", "0", "--quiet"]
+    assert main([*args, "-o", f"{tmp_path / 'plain'}/"]) == 0
+    assert main([*args, "-o", f"{tmp_path / 'marked'}/", "--overlay"]) == 0
+    capsys.readouterr()
+    plain, marked = read_frames(tmp_path / "plain"), read_frames(tmp_path / "marked")
+    assert len(plain) == len(marked) == 2
+    # without the flag the first frame is exactly what a WorldView draws of the scene's start
+    view = WorldView(Renderer.headless((320, 180), samples=0), deforma.load_scene("sample"))
+    try:
+        assert np.array_equal(plain[0], view.draw())
+    finally:
+        view.renderer.release()
+    for p, m in zip(plain, marked):
+        diff = changed(p, m)
+        assert diff[:36, :160].any() and diff[-36:, :160].any()
+        assert not diff[36:-36].any() and not diff[:, 160:].any()
+    # the frames' clocks differ (0.00 s, 0.05 s), and nothing else is drawn in that corner
+    assert changed(marked[0][:36, :160], marked[1][:36, :160]).any()
+
+
+def test_show_overlay_marks_the_frames():
+    kwargs = {"seconds": 0.1, "fps": 10, "size": (320, 180), "format": "gif"}
+    plain = deforma.show("sample", **kwargs).last_frame
+    marked = deforma.show("sample", overlay=True, **kwargs).last_frame
+    diff = changed(plain, marked)
+    assert diff[:36, :160].any() and diff[-36:, :160].any() and not diff[36:-36].any()
