@@ -13,6 +13,7 @@ pytest.importorskip("ray")
 pytest.importorskip("pyarrow")
 
 import deforma.sweeps as sweeps  # noqa: E402
+from signal_runs import kill_leftovers  # noqa: E402
 from deforma.cli import main  # noqa: E402
 
 TINY_SCENE = """
@@ -144,6 +145,56 @@ def test_a_sweep_cut_short_completes_without_duplicates(cluster, folder):
     assert (again.skipped, again.ran) == (3, 3)
     rows = _rows(out)
     assert len(rows) == 6 and len({r["run_id"] for r in rows}) == 6
+
+
+# 8 runs of 4 simulated seconds (about 0.2 s of wall time each): long enough to be stopped half-way
+SLOW_SWEEP = """
+scene = "tiny.toml"
+seconds = 4.0
+
+[parameters]
+"physics.stiffness" = [500, 700, 1000, 1500]
+"body[0].position" = [[0, 1], [1, 1]]
+"""
+
+
+def test_a_sweep_stopped_half_way_with_ctrl_c_and_restarted_completes_without_duplicates(cluster, folder):
+    """`deforma sweep` in a process of its own (joined to the module's cluster, so no second
+    start-up) gets SIGINT once its first rows are in the table: exit code 130, the finished runs
+    kept; the same sweep again runs only the rest. (A kill without clean-up is the test above.)"""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    import ray
+
+    spec = _spec(folder, "slow.toml", SLOW_SWEEP)
+    out = folder / "slow"
+    parts = out / "results.parquet"
+    p = subprocess.Popen([sys.executable, "-m", "deforma.cli", "sweep", str(spec), "-o", str(out), "--address",
+                          ray.get_runtime_context().gcs_address, "--quiet"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.perf_counter() + 60
+        while not list(parts.glob("part-*.parquet")):
+            assert p.poll() is None, p.communicate()
+            assert time.perf_counter() < deadline, "no run finished within 60 s"
+            time.sleep(0.02)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=30)
+    finally:
+        kill_leftovers([p])
+    assert p.returncode == 130, err
+    assert err.startswith("deforma: interrupted; ") and "the same command carries on" in err
+    kept = {r["run_id"] for r in _rows(out)}
+    assert 1 <= len(kept) < 8, "not stopped half-way"
+    assert not [f for f in os.listdir(parts) if not f.startswith("part-")]  # no temporary file left
+    again = sweeps.sweep(spec, out)
+    assert (again.total, again.skipped, again.ran, again.ok) == (8, len(kept), 8 - len(kept), 8 - len(kept))
+    rows = _rows(out)
+    assert len(rows) == 8 and len({r["run_id"] for r in rows}) == 8
+    assert kept <= {r["run_id"] for r in rows} and all(r["status"] == "ok" for r in rows)
 
 
 def test_other_spec_refused_unless_force(done, folder):
