@@ -100,6 +100,8 @@ def test_one_row_per_run_unstable_marked_with_hint(done):
             assert r["status"] == "ok", r["message"]
             assert r["steps"] == 150 and r["simulated_s"] == pytest.approx(0.3)
             assert np.isfinite(r["final_energy_j"]) and 0 <= r["max_spring_strain"] < 1
+            # 0.3 s is too short for a dropped box to settle (tests below show one that does)
+            assert np.isnan(r["time_to_rest_s"])
             # the box starts at the x of its position and falls onto the ground
             (cx, cy), = r["centroid"]
             assert cx == pytest.approx(r["body[0].position"][0], abs=0.05) and cy < 1.0
@@ -230,6 +232,33 @@ def test_random_mode_is_reproducible(folder):
     assert [r.parameters for r in runs] == [r.parameters for r in sweeps.plan(spec)]
     assert len(runs) == 5 and all(0.1 <= r.parameters["physics.friction"] <= 0.9 for r in runs)
     assert all(r.parameters["physics.stiffness"] in (500, 1000) for r in runs)
+
+
+# the tiny box, but with implicit Euler and strong damping: it lands at about 0.25 s and settles
+# within a second; the event throws it up only when a run sets its time below the run's end
+REST_SCENE = TINY_SCENE.replace('"symplectic-euler"', '"implicit-euler"').replace("damping = 1.0", "damping = 20.0") + """
+[[event]]
+time = 100.0
+action = "explode"
+"""
+
+
+@pytest.mark.parametrize("parameters, rests", [
+    ({"physics.gravity": [0.0, 0.0]}, (0.0, 0.0)),      # still from the first frame
+    ({}, (0.3, 1.5)),                                   # lands, bounces, settles
+    ({"body[0].position": [0.0, 100.0]}, None),         # falls for the whole run
+    ({"event[0].time": 1.5}, None),                     # settles, then thrown up half a second before the end
+])
+def test_time_to_rest(folder, parameters, rests):
+    (folder / "rest.toml").write_text(REST_SCENE)
+    spec = sweeps.load_spec(_spec(folder, "rest_sweep.toml", 'scene = "rest.toml"\nseconds = 2.0\n[parameters]\n'
+                                                          '"physics.stiffness" = [1000]\n'))
+    row = sweeps.simulate(sweeps.scene_for(spec, parameters, source="test"))
+    assert row["status"] == "ok", row["message"]
+    if rests is None:
+        assert np.isnan(row["time_to_rest_s"])
+    else:
+        assert rests[0] <= row["time_to_rest_s"] <= rests[1]
 
 
 def test_unreachable_address_fails_fast():

@@ -56,6 +56,10 @@ MAX_RUNS = 1_000_000
 #: How long to wait for a TCP answer from ``--address`` before saying it is unreachable (Ray
 #: itself retries an unreachable head for minutes).
 CONNECT_TIMEOUT = 10.0
+#: A run is at rest while the fastest vertex of every body moves slower than this (m/s):
+#: 1 cm/s, a third of a millimetre per frame at 30 fps: no visible motion in a video of a scene a
+#: few metres across. See :func:`simulate` (``time_to_rest_s``).
+REST_SPEED = 0.01
 RESULTS_NAME = "results.parquet"
 STATES_FOLDER = "states"
 
@@ -329,11 +333,24 @@ def _largest_spring_strain(world) -> float:
     return largest
 
 
+def _largest_speed(world) -> float:
+    import numpy as np
+
+    return max((float(np.max(np.hypot(v[:, 0], v[:, 1]))) for v in (b.velocities for b in world.bodies)
+                if len(v)), default=0.0)
+
+
 def simulate(scene, *, states: bool = False) -> dict:
     """Run one scene for its ``run.seconds``; the row's status, message and metrics (and the states NPZ bytes).
 
     Never raises for the simulation's sake: an unstable world is ``status = "unstable"`` with its
     hint, any other exception ``status = "error"`` with its message.
+
+    ``time_to_rest_s`` is the simulated time of the first frame (at the scene's ``run.fps``)
+    from which on, up to and including the last frame, no vertex of any body moves faster than
+    :data:`REST_SPEED`; NaN if the last frame is not at rest (the bodies never settle, or
+    settle and are thrown again). Only frames are looked at, so a bounce that turns exactly
+    at the last frame would count as rest there: give a run some time after it settles.
     """
     import numpy as np
 
@@ -342,7 +359,8 @@ def simulate(scene, *, states: bool = False) -> dict:
 
     t0 = time.perf_counter()
     row = {"status": "ok", "message": "", "hint": "", "steps": 0, "simulated_s": 0.0, "final_energy_j": math.nan,
-           "max_spring_strain": math.nan, "centroid": [], "worker": socket.gethostname(), "states": None}
+           "max_spring_strain": math.nan, "time_to_rest_s": math.nan, "centroid": [], "worker": socket.gethostname(),
+           "states": None}
     world = None
     try:
         world = scene.build()
@@ -351,14 +369,20 @@ def simulate(scene, *, states: bool = False) -> dict:
         script = Script(scene, world)
         times, frames, poses = [], [], []
         strain = 0.0
+        resting_since = None  # the first frame of the current run of frames at rest
         for k in range(n_frames + 1):  # frame k at k / fps, the last one at the end of the run
             script.advance(k / fps)
             strain = max(strain, _largest_spring_strain(world))
+            if _largest_speed(world) < REST_SPEED:
+                resting_since = world.time if resting_since is None else resting_since
+            else:
+                resting_since = None
             if states:
                 times.append(world.time)
                 frames.append([b.positions.copy() for b in world.bodies])
                 poses.append([(*c.center, c.angle) for c in world.colliders])
         row["max_spring_strain"] = strain
+        row["time_to_rest_s"] = math.nan if resting_since is None else float(resting_since)
         row["final_energy_j"] = float(world.energy().total)
         row["centroid"] = [[float(v) for v in np.mean(b.positions, axis=0)] for b in world.bodies]
         if states:
@@ -473,7 +497,7 @@ def _schema(spec: SweepSpec):
         ("run_id", pa.string()), ("run_index", pa.int64()), ("spec_fingerprint", pa.string()),
         ("status", pa.string()), ("message", pa.string()), ("hint", pa.string()),
         ("wall_s", pa.float64()), ("steps", pa.int64()), ("simulated_s", pa.float64()),
-        ("final_energy_j", pa.float64()), ("max_spring_strain", pa.float64()),
+        ("final_energy_j", pa.float64()), ("max_spring_strain", pa.float64()), ("time_to_rest_s", pa.float64()),
         ("centroid", pa.list_(pa.list_(pa.float64()))), ("states_path", pa.string()), ("worker", pa.string()),
         ("finished_at", pa.timestamp("s", tz="UTC")), ("parameters", pa.string()),
     ]
@@ -491,7 +515,8 @@ def _row_table(spec: SweepSpec, run: Run, row: dict, states_path: str | None):
         "run_id": run.run_id, "run_index": run.index, "spec_fingerprint": spec.fingerprint,
         "status": row["status"], "message": row["message"], "hint": row["hint"], "wall_s": row["wall_s"],
         "steps": row["steps"], "simulated_s": row["simulated_s"], "final_energy_j": row["final_energy_j"],
-        "max_spring_strain": row["max_spring_strain"], "centroid": row["centroid"], "states_path": states_path,
+        "max_spring_strain": row["max_spring_strain"], "time_to_rest_s": row["time_to_rest_s"],
+        "centroid": row["centroid"], "states_path": states_path,
         "worker": row["worker"], "finished_at": datetime.datetime.now(datetime.timezone.utc),
         "parameters": json.dumps(run.parameters, sort_keys=True),
     }
@@ -627,7 +652,7 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
                 first = (str(e).strip().splitlines() or [type(e).__name__])[-1]
                 row = {"status": "error", "message": f"{type(e).__name__}: {first}", "hint": "", "steps": 0,
                        "simulated_s": 0.0, "final_energy_j": math.nan, "max_spring_strain": math.nan,
-                       "centroid": [], "worker": "", "wall_s": math.nan, "states": None}
+                       "time_to_rest_s": math.nan, "centroid": [], "worker": "", "wall_s": math.nan, "states": None}
             states_path = None
             if row.get("states") is not None:
                 target = outdir / STATES_FOLDER / f"{run.run_id}.npz"
