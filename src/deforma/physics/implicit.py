@@ -448,3 +448,33 @@ class ImplicitEuler:
                              inputs.hits, float(h)) < 0:
                 return 0  # the contact buffer is too small; the world grows it and repeats the step
         return 0
+
+    def __deepcopy__(self, memo):
+        # copy.deepcopy(world): SciPy's SuperLU factor can be neither copied nor pickled, so the
+        # copy gets everything else and a stand-in that factors the same matrix again (same
+        # contact set, weights and edge parameters s, hence the same factor, bit for bit) the
+        # first time the copy solves with it. A changed contact set refactors as usual first.
+        import copy
+
+        new = type(self).__new__(type(self))
+        memo[id(self)] = new
+        for name, value in self.__dict__.items():
+            if name != "_lu":
+                new.__dict__[name] = copy.deepcopy(value, memo)
+        new._lu = None if self._lu is None else _FactorOnFirstSolve(new)
+        return new
+
+
+class _FactorOnFirstSolve:
+    """A copied :class:`ImplicitEuler`'s factor until its first solve (see ``__deepcopy__``)."""
+
+    def __init__(self, owner):
+        self.owner = owner
+
+    def solve(self, b):
+        o = self.owner
+        touching, factorizations = o._touching, o.factorizations
+        o._touching = None  # what makes _factor_if_needed factor again, from the stored set
+        o._factor_if_needed(o._key[0], touching, o._triples, o._s)
+        o.factorizations = factorizations  # the copy counts what the original counted
+        return o._lu.solve(b)

@@ -130,6 +130,11 @@ class World:
     Every parameter is also a settable attribute, validated the same way, and takes effect
     at the next step (bodies and colliders that do not override it follow the world).
 
+    ``copy.deepcopy(world)`` makes an independent world (its own bodies, colliders, grabs and
+    integrator) that steps exactly as this one would, bit for bit, whichever the integrator:
+    run one ahead to look into the future without changing the other. Body and grab handles
+    taken from this world keep pointing into this world; the copy's are in ``copy.bodies``.
+
     Examples
     --------
     >>> import deforma
@@ -174,6 +179,23 @@ class World:
         self.contact_thickness = contact_thickness
         self.air_drag = air_drag
         self.material = material
+
+    def __deepcopy__(self, memo):
+        # everything is copied as usual (the implicit integrator drops its SuperLU factor, see
+        # ImplicitEuler.__deepcopy__); what is keyed by id() is re-keyed to the copies, or the
+        # copy would repack its colliders a step earlier than this world (rounding apart) and
+        # forget which bodies had lost their shape
+        import copy
+
+        new = type(self).__new__(type(self))
+        memo[id(self)] = new
+        for name, value in self.__dict__.items():
+            new.__dict__[name] = copy.deepcopy(value, memo)
+        ids = {id(o): id(memo[id(o)]) for o in (*self._bodies, *self._colliders)}
+        new._lost_shape = {ids[k]: n for k, n in self._lost_shape.items() if k in ids}
+        if self._packed_colliders is not None:
+            new._packed_colliders = tuple((ids.get(k, k), version) for k, version in self._packed_colliders)
+        return new
 
     # -- parameters -------------------------------------------------------------------------
     @property

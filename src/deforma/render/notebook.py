@@ -262,9 +262,10 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
     scene_or_world : str, path, Scene or World
         A built-in scene name (``deforma scenes`` lists them), a ``.toml`` scene file, a
         :class:`deforma.scene.Scene`, or a :class:`deforma.World`. A scene is built afresh on
-        every call. **A World is stepped itself**, from its current state: afterwards it is
-        the animation's length later, as if you had called ``world.step()`` in a loop (run it
-        again to see what happens next; show a scene to start from the beginning each time).
+        every call. A World is shown from its current state, and is left as it was: the
+        animation steps a copy (``copy.deepcopy(world)``), which moves exactly as the world
+        itself would, so showing it twice shows the same thing, and ``world.step()`` afterwards
+        goes on from where the world was, not from the animation's end.
     seconds : float, optional
         Simulated time in seconds, in (0, 600]. Default: the scene's ``run.seconds`` (5 s for
         a world made in code).
@@ -336,9 +337,15 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
     from .video import open_writer
     from .world_view import WorldView
 
+    # the caller's world stays as it was: the animation runs a copy (built scenes are ours to step)
+    looks = world
+    if world is scene_or_world:
+        import copy
+
+        world = copy.deepcopy(world)
     renderer = Renderer.headless(picture, samples=4)
     try:
-        view = WorldView(renderer, world, replace(scene, camera=camera), overlay=bool(overlay))
+        view = WorldView(renderer, world, replace(scene, camera=camera), overlay=bool(overlay), looks_from=looks)
         # the scene's explosions and pulls that are still ahead of the world's clock
         script = Script(scene, world)
         start = world.time

@@ -28,6 +28,11 @@ class WorldView:
         Write the simulated time and a scale bar onto every picture :meth:`draw` reads
         (see :func:`deforma.render.overlay.draw_overlay`). Default off; the ``overlay``
         attribute turns it on or off later.
+    looks_from : deforma.World, optional
+        The world whose scene gives the bodies' and colliders' looks (colours, textures), body
+        by body and collider by collider, when ``world`` is a copy of it
+        (``copy.deepcopy``): a copy is not the world its scene was built into. Default:
+        ``world``.
 
     Examples
     --------
@@ -43,12 +48,13 @@ class WorldView:
     >>> view.renderer.release()
     """
 
-    def __init__(self, renderer: Renderer, world, scene=None, *, overlay: bool = False):
+    def __init__(self, renderer: Renderer, world, scene=None, *, overlay: bool = False, looks_from=None):
         from ..scene import scene_of
 
         self.renderer = renderer
         self.world = world
-        self.scene = scene if scene is not None else scene_of(world)
+        self._looks_from = world if looks_from is None else looks_from
+        self.scene = scene if scene is not None else scene_of(self._looks_from)
         cam = self.scene.camera
         renderer.camera = Camera(cam.center, cam.size)
         renderer.background_top = _as_rgba(cam.background[0])[:3]
@@ -66,7 +72,7 @@ class WorldView:
         from ..scene import load_texture, scene_of
 
         try:
-            current = scene_of(self.world)
+            current = scene_of(self._looks_from)
         except AttributeError:
             # a collider shape the scene format cannot describe (yet): the colliders are then
             # drawn in the default colour; the bodies' looks still need the scene below
@@ -78,7 +84,7 @@ class WorldView:
         if [(id(b), id(b.topology)) for b in bodies] == self._shown:
             return
         if current is None:
-            current = scene_of(self.world)  # raises what the scene could not describe
+            current = scene_of(self._looks_from)  # raises what the scene could not describe
         for h in self._handles:
             self.renderer.remove_mesh(h)
         self._handles = []
