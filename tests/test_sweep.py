@@ -80,10 +80,10 @@ def _rows(outdir):
 
 @pytest.fixture(scope="module")
 def done(cluster, folder):
-    """The six runs, with states, swept once for the tests that read the table."""
+    """The six runs, with states and GIFs, swept once for the tests that read the table."""
     spec = _spec(folder, "sweep.toml", SWEEP)
     out = folder / "out"
-    result = sweeps.sweep(spec, out, states=True)
+    result = sweeps.sweep(spec, out, states=True, video="gif", video_size=(160, 90))
     return spec, out, result
 
 
@@ -116,6 +116,58 @@ def test_states_reload(done):
                 assert positions.shape[0] == 4 and np.isfinite(positions).all()  # frames at 0, 0.1, 0.2, 0.3 s
                 assert "physics.stiffness" not in str(z["scene_toml"])
                 assert f"stiffness = {r['physics.stiffness']}" in str(z["scene_toml"])
+
+
+def test_videos(done):
+    from PIL import Image
+
+    spec, out, _ = done
+    for r in _rows(out):
+        if r["status"] == "ok":
+            assert r["video_path"] == f"videos/{r['run_id']}.gif"
+            with Image.open(out / r["video_path"]) as gif:
+                assert gif.size == (160, 90) and gif.n_frames == 4  # the states' frames: 0, 0.1, 0.2, 0.3 s
+        else:
+            assert r["video_path"] is None  # an unstable run's video is discarded, as its states
+    assert sorted(p.name for p in (out / "videos").iterdir()) == sorted(
+        f"{r['run_id']}.gif" for r in _rows(out) if r["status"] == "ok")
+
+
+def test_video_mp4_in_process(folder):
+    spec = sweeps.load_spec(_spec(folder, "one.toml", 'scene = "tiny.toml"\nseconds = 0.3\n[parameters]\n'
+                                                   '"physics.stiffness" = [1000]\n'))
+    row = sweeps.simulate(sweeps.scene_for(spec, {}, source="test"), video="mp4", video_size=(160, 90))
+    assert row["status"] == "ok", row["message"]
+    assert row["video"][4:8] == b"ftyp"  # an MP4 file's first box
+
+
+def test_video_without_opengl_fails_that_run_only(folder, monkeypatch):
+    """No OpenGL context (moderngl's EGL and default backends both refuse): the run's row is an
+    error saying what to install; nothing raises, so the sweep goes on with the next run."""
+    import moderngl
+
+    def no_gl(**kwargs):
+        raise Exception("eglGetDisplay failed")
+    monkeypatch.setattr(moderngl, "create_standalone_context", no_gl)
+    spec = sweeps.load_spec(_spec(folder, "one.toml", 'scene = "tiny.toml"\nseconds = 0.3\n[parameters]\n'
+                                                   '"physics.stiffness" = [1000]\n'))
+    row = sweeps.simulate(sweeps.scene_for(spec, {}, source="test"), video="mp4")
+    assert row["status"] == "error" and row.get("video") is None and row["steps"] == 0
+    assert row["message"].startswith("no video: cannot open a headless OpenGL 3.3 context (egl: eglGetDisplay failed")
+    assert "libegl1" in row["message"] and "\n" not in row["message"]
+    # without --video the same run is fine
+    assert sweeps.simulate(sweeps.scene_for(spec, {}, source="test"))["status"] == "ok"
+
+
+@pytest.mark.parametrize("video, size, message", [
+    ("avi", (640, 360), r"video: expected one of mp4, gif .*'avi'"),
+    ("mp4", (8, 360), r"video_size: .*\(8, 360\)"),
+])
+def test_bad_video_options_refused_before_anything_runs(folder, video, size, message):
+    spec = _spec(folder, "sweep_v.toml", SWEEP)
+    with pytest.raises(sweeps.SweepError, match=message):
+        sweeps.sweep(spec, folder / "never_v", video=video, video_size=size)
+    assert not (folder / "never_v").exists()
 
 
 def test_second_invocation_runs_nothing(done):
@@ -273,7 +325,7 @@ def test_unreachable_address_fails_fast():
 
 def test_cli(done, folder, capsys):
     spec, out, _ = done
-    assert main(["sweep", str(spec), "-o", str(out), "--quiet"]) == 0
+    assert main(["sweep", str(spec), "-o", str(out), "--quiet", "--video", "gif", "--video-size", "160x90"]) == 0
     assert "6 runs, 6 already in the table, 0 run now" in capsys.readouterr().out
     bad = _spec(folder, "bad_cli.toml", 'scene = "tiny.toml"\nseconds = 0.3\n[parameters]\n"physics.stifness" = [1]\n')
     assert main(["sweep", str(bad), "-o", str(folder / "never")]) == 1

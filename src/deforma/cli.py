@@ -176,12 +176,18 @@ def _parser() -> argparse.ArgumentParser:
                                    "Runs already in the table are skipped. Needs the sweep extra: "
                                    "pip install 'deforma[sweep]'.")
     w.add_argument("spec", metavar="SPEC.toml", help="the sweep file")
-    w.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="folder for results.parquet and states/")
+    w.add_argument("-o", "--output", required=True, metavar="OUTDIR",
+                   help="folder for results.parquet, states/ and videos/")
     w.add_argument("--workers", type=_positive(int, hi=4096), metavar="N",
                    help="CPUs of the local Ray cluster (default: every core); ignored with --address")
     w.add_argument("--address", metavar="ADDR", help="a running Ray cluster: HOST:PORT (from `ray start --head`), "
                                                      "ray://HOST:PORT or auto")
     w.add_argument("--states", action="store_true", help="also write each ok run's states to OUTDIR/states/ID.npz")
+    w.add_argument("--video", nargs="?", const="mp4", choices=("mp4", "gif"), metavar="FORMAT",
+                   help="also draw each run and write each ok run's video to OUTDIR/videos/ID.mp4 (or gif with "
+                        "--video gif); a worker without OpenGL makes that run an error")
+    w.add_argument("--video-size", type=_size, default=(640, 360), metavar="WxH",
+                   help="size of the videos in pixels (default 640x360)")
     w.add_argument("--retry-failed", action="store_true", help="run again the runs that were unstable or failed")
     w.add_argument("--force", action="store_true", help="add rows to a table that holds a different sweep's runs")
     w.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -581,8 +587,8 @@ def cmd_sweep(a) -> int:
         b.update(done - b.n)
 
     try:
-        r = sweeps.sweep(a.spec, a.output, workers=a.workers, address=a.address, states=a.states,
-                         retry_failed=a.retry_failed, force=a.force, progress=progress)
+        r = sweeps.sweep(a.spec, a.output, workers=a.workers, address=a.address, states=a.states, video=a.video,
+                         video_size=a.video_size, retry_failed=a.retry_failed, force=a.force, progress=progress)
     except KeyboardInterrupt:
         if a.debug:
             raise

@@ -62,6 +62,11 @@ CONNECT_TIMEOUT = 10.0
 REST_SPEED = 0.01
 RESULTS_NAME = "results.parquet"
 STATES_FOLDER = "states"
+VIDEOS_FOLDER = "videos"
+VIDEO_FORMATS = ("mp4", "gif")
+#: A run's video, in pixels: half of ``deforma run``'s 1280x720, as many videos are drawn on
+#: the workers' CPUs (software OpenGL when there is no GPU).
+VIDEO_SIZE = (640, 360)
 
 _KEY_PATH = re.compile(r"^([A-Za-z_]\w*)(?:\[(\d+)\])?\.([A-Za-z_]\w*)$")
 
@@ -340,8 +345,30 @@ def _largest_speed(world) -> float:
                 if len(v)), default=0.0)
 
 
-def simulate(scene, *, states: bool = False) -> dict:
-    """Run one scene for its ``run.seconds``; the row's status, message and metrics (and the states NPZ bytes).
+class _NoVideo(Exception):
+    """A video was asked for and cannot be drawn here (no OpenGL, no moderngl): the run's error."""
+
+
+def _video_view(world, size):
+    """A headless renderer bound to ``world`` (``deforma run -o``'s), or :class:`_NoVideo` saying why not."""
+    try:
+        from .render import Renderer, WorldView
+    except ImportError as e:
+        raise _NoVideo(f"no video: the renderer needs moderngl ({e}); pip install 'deforma[render]'") from None
+    try:
+        renderer = Renderer.headless(size)
+    except RuntimeError as e:
+        raise _NoVideo("no video: " + " ".join(str(e).split())) from None
+    try:
+        return WorldView(renderer, world)
+    except BaseException:
+        renderer.release()
+        raise
+
+
+def simulate(scene, *, states: bool = False, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
+    """Run one scene for its ``run.seconds``; the row's status, message and metrics (and the states NPZ
+    and video bytes).
 
     Never raises for the simulation's sake: an unstable world is ``status = "unstable"`` with its
     hint, any other exception ``status = "error"`` with its message.
@@ -351,7 +378,15 @@ def simulate(scene, *, states: bool = False) -> dict:
     :data:`REST_SPEED`; NaN if the last frame is not at rest (the bodies never settle, or
     settle and are thrown again). Only frames are looked at, so a bounce that turns exactly
     at the last frame would count as rest there: give a run some time after it settles.
+
+    With ``video`` (``"mp4"`` or ``"gif"``) every frame is also drawn, ``video_size`` pixels, by
+    ``deforma run -o``'s renderer and writer; ``row["video"]`` holds the file's bytes for an
+    ok run. Where no OpenGL context can be made the run is not simulated: ``status = "error"``
+    with a message that starts ``no video:`` and says what to install.
     """
+    import shutil
+    import tempfile
+
     import numpy as np
 
     from .physics import SimulationUnstable
@@ -361,11 +396,17 @@ def simulate(scene, *, states: bool = False) -> dict:
     row = {"status": "ok", "message": "", "hint": "", "steps": 0, "simulated_s": 0.0, "final_energy_j": math.nan,
            "max_spring_strain": math.nan, "time_to_rest_s": math.nan, "centroid": [], "worker": socket.gethostname(),
            "states": None}
-    world = None
+    world = view = writer = folder = None
     try:
         world = scene.build()
         fps = scene.run.fps
         n_frames = max(1, int(round(scene.run.seconds * fps)))
+        if video is not None:
+            from .render import open_writer
+
+            view = _video_view(world, video_size)  # before the simulation: without GL, fail at once
+            folder = Path(tempfile.mkdtemp(prefix="deforma-sweep-"))
+            writer = open_writer(folder / f"video.{video}", fps=fps)
         script = Script(scene, world)
         times, frames, poses = [], [], []
         strain = 0.0
@@ -381,16 +422,30 @@ def simulate(scene, *, states: bool = False) -> dict:
                 times.append(world.time)
                 frames.append([b.positions.copy() for b in world.bodies])
                 poses.append([(*c.center, c.angle) for c in world.colliders])
+            if writer is not None:
+                writer.write(view.draw())
         row["max_spring_strain"] = strain
         row["time_to_rest_s"] = math.nan if resting_since is None else float(resting_since)
         row["final_energy_j"] = float(world.energy().total)
         row["centroid"] = [[float(v) for v in np.mean(b.positions, axis=0)] for b in world.bodies]
         if states:
             row["states"] = _states_bytes(world, scene, times, frames, poses)
+        if writer is not None:
+            writer.close()
+            row["video"] = (folder / f"video.{video}").read_bytes()
     except SimulationUnstable as e:
         row.update(status="unstable", message=str(e), hint=e.hint)
+    except _NoVideo as e:
+        row.update(status="error", message=str(e))
     except Exception as e:  # noqa: BLE001 - a run's failure is a row, never the sweep's crash
         row.update(status="error", message=f"{type(e).__name__}: {e}")
+    finally:
+        if writer is not None:
+            writer.abort()  # no-op after close(); discards the temporary file otherwise
+        if view is not None:
+            view.renderer.release()
+        if folder is not None:
+            shutil.rmtree(folder, ignore_errors=True)
     if world is not None:
         row["steps"] = int(world.step_count)
         row["simulated_s"] = float(world.time)
@@ -411,11 +466,11 @@ def _states_bytes(world, scene, times, frames, poses) -> bytes:
         return path.read_bytes()
 
 
-def _worker_run(scene, states: bool) -> dict:
+def _worker_run(scene, states: bool, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
     # one thread per run: a worker is one of `workers` processes on the node's cores (the runtime
     # environment sets it too; this covers a cluster started without it)
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
-    return simulate(scene, states=states)
+    return simulate(scene, states=states, video=video, video_size=video_size)
 
 
 # -- Ray -------------------------------------------------------------------------------------------
@@ -498,14 +553,15 @@ def _schema(spec: SweepSpec):
         ("status", pa.string()), ("message", pa.string()), ("hint", pa.string()),
         ("wall_s", pa.float64()), ("steps", pa.int64()), ("simulated_s", pa.float64()),
         ("final_energy_j", pa.float64()), ("max_spring_strain", pa.float64()), ("time_to_rest_s", pa.float64()),
-        ("centroid", pa.list_(pa.list_(pa.float64()))), ("states_path", pa.string()), ("worker", pa.string()),
+        ("centroid", pa.list_(pa.list_(pa.float64()))), ("states_path", pa.string()), ("video_path", pa.string()),
+        ("worker", pa.string()),
         ("finished_at", pa.timestamp("s", tz="UTC")), ("parameters", pa.string()),
     ]
     fields += [(k, _column_type(v)) for k, v in spec.parameters.items()]
     return pa.schema(fields)
 
 
-def _row_table(spec: SweepSpec, run: Run, row: dict, states_path: str | None):
+def _row_table(spec: SweepSpec, run: Run, row: dict, states_path: str | None, video_path: str | None = None):
     import datetime
 
     import pyarrow as pa
@@ -516,7 +572,7 @@ def _row_table(spec: SweepSpec, run: Run, row: dict, states_path: str | None):
         "status": row["status"], "message": row["message"], "hint": row["hint"], "wall_s": row["wall_s"],
         "steps": row["steps"], "simulated_s": row["simulated_s"], "final_energy_j": row["final_energy_j"],
         "max_spring_strain": row["max_spring_strain"], "time_to_rest_s": row["time_to_rest_s"],
-        "centroid": row["centroid"], "states_path": states_path,
+        "centroid": row["centroid"], "states_path": states_path, "video_path": video_path,
         "worker": row["worker"], "finished_at": datetime.datetime.now(datetime.timezone.utc),
         "parameters": json.dumps(run.parameters, sort_keys=True),
     }
@@ -557,7 +613,8 @@ def _done(outdir: Path, spec: SweepSpec, *, retry_failed: bool, force: bool) -> 
 
 # -- the sweep -------------------------------------------------------------------------------------
 def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None = None, states: bool = False,
-          retry_failed: bool = False, force: bool = False, progress=None) -> SweepResult:
+          video: str | bool | None = None, video_size=VIDEO_SIZE, retry_failed: bool = False, force: bool = False,
+          progress=None) -> SweepResult:
     r"""Run every run of a sweep file on Ray; one row per run in ``outdir/results.parquet``.
 
     Parameters
@@ -565,8 +622,8 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     spec_path : path
         The sweep file (TOML; see this module's docstring and ``docs/sweeps.md``).
     outdir : path
-        Folder for ``results.parquet`` (a folder of one Parquet part per run) and ``states/``;
-        made if missing.
+        Folder for ``results.parquet`` (a folder of one Parquet part per run), ``states/`` and
+        ``videos/``; made if missing.
     workers : int, keyword-only
         CPUs of the local cluster Ray starts (default: every core); ignored with ``address``.
     address : str, keyword-only
@@ -574,6 +631,12 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
         ``auto``). An unreachable address fails within about 10 s.
     states : bool, keyword-only
         Also write each ok run's ``deforma run --states`` NPZ to ``outdir/states/RUN_ID.npz``.
+    video : {"mp4", "gif"} or bool, keyword-only
+        Also draw each run with ``deforma run -o``'s renderer and write each ok run's video to
+        ``outdir/videos/RUN_ID.mp4`` (or ``.gif``; True means mp4). A worker without OpenGL
+        makes that run an ``error`` row ("no video: ..."), not the sweep's failure.
+    video_size : (int, int), keyword-only
+        Width and height of the videos in pixels (default 640x360).
     retry_failed : bool, keyword-only
         Run again the runs whose rows say ``unstable`` or ``error`` (their rows are replaced).
     force : bool, keyword-only
@@ -610,6 +673,7 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     ...
     deforma.sweeps.SweepError: typo.toml: [parameters]: physics.stifness: unknown key; did you mean 'stiffness'? ...
     """
+    video = _check_video(video, video_size)
     spec = load_spec(spec_path)
     runs = plan(spec)
     outdir = Path(outdir)
@@ -631,6 +695,8 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     (outdir / RESULTS_NAME).mkdir(parents=True, exist_ok=True)
     if states:
         (outdir / STATES_FOLDER).mkdir(exist_ok=True)
+    if video is not None:
+        (outdir / VIDEOS_FOLDER).mkdir(exist_ok=True)
     started = connect(workers=workers, address=address)
     import ray
 
@@ -641,7 +707,7 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     try:
         for run in todo:
             scene = scene_for(spec, run.parameters, source=f"{spec.path.name}: run {run.index} ({run.run_id})")
-            pending[remote.remote(scene, states)] = run
+            pending[remote.remote(scene, states, video, tuple(video_size))] = run
         finished = len(runs) - len(todo)
         while pending:
             ready, _ = ray.wait(list(pending), num_returns=1)
@@ -658,7 +724,11 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
                 target = outdir / STATES_FOLDER / f"{run.run_id}.npz"
                 _write_atomic(target, lambda f, data=row["states"]: f.write(data))
                 states_path = f"{STATES_FOLDER}/{run.run_id}.npz"
-            table = _row_table(spec, run, row, states_path)
+            video_path = None
+            if row.get("video") is not None:
+                video_path = f"{VIDEOS_FOLDER}/{run.run_id}.{video}"
+                _write_atomic(outdir / video_path, lambda f, data=row["video"]: f.write(data))
+            table = _row_table(spec, run, row, states_path, video_path)
             _write_part(outdir / RESULTS_NAME / f"part-{run.run_id}.parquet", table, _write_atomic)
             counts[row["status"]] += 1
             finished += 1
@@ -673,6 +743,22 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
         if started:
             ray.shutdown()
     return result()
+
+
+def _check_video(video, size):
+    """``video`` as "mp4", "gif" or None, and the size checked; SweepError otherwise."""
+    if video is True:
+        video = "mp4"
+    elif video is False:
+        video = None
+    if video is not None and video not in VIDEO_FORMATS:
+        raise SweepError(f"video: expected one of {', '.join(VIDEO_FORMATS)} (or True for mp4), got {video!r}")
+    ok = (isinstance(size, (tuple, list)) and len(size) == 2
+          and all(isinstance(v, int) and not isinstance(v, bool) for v in size))
+    if not ok or not (16 <= size[0] <= 7680 and 16 <= size[1] <= 4320):
+        raise SweepError(f"video_size: expected (width, height) in pixels, width in [16, 7680] and height in "
+                         f"[16, 4320], got {size!r}")
+    return video
 
 
 def _write_part(path: Path, table, write_atomic) -> None:
