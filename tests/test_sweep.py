@@ -230,10 +230,10 @@ def test_a_sweep_stopped_half_way_with_ctrl_c_and_restarted_completes_without_du
                           ray.get_runtime_context().gcs_address, "--quiet"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        deadline = time.perf_counter() + 60
+        deadline = time.perf_counter() + 300  # a worker with a cold Numba cache compiles for a minute or more
         while not list(parts.glob("part-*.parquet")):
             assert p.poll() is None, p.communicate()
-            assert time.perf_counter() < deadline, "no run finished within 60 s"
+            assert time.perf_counter() < deadline, "no run finished within 300 s"
             time.sleep(0.02)
         p.send_signal(signal.SIGINT)
         _, err = p.communicate(timeout=30)
