@@ -92,3 +92,14 @@ def test_seconds_since_process_start_counts_the_interpreter_start():
     age = startup.seconds_since_process_start()
     # this test process imported pytest, numpy and deforma first: well over 0.1 s
     assert 0.1 < age < 24 * 3600
+
+
+def test_a_run_without_a_terminal_does_not_import_tqdm(tmp_path):
+    """tqdm draws only on a terminal; importing it anyway cost 65 ms of every start-up."""
+    import subprocess
+
+    code = ("import sys; from deforma.cli import main; "
+            f"code = main(['run', 'sample', '--seconds', '0.05', '-o', {str(tmp_path) + '/'!r}]); "
+            "print(code, 'tqdm' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert out.stdout.split()[-2:] == ["0", "False"], out.stderr
