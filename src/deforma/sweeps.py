@@ -16,7 +16,8 @@ Every run's scene is the base scene's TOML with the run's values set at their ke
 by the scene loader's own validation (:func:`deforma.scene.parse_scene`) before anything
 runs. Each run gets a stable id, a status (``ok``, ``unstable`` with the hint, ``error`` with
 the message), metrics, and one row in ``OUTDIR/results.parquet``, a folder of Parquet parts
-(one per finished run, written atomically) that pyarrow and pandas read as one table.
+(one per finished run, written atomically) that pyarrow and pandas read as one table; on
+request also its states (``OUTDIR/states/``) and a video (``OUTDIR/videos/``).
 
 ``docs/sweeps.md`` describes the table and how to point a sweep at a cluster.
 
