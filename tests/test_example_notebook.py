@@ -85,11 +85,13 @@ def test_the_mesh_and_the_world_show_pictures(executed):
     assert max(w, h) == 400 and colours > 50  # the bunny's texture colours, not a blank
     assert "Mesh(" in rich(outputs_of(nb, "bunny = deforma.mesh.from_image"), "text/plain")
     before = rich(outputs_of(nb, "world.add_body"), "image/png")
+    shown = rich(outputs_of(nb, "as it was"), "image/png")
     after = rich(outputs_of(nb, "two seconds later"), "image/png")
-    for data in (before, after):
+    for data in (before, shown, after):
         (w, h), colours = png_size(data)
         assert max(w, h) == 400 and colours > 50
-    assert before != after  # show stepped the world: the bunny moved
+    assert shown == before  # show simulated a copy: the world is where it was
+    assert after != before  # world.step() moved it: the bunny fell
 
 
 @pytest.mark.parametrize("needle", ["deforma.show(world", "demo = deforma.show"])

@@ -32,7 +32,7 @@ class WorldView:
         The world whose scene gives the bodies' and colliders' looks (colours, textures), body
         by body and collider by collider, when ``world`` is a copy of it
         (``copy.deepcopy``): a copy is not the world its scene was built into. Default:
-        ``world``.
+        the world shown (``world``, or whatever world the attribute ``world`` is set to later).
 
     Examples
     --------
@@ -53,8 +53,8 @@ class WorldView:
 
         self.renderer = renderer
         self.world = world
-        self._looks_from = world if looks_from is None else looks_from
-        self.scene = scene if scene is not None else scene_of(self._looks_from)
+        self.looks_from = looks_from
+        self.scene = scene if scene is not None else scene_of(self._looks())
         cam = self.scene.camera
         renderer.camera = Camera(cam.center, cam.size)
         renderer.background_top = _as_rgba(cam.background[0])[:3]
@@ -72,7 +72,7 @@ class WorldView:
         from ..scene import load_texture, scene_of
 
         try:
-            current = scene_of(self._looks_from)
+            current = scene_of(self._looks())
         except AttributeError:
             # a collider shape the scene format cannot describe (yet): the colliders are then
             # drawn in the default colour; the bodies' looks still need the scene below
@@ -84,7 +84,7 @@ class WorldView:
         if [(id(b), id(b.topology)) for b in bodies] == self._shown:
             return
         if current is None:
-            current = scene_of(self._looks_from)  # raises what the scene could not describe
+            current = scene_of(self._looks())  # raises what the scene could not describe
         for h in self._handles:
             self.renderer.remove_mesh(h)
         self._handles = []
@@ -105,6 +105,11 @@ class WorldView:
         self._bodies = bodies
         self._shown = [(id(b), id(b.topology)) for b in bodies]  # a torn body has a new topology
         self._topologies = [b.topology for b in bodies]
+
+    def _looks(self):
+        # the world whose scene gives the looks: the one shown unless told otherwise, so that a
+        # view given another world (the viewer's, when a scene is loaded) takes that world's
+        return self.world if self.looks_from is None else self.looks_from
 
     def draw(self, *, read: bool = True):
         """Paint the world's current state; returns the picture (H, W, 3) uint8 when ``read``.
