@@ -82,15 +82,13 @@ class Body:
         from ..mesh import Mesh
 
         t, src = self.topology, cut.source
-        rest = t.rest_positions[src]
-        tri = cut.triangles
-        share = (np.full(t.n_vertices, 1.0 / t.n_vertices) if t.mass_share is None else t.mass_share)[src]
-        share = share * cut.mass_share
-        edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])  # from_arrays dedups
-        self.topology = BodyTopology.from_arrays(rest, edges, tri, mass_share=share)
+        tear = self._tear_topology[1] if self._tear_topology is not None and self._tear_topology[0] is t \
+            else _tearing.TearTopology.of(t.rest_positions, t.triangles)
+        self.topology, tt = _tearing.torn_topologies(t, tear, cut)
+        self._tear_topology = (self.topology, tt)  # the tear check's view of the torn mesh, kept
         uv = getattr(self.mesh, "uv", None)
         if uv is not None and len(uv) == t.n_vertices:
-            self.mesh = Mesh._trusted(rest, tri, np.asarray(uv)[src], getattr(self.mesh, "texture", None))
+            self.mesh = Mesh._trusted(t.rest_positions[src], cut.triangles, np.asarray(uv)[src], getattr(self.mesh, "texture", None))
         self._pinned = self._pinned[src]
         self._tear_source = src
         self._overrides["pressure"] = None  # the gas escapes through the tear

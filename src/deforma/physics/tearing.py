@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from .elements import _gradient, rest_geometry
+from .model import stable_order
 from .strain import spring_strains
 
 
@@ -87,6 +88,8 @@ class TearTopology:
         ``low * N + high`` of each edge (sorted: the lookup of :meth:`edge`).
     vertex_ptr, vertex_tris : (N + 1,), (3M,) int64
         The triangles around vertex ``v``: ``vertex_tris[vertex_ptr[v]:vertex_ptr[v + 1]]``.
+    tri_edge : (M, 3) int64
+        Index in ``pairs`` of each triangle's edges: corners 0-1, 1-2 and 2-0.
     """
 
     triangles: np.ndarray
@@ -100,45 +103,82 @@ class TearTopology:
     keys: np.ndarray
     vertex_ptr: np.ndarray
     vertex_tris: np.ndarray
+    tri_edge: np.ndarray
 
     @classmethod
-    def of(cls, rest, tris) -> "TearTopology":
-        """Build from rest positions (N, 2) and counter-clockwise triangles (M, 3)."""
+    def of(cls, rest, tris, b=None, area=None) -> "TearTopology":
+        """Build from rest positions (N, 2) and counter-clockwise triangles (M, 3).
+
+        ``b`` and ``area``: the triangles' rest geometry when already known (a torn mesh keeps
+        its triangles, in order, with corners at the same rest positions, so its geometry is
+        the mesh's before the tear; :func:`rest_geometry` otherwise).
+        """
         rest = np.asarray(rest, dtype=np.float64)
         t = np.asarray(tris, dtype=np.int64)
         n = len(rest)
-        half = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
-        owner = np.tile(np.arange(len(t)), 3)
-        lo, hi = half.min(axis=1), half.max(axis=1)
-        keys = lo * n + hi
-        order = np.argsort(keys, kind="stable")
-        keys, owner, lo, hi = keys[order], owner[order], lo[order], hi[order]
-        first = np.ones(len(keys), bool)
-        first[1:] = keys[1:] != keys[:-1]
-        start = np.flatnonzero(first)
-        two = np.diff(np.append(start, len(keys))) == 2
-        pairs = np.stack([lo[start], hi[start]], axis=1)
-        tri_pair = np.full((len(start), 2), -1, np.int64)
-        tri_pair[:, 0] = owner[start]
-        tri_pair[two, 1] = owner[start[two] + 1]
+        keys, pairs, tri_pair, two, half_edge = edge_table(n, t)
         boundary = np.zeros(n, bool)
         boundary[pairs[~two].ravel()] = True
         inner = np.flatnonzero(two)
         d = rest[pairs[inner, 1]] - rest[pairs[inner, 0]]
         normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]
-        b, area = rest_geometry(rest, t)
-        # the triangles around each vertex (CSR)
-        corner = t.ravel()
-        order = np.argsort(corner, kind="stable")
+        if b is None or area is None:
+            b, area = rest_geometry(rest, t)
+        # the triangles around each vertex (CSR), in triangle order
         ptr = np.zeros(n + 1, np.int64)
-        np.cumsum(np.bincount(corner, minlength=n), out=ptr[1:])
-        return cls(t, pairs, tri_pair, inner, boundary, b, area, np.ascontiguousarray(normal),
-                   pairs[:, 0] * n + pairs[:, 1], ptr, order // 3)
+        np.cumsum(np.bincount(t.ravel(), minlength=n), out=ptr[1:])
+        return cls(t, pairs, tri_pair, inner, boundary, b, area, np.ascontiguousarray(normal), keys, ptr,
+                   stable_order(t.ravel(), n) // 3, np.ascontiguousarray(half_edge.reshape(3, -1).T))
 
     def edge(self, a: int, b: int) -> int:
         """Index of edge ``(a, b)`` in ``pairs``."""
         n = len(self.boundary)
         return int(np.searchsorted(self.keys, min(a, b) * n + max(a, b)))
+
+    def torn(self, rest, cut: "Tear") -> "TearTopology":
+        """The topology of the torn mesh ``cut`` (rest positions ``rest``, (N', 2)): its
+        triangles' rest geometry is this mesh's (same triangles, same rest corners)."""
+        return TearTopology.of(rest, cut.triangles, self.b, self.area)
+
+
+def edge_table(n: int, t):
+    """Every edge of triangles ``t`` (M, 3) over ``n`` vertices once, with its triangles.
+
+    Returns
+    -------
+    keys : (E,) int64
+        ``low * n + high`` of each edge, sorted.
+    pairs : (E, 2) int64
+        ``(low, high)`` of each edge, in that order.
+    tri_pair : (E, 2) int64
+        The triangles on either side (the lower-numbered first; ``-1`` for the second on
+        the outline).
+    two : (E,) bool
+        Interior edges (two triangles).
+    half_edge : (3M,) int64
+        Edge of each half-edge, in the order ``t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]``.
+    """
+    t = np.asarray(t, dtype=np.int64)
+    # half-edge h = k * M + f runs from corner k of triangle f to corner k + 1 (columns, not
+    # rows: a reduction along rows of two is several times slower)
+    head = t.T.ravel()
+    tail = t[:, [1, 2, 0]].T.ravel()
+    lo, hi = np.minimum(head, tail), np.maximum(head, tail)
+    keys = lo * n + hi
+    order = stable_order(keys, n * n)
+    keys, lo, hi = keys[order], lo[order], hi[order]
+    owner = order % max(len(t), 1)
+    first = np.ones(len(keys), bool)
+    first[1:] = keys[1:] != keys[:-1]
+    start = np.flatnonzero(first)
+    two = np.diff(np.append(start, len(keys))) == 2
+    pairs = np.stack([lo[start], hi[start]], axis=1)
+    tri_pair = np.full((len(start), 2), -1, np.int64)
+    tri_pair[:, 0] = owner[start]
+    tri_pair[two, 1] = owner[start[two] + 1]
+    half_edge = np.empty(len(keys), np.int64)
+    half_edge[order] = np.cumsum(first) - 1
+    return keys[start], pairs, tri_pair, two, half_edge
 
 
 @njit(cache=True)
@@ -225,65 +265,139 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None):
         return None
     # strongest first; a cut must touch the outline to open, and each vertex takes one cut per
     # step (a crack advances an edge at a time, so the stress can move to its new tip)
-    used = np.zeros(n, bool)
-    cut = []
-    for e in inner[over[np.argsort(-strain[over], kind="stable")]]:
-        a, b = topo.pairs[e]
-        if used[a] or used[b] or not (topo.boundary[a] or topo.boundary[b]):
-            continue
-        used[a] = used[b] = True
-        cut.append(int(e))
-    if not cut:
+    cut = _choose_cuts(inner[over[np.argsort(-strain[over], kind="stable")]], topo.pairs, topo.boundary, n)
+    if not len(cut):
         return None
-    is_cut = np.zeros(len(topo.pairs), bool)
+    is_cut = np.zeros(len(topo.pairs), np.bool_)
     is_cut[cut] = True
-    new_t = t.copy()
-    source = list(range(n))
-    share = [1.0] * n
-    for v in np.unique(topo.pairs[cut].ravel()):
-        groups = _fans(topo, int(v), is_cut)
-        if len(groups) < 2:
-            continue
-        total = sum(topo.area[f] for g in groups for f in g)
-        for k, members in enumerate(groups):
-            part = sum(topo.area[f] for f in members) / total
-            if k == 0:
-                share[v] = part
-                continue
-            copy = len(source)
-            source.append(int(v))
-            share.append(part)
-            for f in members:
-                new_t[f][new_t[f] == v] = copy
+    new_t, source, share = _split_vertices(t, topo.tri_edge, topo.tri_pair, is_cut, topo.vertex_ptr,
+                                           topo.vertex_tris, topo.area, np.unique(topo.pairs[cut].ravel()), n)
     if len(source) == n:
         return None
-    return Tear(new_t.astype(np.int32), np.array(source, np.int64), np.array(share),
-                topo.pairs[cut].astype(np.int32))
+    return Tear(new_t.astype(np.int32), source, share, topo.pairs[cut].astype(np.int32))
 
 
-def _fans(topo: TearTopology, v: int, is_cut) -> list[list[int]]:
-    """The triangles around vertex ``v`` grouped into fans joined across uncut edges."""
-    t = topo.triangles
-    fan = [int(f) for f in topo.vertex_tris[topo.vertex_ptr[v]:topo.vertex_ptr[v + 1]]]
-    parent = {f: f for f in fan}
+@njit(cache=True)
+def _choose_cuts(candidates, pairs, boundary, n):
+    """Edges to cut, from ``candidates`` (strongest first): one touching the outline, and no
+    vertex in two cuts this step."""
+    used = np.zeros(n, np.bool_)
+    out = np.empty(len(candidates), np.int64)
+    c = 0
+    for e in candidates:
+        a, b = pairs[e, 0], pairs[e, 1]
+        if used[a] or used[b] or not (boundary[a] or boundary[b]):
+            continue
+        used[a] = True
+        used[b] = True
+        out[c] = e
+        c += 1
+    return out[:c]
 
-    def find(f):
-        while parent[f] != f:
-            parent[f] = parent[parent[f]]
-            f = parent[f]
-        return f
-    for f in fan:
-        for w in t[f]:
-            if w == v:
+
+@njit(cache=True)
+def _root(parent, a):
+    while parent[a] != a:
+        parent[a] = parent[parent[a]]
+        a = parent[a]
+    return a
+
+
+@njit(cache=True)
+def _split_vertices(tris, tri_edge, tri_pair, is_cut, vertex_ptr, vertex_tris, area, verts, n):
+    """Split each vertex of ``verts`` into one copy per fan (triangles around it joined across
+    uncut edges): ``(triangles, source, mass share)`` of the torn mesh.
+
+    The first fan (in triangle order) keeps the vertex, each other fan gets a copy appended
+    after the ``n`` vertices, vertex by vertex; a copy's share of the vertex's mass is its
+    fan's area over the area of all its fans (summed fan by fan, triangle by triangle).
+    """
+    new_t = tris.copy()
+    cap = n
+    for v in verts:
+        cap += vertex_ptr[v + 1] - vertex_ptr[v]
+    source = np.empty(cap, np.int64)
+    share = np.ones(cap)
+    for i in range(n):
+        source[i] = i
+    m = n
+    for v in verts:
+        p0 = vertex_ptr[v]
+        k = vertex_ptr[v + 1] - p0
+        parent = np.arange(k)
+        for a in range(k):
+            f = vertex_tris[p0 + a]
+            for c in range(3):
+                if tris[f, c] != v:
+                    continue
+                for e in (tri_edge[f, c], tri_edge[f, (c + 2) % 3]):  # the two edges at v
+                    g = tri_pair[e, 1] if tri_pair[e, 0] == f else tri_pair[e, 0]
+                    if g < 0 or is_cut[e]:
+                        continue
+                    for q in range(k):
+                        if vertex_tris[p0 + q] == g:
+                            parent[_root(parent, a)] = _root(parent, q)
+                            break
+        # fans numbered in order of their first triangle
+        label = np.empty(k, np.int64)
+        fan_of_root = np.full(k, -1, np.int64)
+        fans = 0
+        for a in range(k):
+            r = _root(parent, a)
+            if fan_of_root[r] < 0:
+                fan_of_root[r] = fans
+                fans += 1
+            label[a] = fan_of_root[r]
+        if fans < 2:
+            continue
+        total = 0.0
+        for g in range(fans):
+            for a in range(k):
+                if label[a] == g:
+                    total += area[vertex_tris[p0 + a]]
+        for g in range(fans):
+            part = 0.0
+            for a in range(k):
+                if label[a] == g:
+                    part += area[vertex_tris[p0 + a]]
+            part = part / total
+            if g == 0:
+                share[v] = part
                 continue
-            e = topo.edge(v, int(w))
-            g = int(topo.tri_pair[e, 1] if topo.tri_pair[e, 0] == f else topo.tri_pair[e, 0])
-            if g >= 0 and not is_cut[e]:
-                parent[find(f)] = find(g)
-    groups = {}
-    for f in fan:
-        groups.setdefault(find(f), []).append(f)
-    return list(groups.values())
+            source[m] = v
+            share[m] = part
+            for a in range(k):
+                if label[a] == g:
+                    f = vertex_tris[p0 + a]
+                    for c in range(3):
+                        if new_t[f, c] == v:
+                            new_t[f, c] = m
+            m += 1
+    return new_t, source[:m], share[:m]
+
+
+def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
+    """A torn body's new ``(BodyTopology, TearTopology)`` from its old ones and the tear ``cut``.
+
+    The same arrays as ``BodyTopology.from_arrays(rest, edges of the triangles, triangles,
+    mass_share=...)`` and ``TearTopology.of(rest, triangles)`` of the torn mesh, made from one
+    edge table and the triangles' rest geometry before the tear (a torn mesh keeps its
+    triangles in order, with corners at the same rest positions, so none of them turns or
+    changes shape): no validation, no second sort.
+    """
+    from .model import BodyTopology
+
+    src = cut.source
+    rest = topology.rest_positions[src]
+    n = topology.n_vertices
+    share = (np.full(n, 1.0 / n) if topology.mass_share is None else topology.mass_share)[src]
+    share = share * cut.mass_share
+    tt = tear_topology.torn(rest, cut)
+    t = cut.triangles
+    half = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    outline = tt.tri_pair[tt.tri_edge.T.ravel(), 1] < 0  # half-edges in one triangle
+    body = BodyTopology._trusted(rest, tt.pairs, t, half[outline], mass_share=share, geometry=(tt.b, tt.area))
+    return body, tt
 
 
 def snap_springs(x, springs, rest_length, tear_strain):
