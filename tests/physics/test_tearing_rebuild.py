@@ -12,7 +12,7 @@ import pytest
 
 import deforma
 from deforma.physics import tearing
-from deforma.physics.model import BodyTopology, Model, element_geometry, stable_order
+from deforma.physics.model import BodyTopology, Model, element_geometry, lengths, stable_order
 
 BODY_FIELDS = ("rest_positions", "springs", "spring_rest_length", "triangles", "boundary_edges",
                "boundary_vertices", "boundary_clearance", "mass_share")
@@ -184,3 +184,9 @@ def test_stable_order_is_numpys_stable_argsort():
         keys = rng.integers(0, n, m)
         assert same(stable_order(keys, n), np.argsort(keys, kind="stable"))
     assert same(stable_order(np.array([3, 1, 3, 0]), 2 ** 62), np.array([3, 1, 0, 2]))  # too big: argsort
+
+
+def test_lengths_are_numpys_norm():
+    x = np.random.default_rng(4).normal(size=(500, 2)) * [1e-3, 1e3]
+    i, j = np.arange(499), np.arange(1, 500)
+    assert same(lengths(x, i, j), np.linalg.norm(x[j] - x[i], axis=1))

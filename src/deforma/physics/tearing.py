@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit
 
 from .elements import _gradient, rest_geometry
-from .model import stable_order
+from .model import lengths, stable_order
 from .strain import spring_strains
 
 
@@ -120,8 +120,11 @@ class TearTopology:
         boundary = np.zeros(n, bool)
         boundary[pairs[~two].ravel()] = True
         inner = np.flatnonzero(two)
-        d = rest[pairs[inner, 1]] - rest[pairs[inner, 0]]
-        normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]
+        a, c = pairs[inner, 0], pairs[inner, 1]
+        length = lengths(rest, a, c)
+        normal = np.empty((len(inner), 2))
+        normal[:, 0] = -(rest[c, 1] - rest[a, 1]) / length  # (-dy, dx) / length
+        normal[:, 1] = (rest[c, 0] - rest[a, 0]) / length
         if b is None or area is None:
             b, area = rest_geometry(rest, t)
         # the triangles around each vertex (CSR), in triangle order
