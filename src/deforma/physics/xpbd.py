@@ -34,8 +34,11 @@ from its predicted push (the collider rule's impulse): stuck, its tangential mot
 substep began is undone in every sweep; sliding, each sweep holds it back by ``friction``
 times that sweep's push. Body contacts are found for the predicted motion by the contact
 stage's own broad and narrow phase (:func:`~deforma.physics.contacts.detect_contacts`) and
-projected as the stage projects them. The full collider response and contact stage still
-run after the sweep.
+projected as the stage projects them, with the same position-level friction as colliders
+(stick or slide decided by the first sweep; :func:`~deforma.physics.contacts.project_contacts`):
+without it a stack of soft boxes slid apart, since the contact stage after the sweep sees a
+resting pair that no longer approaches and applies no friction. The full collider response
+and contact stage still run after the sweep.
 
 One Gauss-Seidel sweep per substep (``iterations = 1``, the "small steps" choice) carries
 a correction across about one spring per substep against the sweep order (and across the
@@ -169,6 +172,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         n_body = detect_contacts(x, ctopo, cscr, cbuf)  # of the predicted motion
         if n_body < 0:
             return 0  # the contact buffer is too small; the world grows it and repeats the step
+        stick = np.full(n_body, -1.0)  # the body contacts' stick or slide: not decided yet
         for _ in range(iterations):
             # collider contacts first, so that the springs carry their support through the sweep
             for k in range(count):
@@ -191,7 +195,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
                     slide = min(abs(slide), planes[k, 4] * push) * (1.0 if slide > 0.0 else -1.0)
                 x[i, 0] += push * nx - slide * ny
                 x[i, 1] += push * ny + slide * nx
-            project_contacts(x, inv_mass, ctopo, cbuf, n_body)
+            project_contacts(x, x_prev, inv_mass, ctopo, cbuf, n_body, stick)
             for e in range(spring_i.shape[0]):
                 i = np.uint64(spring_i[e])
                 j = np.uint64(spring_j[e])
