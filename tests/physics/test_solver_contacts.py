@@ -127,9 +127,10 @@ def oblique_hit(name, mu, *, on_body):
 @pytest.mark.parametrize("name", ["symplectic-euler", "xpbd"])
 def test_an_oblique_hit_on_another_body_loses_sideways_speed_to_friction_as_on_a_collider(name):
     # XPBD's sweep projected body contacts without friction, and the contact stage after it
-    # sees a pair the sweep already separated, so body-on-body impacts were frictionless
-    # (3.0 m/s kept at mu = 1; on a collider 2.2 m/s). Now the sweep's position-level
-    # friction acts on body contacts as on colliders (2.25 m/s).
+    # sees a pair the sweep already separated: where the sweep does the separating (here a
+    # plank of two triangles, whose contact thickness is 10 cm, so the pair is projected from
+    # 5 cm away) the hit was frictionless (3.0 m/s kept at mu = 1; on a collider 2.2 m/s).
+    # Now the sweep's position-level friction acts on body contacts as on colliders (2.25 m/s).
     assert oblique_hit(name, 0.0, on_body=True) == pytest.approx(3.0, abs=1e-6)  # frictionless: kept
     on_body, on_collider = oblique_hit(name, 1.0, on_body=True), oblique_hit(name, 1.0, on_body=False)
     assert on_body < 2.6 and on_collider < 2.6, (on_body, on_collider)
