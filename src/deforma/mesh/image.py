@@ -57,7 +57,6 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 from PIL import Image, UnidentifiedImageError
-from scipy import ndimage
 
 from ..checks import positive
 from . import quality
@@ -230,6 +229,8 @@ def from_image(
             outline_field, outline_level = np.where(mask, 255.0, 0.0), 127.5
         rings = _outline_rings(outline_field, outline_level, e)
         margin = max(0.5 * r, 0.5 * e + 1.0)
+        from scipy import ndimage  # here, not at import: 0.3 s that a box-only run never needs
+
         depth = ndimage.distance_transform_edt(mask) - 0.5  # ~distance to the contour
         rows, cols = np.nonzero(grid & (depth >= margin))
         interior = np.c_[cols + 0.5, rows + 0.5]
@@ -665,6 +666,8 @@ _OUTLINE_TOLERANCE = 0.5  # pixels: how far an outline segment may stray from th
 
 
 def _clean(mask):
+    from scipy import ndimage
+
     labels, n = ndimage.label(mask)
     if n:
         sizes = np.bincount(labels.ravel())
@@ -684,6 +687,8 @@ def _clean(mask):
 
 
 def _boundary_pixel_count(mask):
+    from scipy import ndimage
+
     return int((mask & ~ndimage.binary_erosion(mask, border_value=0)).sum())
 
 

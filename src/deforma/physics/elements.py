@@ -26,12 +26,16 @@ Units: m, s, kg, Pa (N/m per metre of thickness), J.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import scipy.sparse as sp
 from numba import njit
 
 from . import corotated, neo_hookean
 from .material import KIND_COROTATED
+
+if TYPE_CHECKING:  # SciPy's sparse matrices are imported where built: only implicit Euler needs them
+    import scipy.sparse as sp
 
 
 def rest_geometry(x, tris):
@@ -143,6 +147,8 @@ def element_matrix(tris, b, weight, n) -> sp.csc_matrix:
     >>> element_matrix([[0, 1, 2]], b, np.ones(1), 3).toarray().tolist()
     [[2.0, -1.0, -1.0], [-1.0, 1.0, 0.0], [-1.0, 0.0, 1.0]]
     """
+    import scipy.sparse as sp
+
     t = np.asarray(tris, dtype=np.int64)
     bb = np.asarray(b).reshape(-1, 2, 2)
     d = np.stack([-bb[:, 0] - bb[:, 1], bb[:, 0], bb[:, 1]], axis=1)

@@ -59,15 +59,18 @@ Units: m, m/s, kg, N/m, N*s/m, s.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from numba import njit
 
 from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start
 from .elements import element_matrix, implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
+
+if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
+    import scipy.sparse as sp
 
 
 @njit(cache=True)
@@ -250,6 +253,8 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None) -> sp.csc_ma
     >>> system_matrix(m, np.full(2, -1, np.int32), np.zeros((0, 3)), 0.1).toarray().round(9).tolist()
     [[2.0, -1.0], [-1.0, 2.0]]
     """
+    import scipy.sparse as sp
+
     n = model.n_vertices
     w = h * h * model.spring_stiffness + h * model.spring_damping
     i, j = model.spring_i, model.spring_j
@@ -273,6 +278,8 @@ def pin_rows(a, pinned) -> sp.csc_matrix:
     their coupling to it, so that it acts on them as a known position."""
     if not pinned.any():
         return a
+    import scipy.sparse as sp
+
     free = sp.diags((~pinned).astype(np.float64))
     return (free @ a + sp.diags(pinned.astype(np.float64))).tocsc()
 
@@ -351,6 +358,9 @@ class ImplicitEuler:
         if self._touching is not None and self._weight_used == self.contact_weight \
                 and np.array_equal(self._touching, touching) and np.array_equal(self._triples, triples):
             return
+        import scipy.sparse as sp
+        import scipy.sparse.linalg as spla
+
         self._weight_used = self.contact_weight
         self._touching = touching.copy()
         self._triples = triples.copy()
