@@ -190,3 +190,18 @@ def test_lengths_are_numpys_norm():
     x = np.random.default_rng(4).normal(size=(500, 2)) * [1e-3, 1e3]
     i, j = np.arange(499), np.arange(1, 500)
     assert same(lengths(x, i, j), np.linalg.norm(x[j] - x[i], axis=1))
+
+
+def test_clearance_through_a_grid_equals_rest_clearance():
+    from deforma.physics.contacts import rest_clearance
+    from deforma.physics.model import _clearance
+
+    # a wiggly ring, flattened: many vertices close to edges across from them
+    rng = np.random.default_rng(5)
+    for count in (700, 3000):
+        angle = np.sort(rng.uniform(0, 2 * np.pi, count))
+        radius = 1.0 + 0.05 * rng.standard_normal(count)
+        x = np.stack([radius * np.cos(angle), 0.5 * radius * np.sin(angle)], axis=1)
+        edges = np.stack([np.arange(count), (np.arange(count) + 1) % count], axis=1).astype(np.int32)
+        for reach in (0.01, 0.05, 0.5):
+            assert same(_clearance(x, edges, reach), rest_clearance(x, edges, reach))
