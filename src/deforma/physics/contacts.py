@@ -831,7 +831,8 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
 
 
 @njit(cache=True)
-def _find(parent, k):
+def find_root(parent, k):
+    """The root of ``k`` in the union-find forest ``parent``, halving the path on the way."""
     while parent[k] != k:
         parent[k] = parent[parent[k]]
         k = parent[k]
@@ -890,9 +891,9 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
                     parent[q] = q
                     zl[nz] = q
                     nz += 1
-            k = _find(parent, o_vertex[c])
+            k = find_root(parent, o_vertex[c])
             for q in (ce_a[o_edge[c]], ce_b[o_edge[c]]):
-                r = _find(parent, q)
+                r = find_root(parent, q)
                 if r != k:
                     parent[r] = k
         # zone sums: m vx, m vy, m, members, still (1: a pinned member, 2: pushed into a collider)
@@ -900,7 +901,7 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
             zone[zl[m], :] = 0.0
         for m in range(nz):
             k = zl[m]
-            r = _find(parent, k)
+            r = find_root(parent, k)
             i = cv[k]
             zone[r, 3] += 1.0
             if inv_mass[i] == 0.0:
@@ -914,7 +915,7 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
         frozen = False
         for m in range(nz):
             k = zl[m]
-            r = _find(parent, k)
+            r = find_root(parent, k)
             i = cv[k]
             vx = 0.0
             vy = 0.0
@@ -932,7 +933,7 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
         if frozen:  # a zone pushed into a collider stays where it started (outside, like every start)
             for m in range(nz):
                 k = zl[m]
-                if zone[_find(parent, k), 4] == 2.0:
+                if zone[find_root(parent, k), 4] == 2.0:
                     i = cv[k]
                     v[i, 0] = 0.0
                     v[i, 1] = 0.0
@@ -1191,26 +1192,33 @@ def rest_clearance(x, edges, reach):
     """
     out = np.full(x.shape[0], np.inf)
     for p in range(x.shape[0]):
-        px, py = x[p, 0], x[p, 1]
         for j in range(edges.shape[0]):
-            a = edges[j, 0]
-            b = edges[j, 1]
-            if a == p or b == p:
-                continue
-            ax, ay, bx, by = x[a, 0], x[a, 1], x[b, 0], x[b, 1]
-            if px < min(ax, bx) - reach or px > max(ax, bx) + reach or py < min(ay, by) - reach \
-                    or py > max(ay, by) + reach:
-                continue
-            ex = bx - ax
-            ey = by - ay
-            l2 = ex * ex + ey * ey
-            s = ((px - ax) * ex + (py - ay) * ey) / l2
-            if s < 0.0 or s > 1.0:
-                continue
-            d = ((px - ax) * ey - (py - ay) * ex) / math.sqrt(l2)
-            if 0.0 <= d < out[p]:
-                out[p] = d
+            clear_against(x, p, edges[j, 0], edges[j, 1], reach, out)
     return out
+
+
+@njit(cache=True, inline="always")
+def clear_against(x, p, a, b, reach, out):
+    """Lower ``out[p]`` to vertex ``p``'s distance in front of the edge ``a -> b`` (the body on
+    its left) if ``p`` is not one of its ends, lies within ``reach`` of its box and its foot
+    falls on the edge: the one test of :func:`rest_clearance` and its grid version
+    (``deforma.physics.model``)."""
+    if a == p or b == p:
+        return
+    px, py = x[p, 0], x[p, 1]
+    ax, ay, bx, by = x[a, 0], x[a, 1], x[b, 0], x[b, 1]
+    if px < min(ax, bx) - reach or px > max(ax, bx) + reach or py < min(ay, by) - reach \
+            or py > max(ay, by) + reach:
+        return
+    ex = bx - ax
+    ey = by - ay
+    l2 = ex * ex + ey * ey
+    s = ((px - ax) * ex + (py - ay) * ey) / l2
+    if s < 0.0 or s > 1.0:
+        return
+    d = ((px - ax) * ey - (py - ay) * ex) / math.sqrt(l2)
+    if 0.0 <= d < out[p]:
+        out[p] = d
 
 
 @dataclass(frozen=True)

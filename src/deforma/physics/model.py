@@ -14,14 +14,13 @@ pascals (Lamé parameters), seconds (element damping).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from .elements import rest_geometry
-from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology, rest_clearance
+from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology, clear_against, rest_clearance
 
 
 def lengths(x, i, j) -> np.ndarray:
@@ -277,25 +276,8 @@ def _clearance_grid(x, edges, reach, size):
         px, py = x[p, 0], x[p, 1]
         c = int(np.floor((px - lo0) / size)) * ny + int(np.floor((py - lo1) / size))
         for k in range(ptr[c], ptr[c + 1]):
-            # from here on as in rest_clearance
             j = cell_edges[k]
-            a = edges[j, 0]
-            b = edges[j, 1]
-            if a == p or b == p:
-                continue
-            ax, ay, bx, by = x[a, 0], x[a, 1], x[b, 0], x[b, 1]
-            if px < min(ax, bx) - reach or px > max(ax, bx) + reach or py < min(ay, by) - reach \
-                    or py > max(ay, by) + reach:
-                continue
-            ex = bx - ax
-            ey = by - ay
-            l2 = ex * ex + ey * ey
-            t = ((px - ax) * ex + (py - ay) * ey) / l2
-            if t < 0.0 or t > 1.0:
-                continue
-            d = ((px - ax) * ey - (py - ay) * ex) / math.sqrt(l2)
-            if 0.0 <= d < out[p]:
-                out[p] = d
+            clear_against(x, p, edges[j, 0], edges[j, 1], reach, out)
     return out
 
 

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from .contacts import find_root
 from .elements import _gradient, rest_geometry
 from .model import lengths, stable_order
 from .strain import spring_strains
@@ -299,14 +300,6 @@ def _choose_cuts(candidates, pairs, boundary, n):
 
 
 @njit(cache=True)
-def _root(parent, a):
-    while parent[a] != a:
-        parent[a] = parent[parent[a]]
-        a = parent[a]
-    return a
-
-
-@njit(cache=True)
 def _split_vertices(tris, tri_edge, tri_pair, is_cut, vertex_ptr, vertex_tris, area, verts, n):
     """Split each vertex of ``verts`` into one copy per fan (triangles around it joined across
     uncut edges): ``(triangles, source, mass share)`` of the torn mesh.
@@ -339,14 +332,14 @@ def _split_vertices(tris, tri_edge, tri_pair, is_cut, vertex_ptr, vertex_tris, a
                         continue
                     for q in range(k):
                         if vertex_tris[p0 + q] == g:
-                            parent[_root(parent, a)] = _root(parent, q)
+                            parent[find_root(parent, a)] = find_root(parent, q)
                             break
         # fans numbered in order of their first triangle
         label = np.empty(k, np.int64)
         fan_of_root = np.full(k, -1, np.int64)
         fans = 0
         for a in range(k):
-            r = _root(parent, a)
+            r = find_root(parent, a)
             if fan_of_root[r] < 0:
                 fan_of_root[r] = fans
                 fans += 1
