@@ -596,7 +596,8 @@ def project_contacts(x, x_prev, inv_mass, topo, out, count, stick):
     began (``x_prev``) is undone if it is within ``static friction * push``, the contact
     then sticks for the rest of the substep; otherwise it slides, held back by ``dynamic
     friction * push`` in each pass. ``stick[c]`` holds the decision: -1 before the first
-    pass (set it so), then 1 stuck, 0 sliding. Positions only: the solver derives velocities
+    pass (set it so), then 1 stuck, 0 sliding (as is a pair not touching in the first pass:
+    it gets friction from the pass it touches in, from its push there). Positions only: the solver derives velocities
     afterwards.
 
     Examples
@@ -647,7 +648,7 @@ def project_contacts(x, x_prev, inv_mass, topo, out, count, stick):
         ry = (x[ip, 1] - x_prev[ip, 1]) - ca * (x[ia, 1] - x_prev[ia, 1]) - s * (x[ib, 1] - x_prev[ib, 1])
         slide = -rx * ny + ry * nx
         if stick[c] < 0.0:
-            stick[c] = 1.0 if abs(slide) <= o_mu[c, 1] * push else 0.0
+            stick[c] = 1.0 if push > 0.0 and abs(slide) <= o_mu[c, 1] * push else 0.0  # touching only
         if stick[c] == 0.0:
             slide = min(abs(slide), o_mu[c, 0] * push) * (1.0 if slide > 0.0 else -1.0)
         lam = -slide / w
