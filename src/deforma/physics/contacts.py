@@ -597,8 +597,8 @@ def project_contacts(x, x_prev, inv_mass, topo, out, count, stick):
     then sticks for the rest of the substep; otherwise it slides, held back by ``dynamic
     friction * push`` in each pass. ``stick[c]`` holds the decision: -1 before the first
     pass (set it so), then 1 stuck, 0 sliding (as is a pair not touching in the first pass:
-    it gets friction from the pass it touches in, from its push there). Positions only: the solver derives velocities
-    afterwards.
+    it gets friction from the pass it touches in, from its push there). Positions only: the
+    solver derives velocities afterwards.
 
     Examples
     --------
