@@ -35,10 +35,11 @@ substep began is undone in every sweep; sliding, each sweep holds it back by ``f
 times that sweep's push. Body contacts are found for the predicted motion by the contact
 stage's own broad and narrow phase (:func:`~deforma.physics.contacts.detect_contacts`) and
 projected as the stage projects them, with the same position-level friction as colliders
-(stick or slide decided by the first sweep; :func:`~deforma.physics.contacts.project_contacts`):
-without it a stack of soft boxes slid apart, since the contact stage after the sweep sees a
-resting pair that no longer approaches and applies no friction. The full collider response
-and contact stage still run after the sweep.
+(stick or slide decided by the first sweep; :func:`~deforma.physics.contacts.project_contacts`).
+That friction matters where the sweep itself separates a pair (a thick contact, a fast hit):
+the contact stage after the sweep then sees no approach and gives no friction impulse.
+Resting pairs are held by the stage's speculative contacts, which carry friction. The full
+collider response and contact stage still run after the sweep.
 
 One Gauss-Seidel sweep per substep (``iterations = 1``, the "small steps" choice) carries
 a correction across about one spring per substep against the sweep order (and across the
