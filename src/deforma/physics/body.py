@@ -77,18 +77,25 @@ class Body:
         self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
 
+    def _tear_view(self):
+        """The tear check's view (:class:`~deforma.physics.tearing.TearTopology`) of the current
+        topology: kept from the last tear, or built once for a topology it has not seen."""
+        t = self.topology
+        if self._tear_topology is None or self._tear_topology[0] is not t:
+            self._tear_topology = (t, _tearing.TearTopology.of(t.rest_positions, t.triangles))
+        return self._tear_topology[1]
+
     def _apply_tear(self, cut) -> None:
         """Take the torn mesh ``cut`` (a :class:`~deforma.physics.tearing.Tear`) as the body's."""
         from ..mesh import Mesh
 
         t, src = self.topology, cut.source
-        tear = self._tear_topology[1] if self._tear_topology is not None and self._tear_topology[0] is t \
-            else _tearing.TearTopology.of(t.rest_positions, t.triangles)
-        self.topology, tt = _tearing.torn_topologies(t, tear, cut)
+        self.topology, tt = _tearing.torn_topologies(t, self._tear_view(), cut)
         self._tear_topology = (self.topology, tt)  # the tear check's view of the torn mesh, kept
         uv = getattr(self.mesh, "uv", None)
         if uv is not None and len(uv) == t.n_vertices:
-            self.mesh = Mesh._trusted(t.rest_positions[src], cut.triangles, np.asarray(uv)[src], getattr(self.mesh, "texture", None))
+            self.mesh = Mesh._trusted(t.rest_positions[src], cut.triangles, np.asarray(uv)[src],
+                                      getattr(self.mesh, "texture", None))
         self._pinned = self._pinned[src]
         self._tear_source = src
         self._overrides["pressure"] = None  # the gas escapes through the tear

@@ -828,9 +828,7 @@ class World:
                                                              mass_share=topo.mass_share)
                     torn = True
                 continue
-            if body._tear_topology is None or body._tear_topology[0] is not topo:
-                body._tear_topology = (topo, _tearing.TearTopology.of(topo.rest_positions, topo.triangles))
-            cut = _tearing.tear_mesh(body._tear_topology[1], x, limit)
+            cut = _tearing.tear_mesh(body._tear_view(), x, limit)
             if cut is None:
                 continue
             body._apply_tear(cut)
