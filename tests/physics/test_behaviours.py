@@ -297,6 +297,28 @@ def test_below_tear_strain_nothing_tears():
     assert body.n_vertices == n0 and body.pieces.max() == 0
 
 
+def test_a_sheet_pulled_apart_by_two_clamps_tears_across_once_instead_of_shattering():
+    # benchmarks/bench_behaviours.py's sheet (2 m x 1 m, 2500 vertices, clamped at both sides, the
+    # right clamp pulled away faster and faster). Evenly stretched past tear_strain, every outline
+    # vertex used to start a crack in the same step: 7 pieces here, 2172 at 1e4 vertices. One
+    # crack runs at a time: it tears across once, next to a clamp, where the strain is highest.
+    mat = deforma.Material("corotated", youngs_modulus=2e4, poisson_ratio=0.3, density=2.0, tear_strain=0.2)
+    w = deforma.World(gravity=(0.0, 0.0), integrator="implicit-euler", material=mat)
+    body = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=48, edges=True), position=None)
+    x = body.positions
+    left, right = np.flatnonzero(x[:, 0] < 1e-9), np.flatnonzero(x[:, 0] > 2.0 - 1e-9)
+    body.pin(np.concatenate([left, right]))
+    for k in range(300):
+        x = body.positions
+        x[right, 0] += 0.5 / 600 * (1 + k / 100)
+        body.positions = x
+        w.step()
+    sizes = np.bincount(body.pieces[body.triangles[:, 0]])
+    assert len(sizes) == 2 and sizes.min() >= 2 * 48  # the sheet, and the strip along one clamp
+    assert body.pieces[left].max() != body.pieces[right].min()  # apart: the clamps hold different pieces
+    valid_pieces(body)
+
+
 def test_tear_splits_mass_and_momentum_exactly():
     mat = deforma.Material("springs", tear_strain=0.2)
     w = deforma.World(gravity=(0, 0), material=mat, stiffness=100.0, damping=0.0)

@@ -49,8 +49,10 @@ def reference_edges(n, t):
     return np.stack([lo[start], hi[start]], axis=1), tri_pair, np.argsort(t.ravel(), kind="stable") // 3
 
 
-def reference_tear(topo, x, limit):
-    """The tear as the fan search before the incremental rebuild found it (Python, per vertex)."""
+def reference_tear(topo, x, limit, tips):
+    """The tear as the fan search before the incremental rebuild found it (Python, per vertex),
+    with the running cracks' ``tips`` (while there are any, only they advance; else one new
+    crack starts)."""
     n = len(topo.boundary)
     strain = np.empty(len(topo.inner))
     tearing.opening_strain(x, topo.triangles, topo.b, topo.tri_pair[topo.inner], topo.normal, strain)
@@ -60,6 +62,10 @@ def reference_tear(topo, x, limit):
         a, b = topo.pairs[e]
         if used[a] or used[b] or not (topo.boundary[a] or topo.boundary[b]):
             continue
+        if len(tips) and a not in tips and b not in tips:
+            continue
+        if not len(tips) and cut:
+            break
         used[a] = used[b] = True
         cut.append(int(e))
     if not cut:
@@ -122,9 +128,13 @@ def torn_sheet(model, integrator, steps, detail=12):
     def checked_apply(self, cut):
         old, tt = self.topology, tearing.TearTopology.of(self.topology.rest_positions, self.topology.triangles)
         x = w._state.x[self.vertex_slice]
-        ref = reference_tear(tt, x, mat.tear_strain)
+        tips = [int(v) for v in self._crack_tips()]
+        ref = reference_tear(tt, x, mat.tear_strain, tips)
         assert ref is not None
         assert same(cut.triangles, ref[0]) and same(cut.source, ref[1]) and same(cut.mass_share, ref[2])
+        ends = np.unique(tt.pairs[[tt.edge(int(a), int(b)) for a, b in cut.cut]].ravel())
+        assert cut.tips.tolist() == [int(v) for v in ends if not tt.boundary[v]]  # where they ran to
+        assert set(cut.tips.tolist()).isdisjoint(cut.source[old.n_vertices:].tolist())  # tips do not split
         apply(self, cut)
         rest = old.rest_positions[cut.source]
         tri = cut.triangles

@@ -76,6 +76,7 @@ class Body:
         self._pinned = np.zeros(topology.n_vertices, bool)
         self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
+        self._cracks = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
 
     def _tear_view(self):
         """The tear check's view (:class:`~deforma.physics.tearing.TearTopology`) of the current
@@ -84,6 +85,12 @@ class Body:
         if self._tear_topology is None or self._tear_topology[0] is not t:
             self._tear_topology = (t, _tearing.TearTopology.of(t.rest_positions, t.triangles))
         return self._tear_topology[1]
+
+    def _crack_tips(self):
+        """Tips of the cracks that ran in the last step (none once they stopped, or for a
+        topology set since)."""
+        c = self._cracks
+        return c[1] if c is not None and c[0] is self.topology else ()
 
     def _apply_tear(self, cut) -> None:
         """Take the torn mesh ``cut`` (a :class:`~deforma.physics.tearing.Tear`) as the body's."""
@@ -98,6 +105,7 @@ class Body:
                                       getattr(self.mesh, "texture", None))
         self._pinned = self._pinned[src]
         self._tear_source = src
+        self._cracks = (self.topology, cut.tips)
         self._overrides["pressure"] = None  # the gas escapes through the tear
 
     def _check(self) -> "World":

@@ -9,9 +9,16 @@ An edge whose opening strain ``|F n| - 1`` exceeds ``t`` is cut.
 
 A cut opens only where the mesh can open: a vertex splits when the triangles around it fall
 into separate fans (groups joined across uncut edges), each fan getting its own copy of the
-vertex. So cracks start at the outline (or a hole) and run inward one edge per vertex per
-step, along the edges most stretched across: the crack follows the stress, at the mesh's
-resolution. Copies are appended after the body's vertices (the indices of pins, grabs and
+vertex. So cracks start at the outline (or a hole) and run inward one edge per step, along
+the edges most stretched across: the crack follows the stress, at the mesh's resolution.
+
+One crack runs at a time in a body: while a crack's tip advanced in the last step, only the
+tips advance, and a new crack starts (at the most stretched outline edge) only once every
+tip has stopped. A real crack relieves the material beside it faster than the solver can
+show within a step; without the rule, every outline vertex of a sheet stretched evenly past
+``tear_strain`` starts its own crack in the same step, and a sheet pulled apart by two
+clamps (1e4 vertices, ``benchmarks/bench_behaviours.py``) shattered into 2172 pieces of
+confetti instead of tearing across. Copies are appended after the body's vertices (the indices of pins, grabs and
 the rest stay valid) with the same position, velocity and texture coordinate; the vertex's
 mass is shared between its copies in proportion to the area of their fans, so mass and
 momentum are kept exactly. Every triangle is kept (none is deleted or created): the torn
@@ -56,12 +63,17 @@ class Tear:
         the copies of one vertex sum to 1).
     cut : (C, 2) int32
         The edges cut in this tear (vertex pairs before the split).
+    tips : (K,) int64
+        The cracks' tips after this tear: the far ends of the cuts that ran into the mesh
+        (vertices that were inside it and are now on the outline, not split). Pass them to the
+        next :func:`tear_mesh` so the cracks go on from there.
     """
 
     triangles: np.ndarray
     source: np.ndarray
     mass_share: np.ndarray
     cut: np.ndarray
+    tips: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -227,7 +239,7 @@ def opening_strains(rest, tris, x):
     return tt.pairs[tt.inner], out
 
 
-def tear_mesh(topo: TearTopology, x, tear_strain, strain=None):
+def tear_mesh(topo: TearTopology, x, tear_strain, strain=None, tips=()):
     """Cut the edges stretched across beyond ``tear_strain`` and split their vertices.
 
     Parameters
@@ -240,11 +252,14 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None):
         The opening strain beyond which an edge is cut.
     strain : (I,) float64, optional
         Opening strains already measured at ``x`` (:func:`opening_strain`).
+    tips : (K,) int, optional
+        The running cracks' tips (``Tear.tips`` of the last step's tear; empty when the last
+        step did not tear): while there are any, only they advance.
 
     Returns
     -------
     Tear or None
-        ``None`` when nothing opened.
+        ``None`` when nothing opened (every crack stopped).
 
     Examples
     --------
@@ -253,8 +268,8 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None):
     >>> topo = TearTopology.of(rest, [[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
     >>> x = rest.copy(); x[[2, 5], 0] += 3.0  # pull the right column far to the right
     >>> t = tear_mesh(topo, x, 0.5)
-    >>> t.cut.tolist(), t.source.tolist()  # the stretched cell's diagonal 1-5 cut: both ends split
-    ([[1, 5]], [0, 1, 2, 3, 4, 5, 1, 5])
+    >>> t.cut.tolist(), t.source.tolist(), t.tips.tolist()  # the cell's diagonal 1-5 cut: both ends split
+    ([[1, 5]], [0, 1, 2, 3, 4, 5, 1, 5], [])
     >>> pieces(8, [], t.triangles).tolist()  # triangle (1, 2, 5) came off
     [0, 0, 1, 0, 0, 1, 1, 0]
     """
@@ -269,22 +284,29 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None):
         return None
     # strongest first; a cut must touch the outline to open, and each vertex takes one cut per
     # step (a crack advances an edge at a time, so the stress can move to its new tip)
-    cut = _choose_cuts(inner[over[np.argsort(-strain[over], kind="stable")]], topo.pairs, topo.boundary, n)
+    is_tip = np.zeros(n, np.bool_)
+    tips = np.asarray(tips, dtype=np.int64)
+    is_tip[tips[(tips >= 0) & (tips < n)]] = True
+    cut = _choose_cuts(inner[over[np.argsort(-strain[over], kind="stable")]], topo.pairs, topo.boundary, is_tip, n)
     if not len(cut):
         return None
+    ends = topo.pairs[cut].ravel()
+    new_tips = np.unique(ends[~topo.boundary[ends]])  # cuts that ran in from the outline
     is_cut = np.zeros(len(topo.pairs), np.bool_)
     is_cut[cut] = True
     new_t, source, share = _split_vertices(t, topo.tri_edge, topo.tri_pair, is_cut, topo.vertex_ptr,
                                            topo.vertex_tris, topo.area, np.unique(topo.pairs[cut].ravel()), n)
     if len(source) == n:
         return None
-    return Tear(new_t.astype(np.int32), source, share, topo.pairs[cut].astype(np.int32))
+    return Tear(new_t.astype(np.int32), source, share, topo.pairs[cut].astype(np.int32), new_tips)
 
 
 @njit(cache=True)
-def _choose_cuts(candidates, pairs, boundary, n):
-    """Edges to cut, from ``candidates`` (strongest first): one touching the outline, and no
-    vertex in two cuts this step."""
+def _choose_cuts(candidates, pairs, boundary, is_tip, n):
+    """Edges to cut, from ``candidates`` (strongest first): each touching the outline, no
+    vertex in two cuts this step; while any vertex ``is_tip``, only edges at a tip (the
+    running cracks advance), else the strongest one (a new crack starts)."""
+    running = is_tip.any()
     used = np.zeros(n, np.bool_)
     out = np.empty(len(candidates), np.int64)
     c = 0
@@ -292,6 +314,10 @@ def _choose_cuts(candidates, pairs, boundary, n):
         a, b = pairs[e, 0], pairs[e, 1]
         if used[a] or used[b] or not (boundary[a] or boundary[b]):
             continue
+        if running and not (is_tip[a] or is_tip[b]):
+            continue
+        if not running and c == 1:
+            break
         used[a] = True
         used[b] = True
         out[c] = e

@@ -828,8 +828,9 @@ class World:
                                                              mass_share=topo.mass_share)
                     torn = True
                 continue
-            cut = _tearing.tear_mesh(body._tear_view(), x, limit)
+            cut = _tearing.tear_mesh(body._tear_view(), x, limit, tips=body._crack_tips())
             if cut is None:
+                body._cracks = None  # every crack stopped: a new one may start
                 continue
             body._apply_tear(cut)
             torn = True
