@@ -234,8 +234,43 @@ def test_stiffness_100x_the_explicit_limit_stays_finite_and_keeps_its_shape_in_f
     assert np.isfinite(b.positions).all() and np.isfinite(b.velocities).all()
     s = b.springs
     length = np.linalg.norm(b.positions[s[:, 1]] - b.positions[s[:, 0]], axis=1)
-    assert np.abs(length / rest - 1).max() < 0.02  # every spring within 2% of its rest length
+    # every spring within 2% of its rest length; 3.5% under XPBD, whose sweep in colour order
+    # (xpbd.sweep_order: what keeps large stiff bodies from running away) converges slower
+    # than in the Model's row order: 3.0% measured, 1.9% in row order
+    assert np.abs(length / rest - 1).max() < (0.035 if name == "xpbd" else 0.02)
     assert np.all(np.sign(_signed_areas(b)) == np.sign(areas0))  # no triangle turned over
+
+
+def clamped_sheet(material, substeps):
+    """A 2 m x 1 m sheet (1089 vertices; 2500 for springs) held by clamps at both sides,
+    stretched 2% and let go, under XPBD at 1/600 s: ``(world, strain energy at the start)``."""
+    if material is None:
+        w = deforma.World(gravity=(0, 0), integrator="xpbd", stiffness=2e6, damping=0.0, mass=4.0, substeps=substeps)
+        detail = 48
+    else:
+        mat = deforma.Material(material, youngs_modulus=2e4, poisson_ratio=0.3, density=2.0)
+        w = deforma.World(gravity=(0, 0), integrator="xpbd", material=mat, substeps=substeps)
+        detail = 32
+    b = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=detail, edges=True), position=None,
+                   collide=False)
+    x = b.positions
+    b.pin(np.flatnonzero((x[:, 0] < 1e-9) | (x[:, 0] > 2.0 - 1e-9)))
+    b.positions = np.c_[x[:, 0] * 1.02, x[:, 1]]
+    e = w.energy()
+    return w, e.spring + e.elastic
+
+
+@pytest.mark.parametrize("substeps", [1, 4])
+@pytest.mark.parametrize("material", [None, "corotated", "neo-hookean"])
+def test_xpbd_lets_a_clamped_sheet_go_without_running_away(material, substeps):
+    # In the Model's row order the springs sheet ran away in 36 steps at one substep, and the
+    # FEM sheets, whose shear was one constraint |F - (tr S / 2) R| (or C_S), reached 35-148 J
+    # of motion from 8.8 J of strain: a correction ran through the whole sheet in one sweep,
+    # and a projection of that constraint added energy (xpbd.sweep_order, elements.project_elements)
+    w, strain = clamped_sheet(material, substeps)
+    for _ in range(200):
+        w.step()
+    assert w.energy().kinetic < 0.1 * strain  # 0.5 J at most measured (FEM, one substep)
 
 
 @pytest.mark.parametrize("name, substeps", [("implicit-euler", 4), ("xpbd", 10)])

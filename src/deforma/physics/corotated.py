@@ -13,14 +13,15 @@ In 2D the polar rotation has a closed form: with ``c = F00 + F11`` and ``s = F10
 rotation even for an inverted triangle (``det F < 0``): then ``S`` has a negative eigenvalue,
 ``|S - I|`` is large, and the stress pushes the triangle back out.
 
-For XPBD the same energy splits into two constraints with positive stiffness for every
-admissible Poisson ratio (``kappa = mu + lambda > 0``):
+For XPBD the same energy splits into terms with positive stiffness for every admissible
+Poisson ratio (``kappa = mu + lambda > 0``):
 
-    psi = mu C_dev^2 + kappa / 2 C_vol^2,   C_dev = |F - (tr S / 2) R|,   C_vol = tr S - 2,
+    psi = mu / 2 (C_a^2 + C_b^2) + kappa / 2 C_vol^2,
+    C_a = F00 - F11,   C_b = F01 + F10,   C_vol = tr S - 2,
 
-``C_dev`` the distance from ``F`` to the nearest scaled rotation (its gradient is
-``(F - (tr S / 2) R) / C_dev``, as the nearest point does not move to first order) and
-``C_vol`` the change of size (gradient ``R``).
+since ``F - (tr S / 2) R``, the part of ``F`` that is not a scaled rotation, is
+``[[C_a, C_b], [C_b, -C_a]] / 2``: ``C_a`` and ``C_b`` measure shear (linear in ``F``, shared
+with the Neo-Hookean model) and ``C_vol`` the change of size (gradient ``R``).
 """
 
 from __future__ import annotations
@@ -83,28 +84,15 @@ def energy_density(f, mu, lam):
 
 
 @njit(cache=True, inline="always")
-def constraints(f00, f01, f10, f11):
-    """The XPBD constraints of ``F``: ``(C_dev, gradient (4), C_vol, gradient (4))``.
-
-    ``C_dev``'s gradient is zero where ``C_dev = 0`` (no shear: nothing to correct).
+def size_constraint(f00, f01, f10, f11):
+    """XPBD's size constraint of ``F``: ``(C_vol, gradient (4))`` with ``C_vol = tr S - 2``
+    and gradient ``R`` (stiffness ``mu + lambda`` per unit area; the shear constraints are
+    :func:`~deforma.physics.elements.project_elements`'s).
 
     Examples
     --------
-    >>> cd, g0, g1, g2, g3, cv, h0, h1, h2, h3 = constraints(2.0, 0.0, 0.0, 2.0)
-    >>> cd, cv, (h0, h1, h2, h3)  # a uniform scaling by 2: no shape change, size +2
-    (0.0, 2.0, (1.0, -0.0, 0.0, 1.0))
+    >>> size_constraint(2.0, 0.0, 0.0, 2.0)  # a uniform scaling by 2: size +2
+    (2.0, 1.0, -0.0, 0.0, 1.0)
     """
     c, s, t = polar_rotation(f00, f01, f10, f11)
-    half = 0.5 * t
-    d00 = f00 - half * c
-    d01 = f01 + half * s
-    d10 = f10 - half * s
-    d11 = f11 - half * c
-    cd = np.sqrt(d00 * d00 + d01 * d01 + d10 * d10 + d11 * d11)
-    if cd > 0.0:
-        inv = 1.0 / cd
-        d00 *= inv
-        d01 *= inv
-        d10 *= inv
-        d11 *= inv
-    return cd, d00, d01, d10, d11, t - 2.0, c, -s, s, c
+    return t - 2.0, c, -s, s, c

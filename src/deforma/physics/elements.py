@@ -360,54 +360,81 @@ def _rate(x, x_prev, i, j, k, a):
 
 
 @njit(cache=True)
-def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, lam_acc, h):
-    """One Gauss-Seidel XPBD sweep over the elements, both constraints of each solved together.
+def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, order, starts, sequence, lam_acc, h):
+    """One Gauss-Seidel XPBD sweep over the elements, the three constraints of each solved together.
 
-    Corotated: ``C_dev`` (stiffness ``2 mu A``) and ``C_vol = tr S - 2`` (``(mu + lambda)
-    A``); stable Neo-Hookean: ``C_S`` (``mu A``) and ``C_H = J - 1`` (``lambda' A``), after
-    Macklin and Mueller 2021 (see :mod:`~deforma.physics.neo_hookean` for the 2D form).
-    Damping ``beta`` gives each constraint ``kd = beta * stiffness``. ``lam_acc`` (T, 2) holds
+    Both models share their shear term: ``mu / 2 (C_a^2 + C_b^2)`` per unit rest area with
+    ``C_a = F00 - F11`` and ``C_b = F01 + F10`` (the part of ``F`` that is not a scaled
+    rotation; corotated ``mu C_dev^2`` and Neo-Hookean ``mu / 2 C_S^2`` are both this), so
+    each has the two shear constraints ``C_a``, ``C_b`` (stiffness ``mu A``) and a size
+    constraint (``(mu + lambda) A``): corotated ``tr S - 2``
+    (:func:`~deforma.physics.corotated.size_constraint`), Neo-Hookean ``J - 1`` (after
+    Macklin and Mueller 2021; :func:`~deforma.physics.neo_hookean.size_constraint`).
+    Damping ``beta`` gives each constraint ``kd = beta * stiffness``. ``order`` (T,) is the
+    order of the sweep (:func:`deforma.physics.xpbd.sweep_order`); ``lam_acc`` (T, 3) holds
     the multipliers of the substep.
 
-    The two are solved as one 2 x 2 system per element rather than one after the other, so
-    that neither undoes the other's correction within a sweep (one sequential sweep left a
-    hanging column's width barely contracted: Poisson ratio 0.09 measured instead of 0.3).
+    The shear constraints are linear in the positions (their gradients are constant), which
+    is what keeps a sweep from adding energy. Written as one constraint, the distance
+    ``|F - (tr S / 2) R|`` or ``C_S = sqrt(C_a^2 + C_b^2)`` (the same energy), it is zero at
+    rest with a gradient that turns with the smallest shear, and its linearised projection
+    moved vertices by more than the shear they undid: a 2500-vertex corotated sheet held
+    stretched 2% by two clamps and let go (1/600 s, 4 substeps) rose from 8.8 J of strain
+    energy to 27.6 J plus 2.6 J of motion and kept boiling; with the linear pair it comes to
+    rest (``tests/physics/test_integrators.py``). The three are solved as one 3 x 3 system
+    per element rather than one after the other, so that none undoes another's correction
+    within a sweep (one sequential sweep left a hanging column's width barely contracted:
+    Poisson ratio 0.09 measured instead of 0.3).
     """
     h2 = h * h
-    for e in range(elem.shape[0]):
+    for c in range(sequence.shape[0]):
+      colour = sequence[c]
+      for q in range(starts[colour], starts[colour + 1]):
+        e = order[q]
         i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
         a, m, lm, be = area[e], mu[e], lam[e], beta[e]
         f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
         if kind[e] == KIND_COROTATED:
-            c1, d00, d01, d10, d11, c2, v00, v01, v10, v11 = corotated.constraints(f00, f01, f10, f11)
-            k1 = 2.0 * m * a
+            c3, v00, v01, v10, v11 = corotated.size_constraint(f00, f01, f10, f11)
         else:
-            c1, d00, d01, d10, d11, c2, v00, v01, v10, v11 = neo_hookean.constraints(f00, f01, f10, f11)
-            k1 = m * a
-        k2 = (m + lm) * a
+            c3, v00, v01, v10, v11 = neo_hookean.size_constraint(f00, f01, f10, f11)
+        k1 = m * a
+        k3 = (m + lm) * a
         wi, wj, wk = inv_mass[i], inv_mass[j], inv_mass[k]
-        g1 = _vertex_gradients(d00, d01, d10, d11, b0, b1, b2, b3)
-        g2 = _vertex_gradients(v00, v01, v10, v11, b0, b1, b2, b3)
-        # rows scaled by k h^2 (as the springs' update): (kt + dt) G dlam + dlam = -(kt C + lam + dt rate)
-        s1 = (1.0 + be / h) * k1 * h2  # kt + dt, dt = beta k h
-        s2 = (1.0 + be / h) * k2 * h2
-        g11 = _dot(wi, wj, wk, g1, g1)
-        g12 = _dot(wi, wj, wk, g1, g2)
-        g22 = _dot(wi, wj, wk, g2, g2)
-        r1 = -(k1 * h2 * c1 + lam_acc[e, 0] + be * k1 * h * _rate(x, x_prev, i, j, k, g1))
-        r2 = -(k2 * h2 * c2 + lam_acc[e, 1] + be * k2 * h * _rate(x, x_prev, i, j, k, g2))
-        a11 = s1 * g11 + 1.0
-        a12 = s1 * g12
-        a21 = s2 * g12
-        a22 = s2 * g22 + 1.0
-        det = a11 * a22 - a12 * a21  # > 0: det(S G + I) with S, G positive semi-definite
-        dl1 = (r1 * a22 - a12 * r2) / det
-        dl2 = (a11 * r2 - a21 * r1) / det
+        g1 = _vertex_gradients(1.0, 0.0, 0.0, -1.0, b0, b1, b2, b3)  # C_a = F00 - F11
+        g2 = _vertex_gradients(0.0, 1.0, 1.0, 0.0, b0, b1, b2, b3)  # C_b = F01 + F10
+        g3 = _vertex_gradients(v00, v01, v10, v11, b0, b1, b2, b3)
+        # Row n of XPBD's system, divided by s_n = (1 + beta / h) k_n h^2 (kt + dt, dt = beta
+        # k h) so that the matrix is symmetric: (G + diag(1 / s)) dlam = -(kt C + lam + dt
+        # rate) / s, G the inverse-mass Gram matrix of the gradients (positive definite with
+        # the diagonal added, also where corners are pinned)
+        s1 = (1.0 + be / h) * k1 * h2
+        s3 = (1.0 + be / h) * k3 * h2
+        r1 = -(k1 * h2 * (f00 - f11) + lam_acc[e, 0] + be * k1 * h * _rate(x, x_prev, i, j, k, g1)) / s1
+        r2 = -(k1 * h2 * (f01 + f10) + lam_acc[e, 1] + be * k1 * h * _rate(x, x_prev, i, j, k, g2)) / s1
+        r3 = -(k3 * h2 * c3 + lam_acc[e, 2] + be * k3 * h * _rate(x, x_prev, i, j, k, g3)) / s3
+        p = _dot(wi, wj, wk, g1, g1) + 1.0 / s1
+        u = _dot(wi, wj, wk, g2, g2) + 1.0 / s1
+        z = _dot(wi, wj, wk, g3, g3) + 1.0 / s3
+        q12 = _dot(wi, wj, wk, g1, g2)
+        q13 = _dot(wi, wj, wk, g1, g3)
+        q23 = _dot(wi, wj, wk, g2, g3)
+        c00 = u * z - q23 * q23  # cofactors of the symmetric matrix
+        c01 = q13 * q23 - q12 * z
+        c02 = q12 * q23 - u * q13
+        c11 = p * z - q13 * q13
+        c12 = q12 * q13 - p * q23
+        c22 = p * u - q12 * q12
+        inv = 1.0 / (p * c00 + q12 * c01 + q13 * c02)
+        dl1 = (c00 * r1 + c01 * r2 + c02 * r3) * inv
+        dl2 = (c01 * r1 + c11 * r2 + c12 * r3) * inv
+        dl3 = (c02 * r1 + c12 * r2 + c22 * r3) * inv
         lam_acc[e, 0] += dl1
         lam_acc[e, 1] += dl2
-        x[i, 0] += wi * (g1[0] * dl1 + g2[0] * dl2)
-        x[i, 1] += wi * (g1[1] * dl1 + g2[1] * dl2)
-        x[j, 0] += wj * (g1[2] * dl1 + g2[2] * dl2)
-        x[j, 1] += wj * (g1[3] * dl1 + g2[3] * dl2)
-        x[k, 0] += wk * (g1[4] * dl1 + g2[4] * dl2)
-        x[k, 1] += wk * (g1[5] * dl1 + g2[5] * dl2)
+        lam_acc[e, 2] += dl3
+        x[i, 0] += wi * (g1[0] * dl1 + g2[0] * dl2 + g3[0] * dl3)
+        x[i, 1] += wi * (g1[1] * dl1 + g2[1] * dl2 + g3[1] * dl3)
+        x[j, 0] += wj * (g1[2] * dl1 + g2[2] * dl2 + g3[2] * dl3)
+        x[j, 1] += wj * (g1[3] * dl1 + g2[3] * dl2 + g3[3] * dl3)
+        x[k, 0] += wk * (g1[4] * dl1 + g2[4] * dl2 + g3[4] * dl3)
+        x[k, 1] += wk * (g1[5] * dl1 + g2[5] * dl2 + g3[5] * dl3)

@@ -26,9 +26,11 @@ lambda'`` (per unit rest area). Their deviatoric constraint ``|F|`` is not zero 
 its multiplier must carry the rest stress, which XPBD restarts from zero every substep, and
 the shear stiffness then acts only through the constraint's curvature, one substep late
 (explicitly): a box at rest measured unstable with one substep at 1/60 s. The 2D form's
-``C_S`` and ``C_H = J - 1`` are both zero at rest, so the rest shape carries no multiplier
-and shear is resisted directly; with the two solved together (see
-:func:`~deforma.physics.elements.project_elements`) a body rests at any step.
+shear and ``C_H = J - 1`` are both zero at rest, so the rest shape carries no multiplier
+and shear is resisted directly; the shear enters as its two linear parts ``C_a = F00 - F11``
+and ``C_b = F01 + F10`` (``C_S^2 = C_a^2 + C_b^2``), whose projection is exact, and the three
+are solved together (see :func:`~deforma.physics.elements.project_elements`): a body rests
+at any step.
 """
 
 from __future__ import annotations
@@ -108,22 +110,17 @@ def energy_density(f, mu, lam):
 
 
 @njit(cache=True, inline="always")
-def constraints(f00, f01, f10, f11):
-    """The XPBD constraints of ``F``: ``(C_S, gradient (4), C_H, gradient (4))``, stiffness
-    ``mu`` and ``lambda'`` per unit area. ``C_S``'s gradient is zero where ``C_S = 0``.
+def size_constraint(f00, f01, f10, f11):
+    """XPBD's size constraint of ``F``: ``(C_H, gradient (4))`` with ``C_H = J - 1`` and
+    gradient ``cof F`` (stiffness ``lambda'`` per unit area; the shear constraints ``C_a``,
+    ``C_b``, whose squares sum to ``C_S^2``, are
+    :func:`~deforma.physics.elements.project_elements`'s).
 
     Examples
     --------
-    >>> c = constraints(1.0, 0.0, 0.0, 1.0)
-    >>> c[0], c[5]  # at rest both vanish
-    (0.0, 0.0)
-    >>> round(constraints(1.0, 0.0, 0.0, -1.0)[5], 6)  # mirrored: J - 1 = -2
+    >>> size_constraint(1.0, 0.0, 0.0, 1.0)[0]  # at rest: zero
+    0.0
+    >>> round(size_constraint(1.0, 0.0, 0.0, -1.0)[0], 6)  # mirrored: J - 1 = -2
     -2.0
     """
-    a = f00 - f11
-    b = f01 + f10
-    cs = np.sqrt(a * a + b * b)
-    inv = 1.0 / cs if cs > 0.0 else 0.0
-    # d C_S / dF = [[a, b], [b, -a]] / C_S
-    return (cs, a * inv, b * inv, b * inv, -a * inv,
-            f00 * f11 - f01 * f10 - 1.0, f11, -f10, -f01, f00)
+    return f00 * f11 - f01 * f10 - 1.0, f11, -f10, -f01, f00
