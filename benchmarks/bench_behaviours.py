@@ -9,8 +9,9 @@ with ``--quick``) of corotated elements, implicit Euler at 1/600 s:
 - tearing: the sheet clamped at its left side (pinned) and at its right side (pinned
   vertices moved by the script), pulled apart until it tears across (implicit Euler; XPBD
   at one substep is too soft for such a clamp: the strain piles up next to the moving one,
-  which tears a wedge off, rather than across the sheet); the median step that tears (the cut, the split vertices, the rebuilt model and
-  the new factorisation) against the median step that does not (the goal: at most 2x).
+  which tears a wedge off, rather than across the sheet); the median step that tears (the
+  cut, the split vertices, the rebuilt model and the new factorisation) against the median
+  step that does not (the goal: at most 2x).
 """
 
 from __future__ import annotations
