@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import numba
-from numba import njit, prange
+from numba import njit
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import Row  # noqa: E402

@@ -388,53 +388,53 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, or
     """
     h2 = h * h
     for c in range(sequence.shape[0]):
-      colour = sequence[c]
-      for q in range(starts[colour], starts[colour + 1]):
-        e = order[q]
-        i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
-        a, m, lm, be = area[e], mu[e], lam[e], beta[e]
-        f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
-        if kind[e] == KIND_COROTATED:
-            c3, v00, v01, v10, v11 = corotated.size_constraint(f00, f01, f10, f11)
-        else:
-            c3, v00, v01, v10, v11 = neo_hookean.size_constraint(f00, f01, f10, f11)
-        k1 = m * a
-        k3 = (m + lm) * a
-        wi, wj, wk = inv_mass[i], inv_mass[j], inv_mass[k]
-        g1 = _vertex_gradients(1.0, 0.0, 0.0, -1.0, b0, b1, b2, b3)  # C_a = F00 - F11
-        g2 = _vertex_gradients(0.0, 1.0, 1.0, 0.0, b0, b1, b2, b3)  # C_b = F01 + F10
-        g3 = _vertex_gradients(v00, v01, v10, v11, b0, b1, b2, b3)
-        # Row n of XPBD's system, divided by s_n = (1 + beta / h) k_n h^2 (kt + dt, dt = beta
-        # k h) so that the matrix is symmetric: (G + diag(1 / s)) dlam = -(kt C + lam + dt
-        # rate) / s, G the inverse-mass Gram matrix of the gradients (positive definite with
-        # the diagonal added, also where corners are pinned)
-        s1 = (1.0 + be / h) * k1 * h2
-        s3 = (1.0 + be / h) * k3 * h2
-        r1 = -(k1 * h2 * (f00 - f11) + lam_acc[e, 0] + be * k1 * h * _rate(x, x_prev, i, j, k, g1)) / s1
-        r2 = -(k1 * h2 * (f01 + f10) + lam_acc[e, 1] + be * k1 * h * _rate(x, x_prev, i, j, k, g2)) / s1
-        r3 = -(k3 * h2 * c3 + lam_acc[e, 2] + be * k3 * h * _rate(x, x_prev, i, j, k, g3)) / s3
-        p = _dot(wi, wj, wk, g1, g1) + 1.0 / s1
-        u = _dot(wi, wj, wk, g2, g2) + 1.0 / s1
-        z = _dot(wi, wj, wk, g3, g3) + 1.0 / s3
-        q12 = _dot(wi, wj, wk, g1, g2)
-        q13 = _dot(wi, wj, wk, g1, g3)
-        q23 = _dot(wi, wj, wk, g2, g3)
-        c00 = u * z - q23 * q23  # cofactors of the symmetric matrix
-        c01 = q13 * q23 - q12 * z
-        c02 = q12 * q23 - u * q13
-        c11 = p * z - q13 * q13
-        c12 = q12 * q13 - p * q23
-        c22 = p * u - q12 * q12
-        inv = 1.0 / (p * c00 + q12 * c01 + q13 * c02)
-        dl1 = (c00 * r1 + c01 * r2 + c02 * r3) * inv
-        dl2 = (c01 * r1 + c11 * r2 + c12 * r3) * inv
-        dl3 = (c02 * r1 + c12 * r2 + c22 * r3) * inv
-        lam_acc[e, 0] += dl1
-        lam_acc[e, 1] += dl2
-        lam_acc[e, 2] += dl3
-        x[i, 0] += wi * (g1[0] * dl1 + g2[0] * dl2 + g3[0] * dl3)
-        x[i, 1] += wi * (g1[1] * dl1 + g2[1] * dl2 + g3[1] * dl3)
-        x[j, 0] += wj * (g1[2] * dl1 + g2[2] * dl2 + g3[2] * dl3)
-        x[j, 1] += wj * (g1[3] * dl1 + g2[3] * dl2 + g3[3] * dl3)
-        x[k, 0] += wk * (g1[4] * dl1 + g2[4] * dl2 + g3[4] * dl3)
-        x[k, 1] += wk * (g1[5] * dl1 + g2[5] * dl2 + g3[5] * dl3)
+        colour = sequence[c]
+        for q in range(starts[colour], starts[colour + 1]):
+            e = order[q]
+            i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
+            a, m, lm, be = area[e], mu[e], lam[e], beta[e]
+            f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+            if kind[e] == KIND_COROTATED:
+                c3, v00, v01, v10, v11 = corotated.size_constraint(f00, f01, f10, f11)
+            else:
+                c3, v00, v01, v10, v11 = neo_hookean.size_constraint(f00, f01, f10, f11)
+            k1 = m * a
+            k3 = (m + lm) * a
+            wi, wj, wk = inv_mass[i], inv_mass[j], inv_mass[k]
+            g1 = _vertex_gradients(1.0, 0.0, 0.0, -1.0, b0, b1, b2, b3)  # C_a = F00 - F11
+            g2 = _vertex_gradients(0.0, 1.0, 1.0, 0.0, b0, b1, b2, b3)  # C_b = F01 + F10
+            g3 = _vertex_gradients(v00, v01, v10, v11, b0, b1, b2, b3)
+            # Row n of XPBD's system, divided by s_n = (1 + beta / h) k_n h^2 (kt + dt, dt = beta
+            # k h) so that the matrix is symmetric: (G + diag(1 / s)) dlam = -(kt C + lam + dt
+            # rate) / s, G the inverse-mass Gram matrix of the gradients (positive definite with
+            # the diagonal added, also where corners are pinned)
+            s1 = (1.0 + be / h) * k1 * h2
+            s3 = (1.0 + be / h) * k3 * h2
+            r1 = -(k1 * h2 * (f00 - f11) + lam_acc[e, 0] + be * k1 * h * _rate(x, x_prev, i, j, k, g1)) / s1
+            r2 = -(k1 * h2 * (f01 + f10) + lam_acc[e, 1] + be * k1 * h * _rate(x, x_prev, i, j, k, g2)) / s1
+            r3 = -(k3 * h2 * c3 + lam_acc[e, 2] + be * k3 * h * _rate(x, x_prev, i, j, k, g3)) / s3
+            p = _dot(wi, wj, wk, g1, g1) + 1.0 / s1
+            u = _dot(wi, wj, wk, g2, g2) + 1.0 / s1
+            z = _dot(wi, wj, wk, g3, g3) + 1.0 / s3
+            q12 = _dot(wi, wj, wk, g1, g2)
+            q13 = _dot(wi, wj, wk, g1, g3)
+            q23 = _dot(wi, wj, wk, g2, g3)
+            c00 = u * z - q23 * q23  # cofactors of the symmetric matrix
+            c01 = q13 * q23 - q12 * z
+            c02 = q12 * q23 - u * q13
+            c11 = p * z - q13 * q13
+            c12 = q12 * q13 - p * q23
+            c22 = p * u - q12 * q12
+            inv = 1.0 / (p * c00 + q12 * c01 + q13 * c02)
+            dl1 = (c00 * r1 + c01 * r2 + c02 * r3) * inv
+            dl2 = (c01 * r1 + c11 * r2 + c12 * r3) * inv
+            dl3 = (c02 * r1 + c12 * r2 + c22 * r3) * inv
+            lam_acc[e, 0] += dl1
+            lam_acc[e, 1] += dl2
+            lam_acc[e, 2] += dl3
+            x[i, 0] += wi * (g1[0] * dl1 + g2[0] * dl2 + g3[0] * dl3)
+            x[i, 1] += wi * (g1[1] * dl1 + g2[1] * dl2 + g3[1] * dl3)
+            x[j, 0] += wj * (g1[2] * dl1 + g2[2] * dl2 + g3[2] * dl3)
+            x[j, 1] += wj * (g1[3] * dl1 + g2[3] * dl2 + g3[3] * dl3)
+            x[k, 0] += wk * (g1[4] * dl1 + g2[4] * dl2 + g3[4] * dl3)
+            x[k, 1] += wk * (g1[5] * dl1 + g2[5] * dl2 + g3[5] * dl3)

@@ -57,7 +57,8 @@ import numpy as np
 from numba import njit
 
 from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
-from .contacts import ST_NEEDED, ST_PAIRS_NEEDED, ST_STAMP, contact_stage, detect_contacts, gather_start, project_contacts
+from .contacts import (ST_NEEDED, ST_PAIRS_NEEDED, ST_STAMP, contact_stage, detect_contacts, gather_start,
+                       project_contacts)
 from .elements import project_elements
 from .integrators import register_integrator
 
@@ -363,8 +364,9 @@ class XPBD:
                              self._planes, self._touch,
                              model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
                              model.spring_stiffness, model.spring_damping, self._orders[1], model.elem,
-                             model.elem_b, model.elem_area, model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind, self._orders[2], self._orders[3], self._sweeps,
-                             self._elem_lam, float(gx), float(gy),
+                             model.elem_b, model.elem_area, model.elem_mu, model.elem_lambda, model.elem_damping,
+                             model.elem_kind, self._orders[2], self._orders[3], self._sweeps, self._elem_lam,
+                             float(gx), float(gy),
                              1.0 / (1.0 + float(h) * inputs.air_drag),
                              inputs.grab_slot, inputs.grab_pull, inputs.rects, inputs.hits, model.contact,
                              inputs.contact_scratch, inputs.contacts, float(h), int(substeps),
