@@ -18,7 +18,7 @@ motion is never damped, and a mode of angular frequency ``omega`` gets the dampi
 
 Here: the element forces (:func:`element_forces`, used by the symplectic step), the
 implicit solve's right-hand side (:func:`implicit_element_rhs`) and matrix
-(:func:`element_matrix`), the XPBD projection (:func:`project_elements`), and NumPy helpers
+(:func:`element_entries`), the XPBD projection (:func:`project_elements`), and NumPy helpers
 (deformation gradients, energies, the stable-step bound).
 
 Units: m, s, kg, Pa (N/m per metre of thickness), J.
@@ -26,16 +26,11 @@ Units: m, s, kg, Pa (N/m per metre of thickness), J.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 from numba import njit
 
 from . import corotated, neo_hookean
 from .material import KIND_COROTATED
-
-if TYPE_CHECKING:  # SciPy's sparse matrices are imported where built: only implicit Euler needs them
-    import scipy.sparse as sp
 
 
 def rest_geometry(x, tris):
@@ -135,27 +130,33 @@ def gradient_row_sums(tris, b, area, weight, n):
     return out
 
 
-def element_matrix(tris, b, weight, n) -> sp.csc_matrix:
-    """Sum over elements of ``weight_e D D^T`` (N x N): the matrix of ``sum_e weight_e / 2
-    |F_e(x) - T_e|^2`` for one coordinate (symmetric, rows sum to zero).
+@njit(cache=True)
+def element_entries(tris, b, weight, rows, cols, vals, at):
+    """Write the 9 entries per element of ``sum_e weight_e D D^T`` (the matrix of ``sum_e
+    weight_e / 2 |F_e(x) - T_e|^2`` for one coordinate: symmetric, rows sum to zero) into
+    ``rows, cols, vals`` from index ``at`` (coordinate format, duplicates to be summed).
 
     Examples
     --------
     >>> import numpy as np
     >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     >>> b, a = rest_geometry(x, [[0, 1, 2]])
-    >>> element_matrix([[0, 1, 2]], b, np.ones(1), 3).toarray().tolist()
+    >>> r, c, v = np.zeros(9, np.int64), np.zeros(9, np.int64), np.zeros(9)
+    >>> element_entries(np.array([[0, 1, 2]]), b, np.ones(1), r, c, v, 0)
+    >>> m = np.zeros((3, 3)); np.add.at(m, (r, c), v); m.tolist()
     [[2.0, -1.0, -1.0], [-1.0, 1.0, 0.0], [-1.0, 0.0, 1.0]]
     """
-    import scipy.sparse as sp
-
-    t = np.asarray(tris, dtype=np.int64)
-    bb = np.asarray(b).reshape(-1, 2, 2)
-    d = np.stack([-bb[:, 0] - bb[:, 1], bb[:, 0], bb[:, 1]], axis=1)
-    vals = np.asarray(weight)[:, None, None] * np.einsum("tvc,twc->tvw", d, d)
-    rows = np.repeat(t, 3, axis=1).ravel()
-    cols = np.tile(t, (1, 3)).ravel()
-    return sp.csc_matrix((vals.ravel(), (rows, cols)), shape=(n, n))
+    d = np.empty((3, 2))
+    for e in range(tris.shape[0]):
+        d[1, 0], d[1, 1], d[2, 0], d[2, 1] = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        d[0, 0] = -d[1, 0] - d[2, 0]
+        d[0, 1] = -d[1, 1] - d[2, 1]
+        for v in range(3):
+            for u in range(3):
+                rows[at] = tris[e, v]
+                cols[at] = tris[e, u]
+                vals[at] = weight[e] * (d[v, 0] * d[u, 0] + d[v, 1] * d[u, 1])
+                at += 1
 
 
 @njit(cache=True, inline="always")
