@@ -132,3 +132,29 @@ def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_los
     assert picks.count("parallel") == 2  # one probe, then none for 4096 calls
     integ._estimate["parallel"] = 0.5  # cores free again: the probe wins, parallel is used
     assert integ._choose() == "parallel"
+
+
+def test_the_implicit_matrix_assembly_matches_a_dense_sum():
+    from deforma.physics.implicit import csc_matrix, with_entries
+
+    rng = np.random.default_rng(7)
+    n = 40
+    rows, cols = rng.integers(0, n, 600), rng.integers(0, n, 600)
+    vals = rng.normal(size=600)
+    vals[:50] = 0.0  # stored zeros and entries that cancel must not be kept
+    rows[50:60], cols[50:60], vals[50:60] = 3, 5, 1.0
+    rows[60:70], cols[60:70], vals[60:70] = 3, 5, -1.0
+    pinned = rng.random(n) < 0.2
+    dense = np.zeros((n, n))
+    np.add.at(dense, (rows, cols), vals)
+    dense[pinned] = 0.0
+    dense[pinned, pinned] = 1.0
+    a = csc_matrix(n, rows, cols, vals, pinned)
+    assert a.has_canonical_format and np.allclose(a.toarray(), dense, rtol=0, atol=1e-12)
+    off = a.indices != np.repeat(np.arange(n), np.diff(a.indptr))
+    assert np.all(a.data[off] != 0.0)  # no stored zero off the diagonal
+    more_r, more_c, more_v = rng.integers(0, n, 80), rng.integers(0, n, 80), rng.normal(size=80)
+    b = with_entries(a, more_r, more_c, more_v, pinned)
+    keep = ~pinned[more_r]
+    np.add.at(dense, (more_r[keep], more_c[keep]), more_v[keep])
+    assert b.has_canonical_format and np.allclose(b.toarray(), dense, rtol=0, atol=1e-12)
