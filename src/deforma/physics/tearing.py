@@ -11,18 +11,19 @@ A cut opens only where the mesh can open: a vertex splits when the triangles aro
 into separate fans (groups joined across uncut edges), each fan getting its own copy of the
 vertex. So cracks start at the outline (or a hole) and run inward one edge per step, along
 the edges most stretched across: the crack follows the stress, at the mesh's resolution.
+Copies are appended after the body's vertices (the indices of pins, grabs and the rest stay
+valid) with the same position, velocity and texture coordinate; the vertex's mass is shared
+between its copies in proportion to the area of their fans, so mass and momentum are kept
+exactly. Every triangle is kept (none is deleted or created): the torn mesh is a valid mesh
+(every edge in one or two triangles) with the texture on both sides.
 
 One crack runs at a time in a body: while a crack's tip advanced in the last step, only the
 tips advance, and a new crack starts (at the most stretched outline edge) only once every
 tip has stopped. A real crack relieves the material beside it faster than the solver can
 show within a step; without the rule, every outline vertex of a sheet stretched evenly past
-``tear_strain`` starts its own crack in the same step, and a sheet pulled apart by two
+``tear_strain`` started its own crack in the same step, and a sheet pulled apart by two
 clamps (1e4 vertices, ``benchmarks/bench_behaviours.py``) shattered into 2172 pieces of
-confetti instead of tearing across. Copies are appended after the body's vertices (the indices of pins, grabs and
-the rest stay valid) with the same position, velocity and texture coordinate; the vertex's
-mass is shared between its copies in proportion to the area of their fans, so mass and
-momentum are kept exactly. Every triangle is kept (none is deleted or created): the torn
-mesh is a valid mesh (every edge in one or two triangles) with the texture on both sides.
+confetti instead of tearing across.
 
 The body stays one :class:`~deforma.Body` whose :attr:`~deforma.Body.pieces` label its
 connected pieces: its pins, grabs, material and scene entry stay whole, and a piece that
