@@ -252,7 +252,7 @@ def system_entries(model, grab_slot, grab_pull, h: float, mass=None):
     Examples
     --------
     >>> from deforma.physics.model import BodyTopology, Model
-    >>> t = BodyTopology.from_arrays([[0, 1], [1, 0]], [[0, 1]])
+    >>> t = BodyTopology.from_arrays([[0, 0], [1, 0]], [[0, 1]])
     >>> m = Model([t], masses=[2.0], stiffness=[100.0], damping=[0.0])
     >>> a = csc_matrix(2, *system_entries(m, np.full(2, -1, np.int32), np.zeros((0, 3)), 0.1))
     >>> a.toarray().round(9).tolist()
