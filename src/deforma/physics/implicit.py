@@ -278,6 +278,21 @@ def system_entries(model, grab_slot, grab_pull, h: float, mass=None):
     return rows, cols, vals
 
 
+@njit(cache=True, inline="always")
+def _sort_rows(ind, val, lo, hi):
+    """Sort ``ind[lo:hi]`` (row indices of one column) and ``val`` with it, in place: an
+    insertion sort, as a column holds a vertex's few neighbours."""
+    for a in range(lo + 1, hi):
+        r, v = ind[a], val[a]
+        b = a - 1
+        while b >= lo and ind[b] > r:
+            ind[b + 1] = ind[b]
+            val[b + 1] = val[b]
+            b -= 1
+        ind[b + 1] = r
+        val[b + 1] = v
+
+
 @njit(cache=True)
 def _compress(n, rows, cols, vals, pinned):
     """CSC arrays ``(indptr, indices, data)`` of the N x N matrix with entries ``(rows,
@@ -313,15 +328,7 @@ def _compress(n, rows, cols, vals, pinned):
     start = 0
     for c in range(n):
         lo, hi = start, ptr[c + 1]
-        for a in range(lo + 1, hi):
-            r, v = ind[a], val[a]
-            b = a - 1
-            while b >= lo and ind[b] > r:
-                ind[b + 1] = ind[b]
-                val[b + 1] = val[b]
-                b -= 1
-            ind[b + 1] = r
-            val[b + 1] = v
+        _sort_rows(ind, val, lo, hi)
         start = hi
         first = out
         for a in range(lo, hi):
@@ -366,15 +373,7 @@ def _merge(ptr, ind, val, rows, cols, vals, pinned):
     out = 0
     for c in range(n):
         lo, hi = extra[c], extra[c + 1]
-        for a in range(lo + 1, hi):  # the column's few extra entries in row order
-            r, v = er[a], ev[a]
-            b = a - 1
-            while b >= lo and er[b] > r:
-                er[b + 1] = er[b]
-                ev[b + 1] = ev[b]
-                b -= 1
-            er[b + 1] = r
-            ev[b + 1] = v
+        _sort_rows(er, ev, lo, hi)  # the column's few extra entries in row order
         first = out
         p, q = ptr[c], lo
         while p < ptr[c + 1] or q < hi:
