@@ -133,6 +133,35 @@ def test_videos(done):
         f"{r['run_id']}.gif" for r in _rows(out) if r["status"] == "ok")
 
 
+def test_states_name_a_texture_file_from_the_folder_they_are_kept_in(folder, tmp_path):
+    # The NPZ is written in a temporary folder on the worker; its scene named the texture file
+    # relative to that folder, so the scene did not load from OUTDIR/states/
+    import tomllib
+    from pathlib import Path
+
+    from PIL import Image
+
+    from deforma.scene.schema import parse_scene
+
+    (folder / "pics").mkdir(exist_ok=True)
+    Image.new("RGB", (8, 8), (200, 40, 40)).save(folder / "pics" / "red.png")
+    (folder / "textured.toml").write_text(TINY_SCENE.replace("detail = 2\n", 'detail = 2\ntexture = "pics/red.png"\n'))
+    spec = sweeps.load_spec(_spec(folder, "tex.toml", 'scene = "textured.toml"\nseconds = 0.3\n[parameters]\n'
+                                                   '"physics.stiffness" = [1000]\n'))
+    kept = tmp_path / "out" / "states"
+    kept.mkdir(parents=True)
+    row = sweeps.simulate(sweeps.scene_for(spec, {}, source="test"), states=str(kept))
+    assert row["status"] == "ok", row["message"]
+    (kept / "run.npz").write_bytes(row["states"])
+    with np.load(kept / "run.npz") as z:
+        doc = tomllib.loads(str(z["scene_toml"]))
+    texture = doc["body"][0]["texture"]
+    assert (kept / texture).resolve() == (folder / "pics" / "red.png").resolve()
+    # the scene loads from where it is kept (parse_scene refuses a texture file that is not there)
+    scene = parse_scene(doc, source="run.npz", base_dir=kept)
+    assert Path(scene.body[0].texture).resolve() == (folder / "pics" / "red.png").resolve()
+
+
 def test_video_mp4_in_process(folder):
     spec = sweeps.load_spec(_spec(folder, "one.toml", 'scene = "tiny.toml"\nseconds = 0.3\n[parameters]\n'
                                                    '"physics.stiffness" = [1000]\n'))

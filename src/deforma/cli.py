@@ -272,7 +272,9 @@ def _padded(loops) -> np.ndarray:
     return out
 
 
-def _save_states(path: str, world, scene, times, frames, poses) -> None:
+def _save_states(path: str, world, scene, times, frames, poses, *, kept_in=None) -> None:
+    """Write ``deforma run --states``' NPZ to ``path``. The scene's texture files are named
+    relative to ``kept_in``, the folder the file will be read from (default: its own)."""
     import tomli_w
 
     from .scene.schema import scene_to_dict
@@ -297,7 +299,8 @@ def _save_states(path: str, world, scene, times, frames, poses) -> None:
         if uv is not None:
             arrays[f"body{i}_uv"] = np.asarray(uv)
     arrays.update(_collider_arrays(world.colliders, poses))
-    arrays["scene_toml"] = np.array(tomli_w.dumps(scene_to_dict(scene, base_dir=Path(path).parent.resolve())))
+    base = Path(path).parent if kept_in is None else Path(kept_in)
+    arrays["scene_toml"] = np.array(tomli_w.dumps(scene_to_dict(scene, base_dir=base.resolve())))
     _write_atomic(Path(path), lambda f: np.savez_compressed(f, **arrays))
 
 

@@ -367,9 +367,12 @@ def _video_view(world, size):
         raise
 
 
-def simulate(scene, *, states: bool = False, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
+def simulate(scene, *, states=False, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
     """Run one scene for its ``run.seconds``; the row's status, message and metrics (and the states NPZ
     and video bytes).
+
+    ``states``: ``False``, or the folder the states NPZ will be kept in (``True``: the working
+    folder), which its scene's texture files are named relative to.
 
     Never raises for the simulation's sake: an unstable world is ``status = "unstable"`` with its
     hint, any other exception ``status = "error"`` with its message.
@@ -430,7 +433,7 @@ def simulate(scene, *, states: bool = False, video: str | None = None, video_siz
         row["final_energy_j"] = float(world.energy().total)
         row["centroid"] = [[float(v) for v in np.mean(b.positions, axis=0)] for b in world.bodies]
         if states:
-            row["states"] = _states_bytes(world, scene, times, frames, poses)
+            row["states"] = _states_bytes(world, scene, times, frames, poses, None if states is True else states)
         if writer is not None:
             writer.close()
             row["video"] = (folder / f"video.{video}").read_bytes()
@@ -454,20 +457,22 @@ def simulate(scene, *, states: bool = False, video: str | None = None, video_siz
     return row
 
 
-def _states_bytes(world, scene, times, frames, poses) -> bytes:
+def _states_bytes(world, scene, times, frames, poses, kept_in=None) -> bytes:
     """The ``deforma run --states`` NPZ, written by the same function, as bytes (the worker may be
-    on another machine than the sweep's folder)."""
+    on another machine than the sweep's folder), its texture files named relative to
+    ``kept_in`` (default: the working folder), where the file will be read, not to the
+    temporary folder it is written in."""
     import tempfile
 
     from .cli import _save_states
 
     with tempfile.TemporaryDirectory(prefix="deforma-sweep-") as folder:
         path = Path(folder) / "states.npz"
-        _save_states(str(path), world, scene, times, frames, poses)
+        _save_states(str(path), world, scene, times, frames, poses, kept_in=Path.cwd() if kept_in is None else kept_in)
         return path.read_bytes()
 
 
-def _worker_run(scene, states: bool, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
+def _worker_run(scene, states, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
     # one thread per run: a worker is one of `workers` processes on the node's cores (the runtime
     # environment sets it too; this covers a cluster started without it)
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
@@ -704,11 +709,12 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     from .cli import _write_atomic
 
     remote = ray.remote(num_cpus=1, max_retries=0)(_worker_run)
+    kept = str((outdir / STATES_FOLDER).resolve()) if states else False  # where the NPZs go
     pending = {}
     try:
         for run in todo:
             scene = scene_for(spec, run.parameters, source=f"{spec.path.name}: run {run.index} ({run.run_id})")
-            pending[remote.remote(scene, states, video, tuple(video_size))] = run
+            pending[remote.remote(scene, kept, video, tuple(video_size))] = run
         finished = len(runs) - len(todo)
         while pending:
             ready, _ = ray.wait(list(pending), num_returns=1)
