@@ -294,63 +294,11 @@ def _sort_rows(ind, val, lo, hi):
 
 
 @njit(cache=True)
-def _compress(n, rows, cols, vals, pinned):
-    """CSC arrays ``(indptr, indices, data)`` of the N x N matrix with entries ``(rows,
-    cols, vals)`` (duplicates summed, rows sorted in each column), each ``pinned`` row
-    replaced by the identity's."""
-    ptr = np.zeros(n + 1, np.int64)
-    for k in range(rows.shape[0]):
-        if not pinned[rows[k]]:
-            ptr[cols[k] + 1] += 1
-    for c in range(n):
-        if pinned[c]:
-            ptr[c + 1] += 1  # the identity's 1
-    for c in range(n):
-        ptr[c + 1] += ptr[c]
-    fill = ptr[:-1].copy()
-    ind = np.empty(ptr[n], np.int64)
-    val = np.empty(ptr[n])
-    for c in range(n):
-        if pinned[c]:
-            ind[fill[c]] = c
-            val[fill[c]] = 1.0
-            fill[c] += 1
-    for k in range(rows.shape[0]):
-        if not pinned[rows[k]]:
-            c = cols[k]
-            ind[fill[c]] = rows[k]
-            val[fill[c]] = vals[k]
-            fill[c] += 1
-    # each column: rows in order (insertion sort: a column holds a vertex's few neighbours),
-    # duplicates summed in place, and entries that sum to exactly zero dropped (a right
-    # triangle's two legs do not couple): a stored zero would cost the factor fill
-    out = 0
-    start = 0
-    for c in range(n):
-        lo, hi = start, ptr[c + 1]
-        _sort_rows(ind, val, lo, hi)
-        start = hi
-        first = out
-        for a in range(lo, hi):
-            if out > first and ind[out - 1] == ind[a]:
-                val[out - 1] += val[a]
-            else:
-                if out > first and val[out - 1] == 0.0 and ind[out - 1] != c:
-                    out -= 1
-                ind[out] = ind[a]
-                val[out] = val[a]
-                out += 1
-        if out > first and val[out - 1] == 0.0 and ind[out - 1] != c:
-            out -= 1
-        ptr[c + 1] = out
-    return ptr, ind[:out], val[:out]
-
-
-@njit(cache=True)
 def _merge(ptr, ind, val, rows, cols, vals, pinned):
     """CSC arrays of the canonical CSC matrix ``(ptr, ind, val)`` plus the entries ``(rows,
     cols, vals)`` (those in ``pinned`` rows left out), summed where they meet; entries that
-    sum to exactly zero off the diagonal dropped."""
+    sum to exactly zero off the diagonal dropped (a right triangle's two legs do not couple:
+    a stored zero would cost the factor fill)."""
     n = ptr.shape[0] - 1
     extra = np.zeros(n + 1, np.int64)
     for k in range(rows.shape[0]):
@@ -424,9 +372,9 @@ def csc_matrix(n: int, rows, cols, vals, pinned=None) -> sp.csc_matrix:
     ``(rows, cols, vals)`` summed where they repeat, each ``pinned`` row replaced by the
     identity's: its equation becomes ``x_p = b_p`` (the caller puts the pinned position in
     ``b_p``), while the free rows keep their coupling to it, so that it acts on them as a
-    known position. One compiled pass: SciPy's coordinate-to-CSC conversion, the element
-    products and the row replacement took 4-5 ms on a 2500-vertex sheet, at every tear and
-    every new contact set.
+    known position. One compiled pass (:func:`with_entries` on the pinned rows' identity):
+    SciPy's coordinate-to-CSC conversion, the element products and the row replacement took
+    4-5 ms on a 2500-vertex sheet, at every tear and every new contact set.
 
     Examples
     --------
@@ -438,11 +386,10 @@ def csc_matrix(n: int, rows, cols, vals, pinned=None) -> sp.csc_matrix:
     import scipy.sparse as sp
 
     pin = np.zeros(n, np.bool_) if pinned is None else np.asarray(pinned, dtype=np.bool_)
-    ptr, ind, val = _compress(n, np.asarray(rows, dtype=np.int64), np.asarray(cols, dtype=np.int64),
-                              np.asarray(vals, dtype=np.float64), pin)
-    a = sp.csc_matrix((val, ind, ptr), shape=(n, n))
-    a.has_sorted_indices = True
-    return a
+    ptr = np.zeros(n + 1, np.int64)
+    np.cumsum(pin, out=ptr[1:])
+    identity = sp.csc_matrix((np.ones(int(ptr[-1])), np.flatnonzero(pin), ptr), shape=(n, n))  # the pinned rows
+    return with_entries(identity, rows, cols, vals, pin)
 
 
 @register_integrator("implicit-euler")
