@@ -122,18 +122,48 @@ def oblique_hit(name, mu, *, on_body):
     return float(box.velocities[:, 0].mean())
 
 
-# Not implicit Euler: there the same hit gains sideways speed (3.20 m/s at mu = 0, 3.11 at
-# mu = 1; on the collider 2.99 and 2.20), an open defect of its body contacts.
-@pytest.mark.parametrize("name", ["symplectic-euler", "xpbd"])
+@pytest.mark.parametrize("name", ["symplectic-euler", "implicit-euler", "xpbd"])
 def test_an_oblique_hit_on_another_body_loses_sideways_speed_to_friction_as_on_a_collider(name):
     # XPBD's sweep projected body contacts without friction, and the contact stage after it
     # sees a pair the sweep already separated: where the sweep does the separating (here a
     # plank of two triangles, whose contact thickness is 10 cm, so the pair is projected from
     # 5 cm away) the hit was frictionless (3.0 m/s kept at mu = 1; on a collider 2.2 m/s).
-    # Now the sweep's position-level friction acts on body contacts as on colliders (2.25 m/s).
-    assert oblique_hit(name, 0.0, on_body=True) == pytest.approx(3.0, abs=1e-6)  # frictionless: kept
+    # Now the sweep's position-level friction acts on body contacts as on colliders.
+    # Implicit Euler gained sideways speed here (3.20 m/s at mu = 0, 3.11 at mu = 1): its
+    # contacts projected the iterate, which their own weight holds, so three iterations
+    # were far from converged (implicit.free_estimate); it keeps 2.98 now, the rest of the
+    # way to 3.0 being unconverged iterations, not a force (3.000 with 10 iterations).
+    frictionless = oblique_hit(name, 0.0, on_body=True)
+    if name == "implicit-euler":
+        assert frictionless == pytest.approx(3.0, abs=0.03)
+    else:
+        assert frictionless == pytest.approx(3.0, abs=1e-6)  # frictionless: kept
     on_body, on_collider = oblique_hit(name, 1.0, on_body=True), oblique_hit(name, 1.0, on_body=False)
     assert on_body < 2.6 and on_collider < 2.6, (on_body, on_collider)
+
+
+@pytest.mark.parametrize("name", ["implicit-euler", "xpbd"])
+def test_a_body_placed_within_another_bodys_contact_thickness_is_not_thrown_off(name):
+    # The two-triangle plank's contact thickness is 10 cm and the box starts 5 cm above it.
+    # The stable solvers derive velocities from positions and pushed such a pair out to its
+    # target in one substep: the box left at 7.8 m/s under implicit Euler and 7.5 under XPBD.
+    # Now the solve keeps the pair from closing in but does not push it apart
+    # (contacts.hold_start_distance), and the contact stage restores the distance by
+    # positions, as under symplectic Euler, whose springs then throw the pushed box off at
+    # 3.0 m/s (2.8 and 2.6 here).
+    speeds = {}
+    for integrator in ("symplectic-euler", name):
+        w = deforma.World(dt=1 / 600, integrator=integrator, stiffness=3000.0, damping=2.0)
+        plank = w.add_body(deforma.mesh.box([[-2, -0.1], [2, -0.1], [2, 0.1], [-2, 0.1]], detail=0, edges=True))
+        plank.pin(np.arange(plank.n_vertices))
+        box = w.add_body(deforma.mesh.box([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]], detail=2),
+                         position=(0.0, 0.25))
+        up = []
+        for _ in range(60):
+            w.step()
+            up.append(box.velocities[:, 1].mean())
+        speeds[integrator] = max(up)
+    assert speeds[name] < 1.1 * speeds["symplectic-euler"], speeds
 
 
 def test_a_body_leaves_the_floor_when_thrown_up():

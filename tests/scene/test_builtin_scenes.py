@@ -148,12 +148,15 @@ def test_dent_keeps_its_dent():
     for _ in range(int(round(2.0 / w.dt))):
         w.step()
     x = b.positions
-    # the middle of the bottom edge sits higher than its ends: bent over the corner, and staying
+    # the middle of the bottom edge sits higher than its ends: bent over the corner, and staying.
+    # 9.6 cm now, 10.9 cm before implicit Euler's contacts converged (implicit.free_estimate):
+    # then the corner's tip sank 4 cm into the block, which flattened the notch around it.
     bottom = np.abs(rest0[:, 1] - rest0[:, 1].min()) < 1e-9
     xs = x[bottom]
     middle = xs[np.argsort(np.abs(rest0[bottom, 0]))[:3], 1].mean()
     ends = xs[np.argsort(-np.abs(rest0[bottom, 0]))[:4], 1].mean()
-    assert middle - ends > 0.1
+    assert middle - ends > 0.08
+    assert b.center_of_mass[1] > 1.03  # resting on the tip (at y = 0.87), not sunk onto it
     assert (signed_areas(b.positions, b.triangles) <= 0).sum() <= 6  # only over the corner
 
 

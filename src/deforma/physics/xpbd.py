@@ -38,7 +38,9 @@ projected as the stage projects them, with the same position-level friction as c
 (stick or slide decided by the first sweep; :func:`~deforma.physics.contacts.project_contacts`).
 That friction matters where the sweep itself separates a pair (a thick contact, a fast hit):
 the contact stage after the sweep then sees no approach and gives no friction impulse.
-Resting pairs are held by the stage's speculative contacts, which carry friction. The full
+Resting pairs are held by the stage's speculative contacts, which carry friction. A pair
+that starts the substep closer than its target is held there, not pushed apart (velocities
+come from positions: :func:`~deforma.physics.contacts.hold_start_distance`). The full
 collider response and contact stage still run after the sweep.
 
 One Gauss-Seidel sweep per substep (``iterations = 1``, the "small steps" choice) carries
@@ -59,7 +61,7 @@ from numba import njit
 
 from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
 from .contacts import (ST_NEEDED, ST_PAIRS_NEEDED, ST_STAMP, contact_stage, detect_contacts, gather_start,
-                       project_contacts)
+                       hold_start_distance, project_contacts)
 from .elements import project_elements
 from .integrators import register_integrator
 
@@ -258,6 +260,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         n_body = detect_contacts(x, ctopo, cscr, cbuf)  # of the predicted motion
         if n_body < 0:
             return 0  # the contact buffer is too small; the world grows it and repeats the step
+        hold_start_distance(x_prev, ctopo, cbuf, n_body)
         stick = np.full(n_body, -1.0)  # the body contacts' stick or slide: not decided yet
         for it in range(iterations):
             if sub == 0 and it == 0:
