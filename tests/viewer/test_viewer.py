@@ -513,10 +513,12 @@ def test_a_torn_body_keeps_drawing_and_stays_grabbable(viewer):
     for k in range(240):  # pull the bottom edge down until the sheet tears
         post(pygame.MOUSEMOTION, pos=(press[0], press[1] + min(300, 5 * k)), rel=(0, 5), buttons=(1, 0, 0))
         run(viewer, 1)
-        if body(viewer).pieces.max() >= 1:
+        if body(viewer).n_vertices > n0 + 10:
             break
     b = body(viewer)
-    assert b.pieces.max() >= 1 and b.n_vertices > n0, "the sheet did not tear"
+    # torn: whether the crack also runs right across (two pieces) depends on the pull's
+    # details; a crack that stops short leaves one piece with a hole, drawn just the same
+    assert b.n_vertices > n0 + 10, "the sheet did not tear"
     post(pygame.MOUSEBUTTONUP, pos=press, button=1)
     run(viewer, 10)
     assert viewer.unstable is None and np.isfinite(b.positions).all()

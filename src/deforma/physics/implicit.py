@@ -607,8 +607,9 @@ class ImplicitEuler:
             # scr.xp still holds x_n (detect_contacts only read it): no second gather_start
             topo = model.contact
             push_edges_off_corners(x, v, model.vertex_inv_mass, topo.ce_a, topo.ce_b, topo.cv_vertex, inputs.rects)
+            # the stage's impulses change velocities only (contact_stage says why)
             if contact_stage(x, v, model.vertex_inv_mass, model.contact, scr, inputs.contacts, inputs.rects,
-                             inputs.hits, float(h)) < 0:
+                             inputs.hits, float(h), False) < 0:
                 return 0  # the contact buffer is too small; the world grows it and repeats the step
         return 0
 
