@@ -594,9 +594,9 @@ def hold_start_distance(x_start, topo, out, count):
 
     Why: those solvers derive velocities from positions, so a pair that started closer
     than its target (a body placed within another's contact thickness) was pushed out to
-    it in one substep and flew apart (a box placed 5 cm into a 10 cm thickness left at 6
-    m/s under implicit Euler). The contact stage after the solve restores the distance by
-    positions only, without velocity, as it does under symplectic Euler.
+    it in one substep and flew apart (a box placed 5 cm into a 10 cm thickness left at 7.8
+    m/s under implicit Euler, 7.5 m/s under XPBD). The contact stage after the solve restores
+    the distance by positions only, without velocity, as it does under symplectic Euler.
 
     Examples
     --------
@@ -806,9 +806,10 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
 
     See the module docstring; linear momentum is kept exactly, since every impulse is split
     between the vertex and the edge's ends by inverse mass. ``follow``: the impulses move the
-    vertices too, by ``h`` times their velocity change (see :func:`contact_stage`). A vertex the response moves into a
-    collider meets it at once (:func:`~deforma.physics.colliders.collide_point`), so that the
-    sweeps settle with the colliders in place.
+    vertices too, by ``h`` times their velocity change (see :func:`contact_stage`). A vertex
+    the response moves into a collider meets it at once
+    (:func:`~deforma.physics.colliders.collide_point`), so that the sweeps settle with the
+    colliders in place.
     """
     cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
     o_vertex, o_edge, o_s, o_normal, o_target, o_mu = out.vertex, out.edge, out.s, out.normal, out.target, out.mu
