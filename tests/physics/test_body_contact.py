@@ -207,8 +207,11 @@ def test_a_fast_vertex_does_not_jump_a_thin_collider(name):
 
 # -- the pile --------------------------------------------------------------------------------
 def test_pile_scene_never_crosses_and_no_vertex_enters_another_body():
+    # as shipped: implicit Euler at 1/60 s with 2 substeps (it ran at 1/600 s before the heap
+    # came to rest at this step; tests/physics/test_solver_contacts.py says what changed)
     w = deforma.load_scene("pile")
     assert len(w.bodies) >= 12
+    assert w.integrator == "implicit-euler" and w.dt == pytest.approx(1 / 60) and w.substeps == 2
     steps = int(round(6.0 / w.dt))  # poured, landed and at rest
     for k in range(steps):
         w.step()
@@ -227,7 +230,7 @@ def test_pile_scene_never_crosses_and_no_vertex_enters_another_body():
                     assert not inside.any(), (k, c, x[inside][:3])
     heights = [b.center_of_mass[1] for b in w.bodies]
     assert max(heights) < 2.5  # poured in and settled into a heap, not stuck in the air
-    assert max(np.abs(b.velocities).max() for b in w.bodies) < 0.05
+    assert max(np.abs(b.velocities).max() for b in w.bodies) < 0.1  # 0.04 m/s measured
     # finite elements: the bottom of the heap keeps its shape (springs left folded triangles)
     assert not any((signed_areas(b.positions, b.triangles) <= 0).any() for b in w.bodies)
 
