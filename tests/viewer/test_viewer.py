@@ -517,7 +517,7 @@ def test_a_torn_body_keeps_drawing_and_stays_grabbable(viewer):
             break
     b = body(viewer)
     # torn: whether the crack also runs right across (two pieces) depends on the pull's
-    # details; a crack that stops short leaves one piece with a hole, drawn just the same
+    # details; a crack that stops short leaves one piece with a slit, drawn just the same
     assert b.n_vertices > n0 + 10, "the sheet did not tear"
     post(pygame.MOUSEBUTTONUP, pos=press, button=1)
     run(viewer, 10)
