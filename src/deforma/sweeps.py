@@ -742,11 +742,22 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
             if progress is not None:
                 progress(finished, len(runs), counts["unstable"] + counts["error"])
     finally:
-        for ref in pending:  # Ctrl-C or a failure here: what is done stays, the rest is dropped
+        # Ctrl-C or a failure here: what is done stays, the rest is dropped. Runs finishing
+        # this instant are let finish first (half a second at most): Ray 2.60's driver can
+        # abort when a cancellation crosses a task's completion ("Check failed: it !=
+        # submissible_tasks_.end() Tried to complete task that was not pending", a race like the
+        # one ray-project/ray#54798 fixed for retries), and a sweep's runs, of similar length,
+        # tend to finish together: Ctrl-C right after one finished hit it once in a test.
+        if pending:
             try:
-                ray.cancel(ref, force=True)
-            except Exception:  # noqa: BLE001 - already finished or gone
-                pass
+                _, left = ray.wait(list(pending), num_returns=len(pending), timeout=0.5)
+            except BaseException:  # noqa: BLE001 - a second Ctrl-C, or Ray already gone: cancel all
+                left = list(pending)
+            for ref in left:
+                try:
+                    ray.cancel(ref, force=True)
+                except Exception:  # noqa: BLE001 - already finished or gone
+                    pass
         if started:
             ray.shutdown()
     return result()
