@@ -586,6 +586,14 @@ def detect_contacts(x, topo, scr, out):
     return n
 
 
+@njit(cache=True, inline="always")
+def _pair_distance(x, ip, ia, ib, s, nx, ny):
+    """How far vertex ``ip`` is in front of the point ``(1 - s) x_ia + s x_ib`` of its
+    contact's edge, along the contact's normal ``(nx, ny)`` (m)."""
+    ca = 1.0 - s
+    return (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
+
+
 @njit(cache=True)
 def hold_start_distance(x_start, topo, out, count):
     """Lower each contact's target in ``out[:count]`` to the distance its pair had at the
@@ -614,9 +622,7 @@ def hold_start_distance(x_start, topo, out, count):
         ip = cv[out.vertex[c]]
         ia = cv[ce_a[out.edge[c]]]
         ib = cv[ce_b[out.edge[c]]]
-        s = out.s[c]
-        d = (x_start[ip, 0] - (1.0 - s) * x_start[ia, 0] - s * x_start[ib, 0]) * out.normal[c, 0] \
-            + (x_start[ip, 1] - (1.0 - s) * x_start[ia, 1] - s * x_start[ib, 1]) * out.normal[c, 1]
+        d = _pair_distance(x_start, ip, ia, ib, out.s[c], out.normal[c, 0], out.normal[c, 1])
         if d < out.target[c]:
             out.target[c] = max(d, 0.0)
 
@@ -670,7 +676,7 @@ def project_contacts(x, x_prev, inv_mass, topo, out, count, stick):
         w = wp + wa * ca + wb * s
         if w <= 0.0:
             continue
-        d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
+        d = _pair_distance(x, ip, ia, ib, s, nx, ny)
         push = o_target[c] - d
         if push > 0.0:
             lam = push / w
@@ -843,7 +849,7 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
                 # Speculative: a pair still farther than its target may approach by what is
                 # left of the gap in the next substep, no more; closer pairs may not approach.
                 # So a resting pair's support never lapses (it would pop out and back in).
-                d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
+                d = _pair_distance(x, ip, ia, ib, s, nx, ny)
                 allowed = -max(d - o_target[c], 0.0) * inv_h
                 rvx = v[ip, 0] - ca * v[ia, 0] - s * v[ib, 0]
                 rvy = v[ip, 1] - ca * v[ia, 1] - s * v[ib, 1]
@@ -860,7 +866,7 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
                     if check_rects:
                         _keep_out_three(x, v, xp, rects, reach2, h, ip, ia, ib, o_vertex[c], ce_a[o_edge[c]],
                                         ce_b[o_edge[c]])
-            d = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny
+            d = _pair_distance(x, ip, ia, ib, s, nx, ny)
             gap = o_target[c] - d
             if gap > 0.0:
                 lam = gap / w
