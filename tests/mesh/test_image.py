@@ -83,6 +83,37 @@ def test_outline_is_made_of_mesh_edges(name):
     assert np.median(lengths) == pytest.approx(3.0, abs=0.1)
 
 
+def _point_segment_distances(p, a, b):
+    """(P, S) distances from points p to segments a-b."""
+    ab = b - a
+    t = np.clip(((p[:, None, :] - a[None]) * ab[None]).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-300), 0, 1)
+    q = a[None] + t[..., None] * ab[None]
+    return np.hypot(*(p[:, None, :] - q).transpose(2, 0, 1))
+
+
+@pytest.mark.parametrize("name", BUILTIN_TEXTURES)
+@pytest.mark.parametrize("resolution, edge_step", [(22, 16), (12, 8), (30, 30)])
+def test_coarse_outline_has_no_needles_and_stays_within_a_pixel(name, resolution, edge_step):
+    # Coarse settings (the pile scene's are 22/16) used to put two outline points a pixel
+    # apart at ear tips and toes; with an interior point a spacing away that made needles
+    # (2.2-2.5 degrees, 0.7-0.9 px high). Close pairs are merged where the outline allows.
+    m = from_image(name, resolution=resolution, edge_step=edge_step, scale=1.0)
+    px = image_px(m)
+    q = px[m.triangles]
+    twice = np.abs((q[:, 1, 0] - q[:, 0, 0]) * (q[:, 2, 1] - q[:, 0, 1]) - (q[:, 1, 1] - q[:, 0, 1]) * (q[:, 2, 0] - q[:, 0, 0]))
+    longest = np.max([np.hypot(*(q[:, k] - q[:, (k + 1) % 3]).T) for k in range(3)], axis=0)
+    assert m.min_angle >= 10.0
+    assert (twice / longest).min() >= 1.0  # the thinnest triangle's height, px
+    # ... and the merged outline still follows the picture: every point of the sub-pixel
+    # contour is within a pixel of the mesh boundary
+    alpha = np.pad(m.texture[..., 3].astype(float), 1)
+    contour = np.concatenate([c[:, ::-1] - 1 + 0.5 for c in find_contours(alpha, 127.5) if len(c) > 20])
+    e = px[m.boundary_edges]
+    d = np.concatenate([_point_segment_distances(chunk, e[:, 0], e[:, 1]).min(axis=1)
+                        for chunk in np.array_split(contour, max(1, len(contour) // 500))])
+    assert d.max() <= 1.0 + 1e-6
+
+
 def test_donut_keeps_its_hole(masks):
     m = from_image("donut", resolution=4, edge_step=2, scale=SCALE)
     assert len(m.boundary) == 2

@@ -384,6 +384,9 @@ def test_material_drop_down_makes_the_bodies_finite_elements(demo):
 
 def test_fem_under_the_explicit_integrator_shows_the_hint(demo):
     ins = demo.inspector
+    # four times the default E: about 110 substeps at the demo's step, beyond what the viewer
+    # raises on its own (MAX_AUTO_SUBSTEPS)
+    demo.session.material_values["youngs_modulus"] = 4e4
     scroll_into_view(demo, ins.material_menu)
     choose_from_menu(demo, ins.material_menu, "neo-hookean")
     assert demo.session.world.material.model == "neo-hookean"

@@ -17,7 +17,9 @@ How it works (the reasons are in ``docs/mesh.md``):
    without transparency. One closed ring per outline and per hole, resampled every
    ``edge_step`` pixels of arc length; where a straight segment would stray more than half
    a pixel from the contour (a narrow notch, a sharp tip) the farthest contour point is
-   added, so concave parts stay concave.
+   added, so concave parts stay concave. Points closer than 0.4 ``edge_step`` are then
+   merged into one where the outline stays within a pixel (each such pair would make a
+   needle triangle with an interior point).
 3. **Interior points.** Every ``resolution``-th pixel in each direction that is foreground.
    With an outline, points closer to it than about half the larger spacing are left out:
    they would be near-duplicates of outline points and would make slivers.
@@ -142,7 +144,9 @@ def from_image(
         Spacing of the outline points, in pixels of outline length. At least 1. Sharp
         features (a narrow notch, a tip) get an extra point where a segment would stray
         more than half a pixel from the outline; a regular point next to such a feature is
-        merged into it, so spacings range from below ``edge_step`` to ``1.5 * edge_step``.
+        merged into it, and so are two points closer than ``0.4 * edge_step`` where the
+        outline then stays within a pixel, so spacings are ``edge_step`` along smooth parts
+        and range from about 0.15 times it (a narrow notch's two corners) to under twice it.
     scale : float, keyword-only
         Metres per pixel, > 0.
     background : str or tuple of int, keyword-only
@@ -663,6 +667,8 @@ def _from_array(source):
 
 _MIN_PIECE = 9  # pixels: smaller specks and holes are noise, not shape
 _OUTLINE_TOLERANCE = 0.5  # pixels: how far an outline segment may stray from the contour
+_MERGE_GAP = 0.4  # of edge_step: outline points closer than this are merged ...
+_MERGE_TOLERANCE = 1.0  # pixels: ... where the merged outline strays at most this far (a pixel)
 
 
 def _clean(mask):
@@ -731,6 +737,73 @@ class _Ring:
             self.s = np.union1d(uniform, features)
         self._split_far(tolerance)  # whatever happened above, end within tolerance
 
+    def merge_close(self, gap, tolerance):
+        """Merge points closer than ``gap`` px of arc where the outline allows it.
+
+        Feature points land on contour vertices, and two of them can end a pixel apart (both
+        sides of a rounded tip, a notch's two corners). With an interior point a spacing
+        away, such a pair makes a needle triangle whose tiny height sets a finite element's
+        stable step (a bunny at ``edge_step=16`` had a 0.9 px high triangle). Each close
+        pair, closest first, becomes one point: the better of its two ends or the contour
+        vertex between its neighbours that keeps both new segments closest to the contour,
+        provided they stay within ``tolerance``; otherwise the pair is kept (a narrow notch
+        needs both its corners).
+        """
+        t = self.cum[:-1]
+        t3 = np.concatenate([t - self.length, t, t + self.length])  # the closed arc unrolled
+        kept = set()  # pairs that cannot merge (looked at once)
+        while len(self.s) > 3:
+            s, n = self.s, len(self.s)
+            d = np.diff(np.r_[s, s[0] + self.length])
+            merged = False
+            for i in np.argsort(d, kind="stable"):
+                if d[i] >= gap:
+                    break
+                if (s[i], s[(i + 1) % n]) in kept:
+                    continue
+                # the pair (i, i + 1) between its neighbours (i - 1) and (i + 2), unrolled
+                # along the closed arc so that positions increase
+                lo = s[i - 1] - (self.length if i == 0 else 0.0)
+                hi = s[(i + 2) % n] + (self.length if i + 2 >= n else 0.0)
+                cand = t3[(t3 > lo) & (t3 < hi)]
+                worst = self._deviation(lo, cand, hi) if n > 4 and cand.size else np.full(1, np.inf)
+                k = int(np.argmin(worst))
+                if worst[k] > tolerance:
+                    kept.add((s[i], s[(i + 1) % n]))
+                    continue
+                keep = np.ones(n, bool)
+                keep[[i, (i + 1) % n]] = False
+                self.s = np.union1d(s[keep], [cand[k] % self.length])
+                merged = True
+                break
+            if not merged:
+                return
+
+    def _deviation(self, lo, mids, hi):
+        """The largest distance of the contour from the two segments lo-mid and mid-hi, per mid.
+
+        Arc positions may run past the ends of ``[0, length)`` (they wrap).
+        """
+        t = np.concatenate([self.cum[:-1] - self.length, self.cum[:-1], self.cum[:-1] + self.length])
+        v = np.concatenate([self.dense[:-1]] * 3)
+        inside = (t > lo) & (t < hi)
+        t, v = t[inside], v[inside]
+
+        def at(u):
+            u = np.asarray(u, float) % self.length
+            return np.c_[np.interp(u, self.cum, self.dense[:, 0]), np.interp(u, self.cum, self.dense[:, 1])]
+
+        a, m, b = at([lo])[0], at(mids), at([hi])[0]
+        first = t[None, :] <= mids[:, None]  # which segment each contour vertex is measured to
+        start = np.where(first[..., None], a, m[:, None, :])
+        end = np.where(first[..., None], m[:, None, :], b)
+        ab = end - start
+        rel = v[None, :, :] - start
+        length = np.hypot(ab[..., 0], ab[..., 1])
+        cross = np.abs(ab[..., 0] * rel[..., 1] - ab[..., 1] * rel[..., 0])
+        dist = np.where(length > 0, cross / np.where(length > 0, length, 1.0), np.hypot(rel[..., 0], rel[..., 1]))
+        return dist.max(axis=1) if dist.shape[1] else np.zeros(len(mids))
+
     def _split_far(self, tolerance):
         """Split until every segment is within tolerance; return the arc positions added."""
         t = self.cum[:-1]
@@ -784,6 +857,7 @@ def _outline_rings(field, level, step):
             continue
         ring = _Ring(xy, step)
         ring.refine(_OUTLINE_TOLERANCE)
+        ring.merge_close(_MERGE_GAP * step, _MERGE_TOLERANCE)
         rings.append(ring)
     return rings
 
