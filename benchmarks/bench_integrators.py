@@ -14,6 +14,9 @@ it. Each integrator runs at settings that show the body as stiff as it is:
   give the height at the end of the timed steps (the body still rings a little) and use the
   same substeps at 1e5 vertices.
 
+``python benchmarks/bench_integrators.py --xpbd-sag`` prints XPBD's sag at 1/60 s against
+its estimate ``g H h^2 / l^2`` (``World.xpbd_substeps``; docs/integrators.md).
+
 Figures are medians of timed ``world.step()`` calls after warm-up steps (which include
 Numba compilation and, for implicit Euler, the one factorization). The cost per simulated
 second is the step time divided by ``dt``. A separate row times one implicit Euler step of
@@ -113,10 +116,51 @@ def sag(n: int = 100) -> None:
                 print(f"{name} x {s}: unstable ({e})")
 
 
+def _height_lost(w, body, seconds: float = 2.0) -> float:
+    """Fraction of its rest height a body has lost after ``seconds`` (averaged over the last 1/2 s)."""
+    rest = np.ptp(body.topology.rest_positions[:, 1])
+    steps = int(round(seconds / w.dt))
+    heights = []
+    for k in range(steps):
+        w.step()
+        if k >= steps - int(round(0.5 / w.dt)):
+            heights.append(np.ptp(body.positions[:, 1]))
+    return 1.0 - float(np.mean(heights)) / rest
+
+
+def xpbd_sag() -> None:
+    """XPBD's sag at 1/60 s against its estimate g H h^2 / l^2 (docs/integrators.md,
+    "How many substeps XPBD needs"): the pile's bunny and two spring grids on a floor."""
+    g = 9.81
+
+    def estimate(w, body):
+        x, e = body.topology.rest_positions, body.topology.springs
+        spacing = np.median(np.hypot(*(x[e[:, 1]] - x[e[:, 0]]).T))
+        h = w.dt / w.substeps
+        return g * np.ptp(x[:, 1]) * h * h / spacing**2
+
+    bunny = deforma.mesh.from_image("bunny", resolution=22, edge_step=16, scale=0.0022)
+    for s in (2, 4, 8, 16):
+        mat = deforma.Material("corotated", youngs_modulus=2000.0, poisson_ratio=0.3, density=5.5)
+        w = deforma.World(dt=1 / 60, substeps=s, integrator="xpbd", material=mat, friction=0.4,
+                          static_friction=0.6, air_drag=0.6)
+        w.add_collider(deforma.Rect((0.0, -0.2), (4.4, 0.4), 0.0))
+        body = w.add_body(bunny, position=(0.0, 0.45))
+        est = estimate(w, body)
+        print(f"bunny x {s}: estimate {est:.4f}, height lost {_height_lost(w, body):.4f}")
+    for n, counts in ((30, (1, 2, 4, 8, 22)), (100, (16, 32, 64))):
+        for s in counts:
+            w, body = make_world(n, "xpbd", substeps=s)
+            est = estimate(w, body)
+            print(f"{n} x {n} springs x {s}: estimate {est:.4f}, height lost {_height_lost(w, body):.4f}")
+
+
 if __name__ == "__main__":
     from common import format_table
 
     if "--sag" in sys.argv:
         sag()
+    elif "--xpbd-sag" in sys.argv:
+        xpbd_sag()
     else:
         print(format_table(run(quick="--quick" in sys.argv)))

@@ -59,6 +59,20 @@ strength = 10.0
 """
 
 
+def test_run_under_xpbd_with_too_few_substeps_says_how_many_hold_the_bodies(tmp_path, capsys):
+    scene = tmp_path / "stand.toml"
+    scene.write_text('[physics]\ndt = 0.016666666666666666\nintegrator = "xpbd"\n'
+                     '[[body]]\nshape = "box"\ncorners = [[-0.5, 0], [0.5, 0], [0.5, 1], [-0.5, 1]]\ndetail = 28\n'
+                     '[[collider]]\ncenter = [0, -0.2]\nsize = [3, 0.4]\n')
+    code, _, err = run(capsys, "run", str(scene), "--seconds", "0.05")
+    assert code == 0, err
+    assert "note: under xpbd with substeps = 1 the bodies sag under their own weight" in err
+    assert "22 substeps per dt" in err
+    scene.write_text(scene.read_text().replace('integrator = "xpbd"', 'integrator = "xpbd"\nsubsteps = 22'))
+    code, _, err = run(capsys, "run", str(scene), "--seconds", "0.05")
+    assert code == 0 and "note:" not in err, err
+
+
 def test_run_writes_gif_with_the_expected_frames(tmp_path, capsys):
     # thrown up at 10 m/s, the box moves pixels every frame, so no two frames are alike
     # (a GIF stores identical neighbours once, with their durations added)

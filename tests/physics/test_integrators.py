@@ -399,3 +399,38 @@ def test_implicit_euler_rests_where_forces_balance_whatever_the_air_drag():
         ends.append(b.positions[:, 1].min())
     stretch = [-0.5 - e for e in ends]
     assert stretch[0] > 0.05 and abs(stretch[1] / stretch[0] - 1) < 0.01, stretch
+
+
+def _standing_grid(n, substeps):
+    """A 1 m square of n x n vertices (2000 N/m springs, 1 kg) standing on a floor under XPBD."""
+    w = deforma.World(dt=1 / 60, substeps=substeps, stiffness=2000.0, damping=0.5, mass=1.0, integrator="xpbd")
+    w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
+    body = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=n - 2), position=(0.0, 0.5 + 1e-6))
+    return w, body
+
+
+def test_xpbd_substeps_tells_holding_from_sinking():
+    # One sweep per substep carries the floor's support one row up: with the substeps the
+    # estimate asks for, a 30 x 30 body stands within 1% of its height; with a quarter of
+    # them it sinks into itself (measured 66%)
+    w, body = _standing_grid(30, 1)
+    need = w.xpbd_substeps()
+    assert need == 22  # 1 m, spacing 1/29 m: dt / (l sqrt(0.01 / (2 g H))) = 21.4
+    rest = np.ptp(body.topology.rest_positions[:, 1])
+    for substeps, lo, hi in ((need, 0.0, 0.01), (need // 4, 0.1, 1.0)):
+        w, body = _standing_grid(30, substeps)
+        for _ in range(90):
+            w.step()
+        assert lo < 1 - np.ptp(body.positions[:, 1]) / rest < hi, substeps
+
+
+def test_xpbd_substeps_scales_with_step_iterations_and_gravity():
+    w, _ = _standing_grid(30, 1)
+    assert w.xpbd_substeps(strain=0.04) == 11  # half of 22 (rounded up): h grows as sqrt(strain)
+    w._integrator.iterations = 4
+    assert w.xpbd_substeps() == 11  # the sag goes as h^2 / sweeps: four sweeps do what twice the substeps do
+    w.gravity = (0.0, 0.0)
+    assert w.xpbd_substeps() == 1
+    for bad in (0.0, 1.0, float("nan"), True, "0.01"):
+        with pytest.raises(ValueError, match=r"strain must be a number in \(0, 1\)"):
+            w.xpbd_substeps(strain=bad)

@@ -97,10 +97,13 @@ def test_a_step_too_long_for_xpbd_is_reported_as_a_lost_shape():
     w = deforma.load_scene("demo")
     w.integrator = "xpbd"
     w.dt = 1 / 30
-    with pytest.raises(deforma.SimulationUnstable, match="lost its shape at step [0-9]+: its area fell"):
+    with pytest.raises(deforma.SimulationUnstable, match="lost its shape at step [0-9]+: its area fell") as e:
         for _ in range(120):
             w.step()
     assert np.isfinite(w.bodies[0].positions).all()
+    # the hint says how many substeps hold the body up under XPBD
+    assert f"raise substeps to {w.xpbd_substeps()} (world.xpbd_substeps())" in e.value.hint
+    assert w.xpbd_substeps() > w.substeps
 
 
 def test_the_built_in_scenes_never_lose_their_shape_check():

@@ -167,6 +167,17 @@ def test_integrator_switches_on_the_running_world_and_is_saved(tmp_path):
     assert deforma.load_scene(path).integrator == "implicit-euler"
 
 
+def test_xpbd_with_too_few_substeps_says_how_many_hold_the_bodies():
+    s = Session("pile")  # 1/60 s x 2: the heap's bodies need about 14 under XPBD
+    s.set_integrator("xpbd")
+    assert s.note_is_warning and "14 substeps, or implicit-euler, hold them" in s.note
+    s.world.substeps = 14
+    s.set_integrator("xpbd")
+    assert s.note == ""
+    s.set_integrator("implicit-euler")
+    assert s.note == "" and not s.note_is_warning
+
+
 def test_unknown_integrator_is_refused_with_the_names():
     s = Session(seed("demo"))
     with pytest.raises(ValueError, match="integrator must be one of .*xpbd.*got 'rk4'"):

@@ -876,6 +876,10 @@ class World:
             self._state.restore()
             hint = ("shorten dt or raise substeps (or use implicit-euler), and start bodies outside colliders; "
                     "a stiffer or denser body keeps its shape better")
+            if self.integrator == "xpbd" and self._substeps < self.xpbd_substeps():
+                hint = (f"under xpbd with substeps = {self._substeps} the bodies sink into themselves (a sweep "
+                        f"carries the support one mesh row): raise substeps to {self.xpbd_substeps()} "
+                        f"(world.xpbd_substeps()) or use implicit-euler, and start bodies outside colliders")
             raise SimulationUnstable(f"body {b} lost its shape at step {self.step_count}: {what}; {hint}",
                                      body=body, step=self.step_count, hint=hint)
 
@@ -983,6 +987,62 @@ class World:
         # (sqrt(gamma^2 + 4 w2) - gamma) / w2, written without the difference of two close
         # numbers (heavy damping made it 0, and a hint then divided by it)
         return 4.0 / (math.hypot(gamma, 2.0 * math.sqrt(w2)) + gamma)
+
+    def xpbd_substeps(self, strain: float = 0.01) -> int:
+        """Substeps per ``dt`` at which XPBD holds the bodies up under their own weight.
+
+        XPBD's Gauss-Seidel sweep carries a correction only about one row of the mesh per
+        sweep, so within a substep the support of the floor (or of pins) does not reach the
+        whole body, and a stiff body standing or hanging sags far more than its material
+        says. A column of ``N = H / l`` rows (height ``H`` along gravity, mesh spacing ``l``,
+        the median edge) whose every spring is corrected once per sweep comes to rest
+        shortened by ``g H h^2 / (l^2 iterations)`` of its height; measured on finite-element
+        and spring bodies the sag is up to twice that (and a lattice of springs beyond about
+        10% folds flat; docs/integrators.md, "How many substeps XPBD needs"). This returns
+        the smallest number of substeps for which twice that estimate is at most ``strain``
+        for every body, with the XPBD integrator's ``iterations`` (one sweep per substep
+        under any other integrator). It does not include the material's own sag, which every
+        integrator shows.
+
+        Parameters
+        ----------
+        strain : float
+            Shortening allowed, as a fraction of each body's height, in (0, 1); default 1%.
+
+        Returns
+        -------
+        int
+            At least 1 (also without gravity or bodies).
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(dt=1 / 60, integrator="xpbd")
+        >>> _ = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=98))
+        >>> w.xpbd_substeps()  # a 1 m body with 1 cm spacing at a display step
+        74
+        """
+        if isinstance(strain, bool) or not isinstance(strain, (int, float, np.number)) \
+                or not 0.0 < float(strain) < 1.0:
+            raise ValueError(f"strain must be a number in (0, 1), got {strain!r}")
+        g = math.hypot(*self.gravity)
+        if g == 0.0 or not self._bodies:
+            return 1
+        down = np.asarray(self.gravity, dtype=np.float64) / g
+        sweeps = self._integrator.iterations if self.integrator == "xpbd" else 1
+        need = 1
+        for body in self._bodies:
+            t = body.topology
+            x, e = t.rest_positions, t.springs
+            if len(e) == 0:
+                continue
+            spacing = float(np.median(np.hypot(*(x[e[:, 1]] - x[e[:, 0]]).T)))
+            height = float(np.ptp(x @ down))
+            if spacing <= 0.0 or height <= 0.0:
+                continue
+            h = spacing * math.sqrt(strain * sweeps / (2.0 * g * height))
+            need = max(need, math.ceil(self._dt / h - 1e-9))
+        return need
 
     def energy(self, body: Body | None = None) -> Energy:
         """Kinetic, spring, gravitational and elastic (finite-element) energy in joules, of one body or all.

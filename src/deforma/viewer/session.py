@@ -487,6 +487,7 @@ class Session:
             raise ValueError(f"integrator must be one of {', '.join(names)}, got {name!r}")
         self.world.integrator = name
         self.note, self.note_is_warning = "", False
+        self._xpbd_note()
         stable = self.world.stable_dt()
         h = self.world.dt / self.world.substeps
         if h > stable:
@@ -577,6 +578,19 @@ class Session:
             self.note = (f"{what} needs {need} substeps under {w.integrator} (stable dt {stable:.2g} s): "
                          f"switch the integrator to implicit-euler or xpbd, or soften it (lower stiffness, E "
                          f"or material damping)")
+        self._xpbd_note()
+
+    def _xpbd_note(self) -> None:
+        # XPBD never blows up, but with too few substeps a body sinks into itself: say so
+        # (World.xpbd_substeps says why) rather than raise substeps behind the user's back
+        w = self.world
+        if w.integrator != "xpbd":
+            return
+        need = w.xpbd_substeps()
+        if w.substeps < need:
+            self.note_is_warning = True
+            self.note = (f"under xpbd with substeps = {w.substeps} the bodies sag under their own weight (a sweep "
+                         f"carries the support one mesh row): {need} substeps, or implicit-euler, hold them")
 
     def _rebuild(self, body_spec=None) -> None:
         self.note, self.note_is_warning = "", False
