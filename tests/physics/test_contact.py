@@ -167,3 +167,24 @@ def test_a_collider_corner_never_pokes_between_outline_vertices(integrator):
         assert not inside_outline(b, corner), k
         assert not diamond.contains(b.positions).any(), k
     assert b.center_of_mass[1] < 0.3  # it slid off the diamond rather than hanging on it
+
+
+@pytest.mark.parametrize("integrator", ["symplectic-euler", "implicit-euler", "xpbd"])
+@pytest.mark.parametrize("shift, tips", [(0.0, True), (0.14, False)])
+def test_a_block_on_a_ledge_corner_tips_off_when_its_centre_overhangs(integrator, shift, tips):
+    # a frictionless 0.2 x 0.1 m block of two triangles whose bottom edge lands on a ledge's
+    # corner (x = 0.07): with 85% of it overhanging it tips off (its end beyond the corner
+    # falls; the corner's push acts at the contact point, not on both ends alike), with 15%
+    # it stays on the ledge
+    w = deforma.World(integrator=integrator, dt=1 / 1000, substeps=10 if integrator == "symplectic-euler" else 1,
+                      stiffness=2e4, damping=20.0, friction=0.0, static_friction=0.0)
+    w.add_collider(deforma.Rect((1.07, 0.0), (2.0, 0.2), 0.0))  # top face at y = 0.1
+    block = deforma.mesh.Mesh([[0, 0], [0.2, 0], [0.2, 0.1], [0, 0.1]], [[0, 1, 2], [0, 2, 3]])
+    b = w.add_body(block, position=(shift, 0.151))
+    for _ in range(600):
+        w.step()
+    if tips:
+        assert b.center_of_mass[1] < 0.0  # fallen past the ledge's top face
+    else:
+        assert b.center_of_mass[1] == pytest.approx(0.15, abs=0.005)
+        assert b.center_of_mass[0] == pytest.approx(shift, abs=0.005)

@@ -702,7 +702,9 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
     is a contact with an infinitely heavy point: the edge point ``p = (1 - s) a + s b``
     facing it moves out by ``d`` (plus the collider's nanometre skin) along the edge's normal, split by the inverse masses as for
     a vertex against an edge (``da = (1 - s) w_a lam n``, ``db = s w_b lam n``, ``lam = d /
-    ((1 - s)^2 w_a + s^2 w_b)``), and the two vertices lose their velocity into the corner.
+    ((1 - s)^2 w_a + s^2 w_b)``), and the edge point's velocity into the corner is taken away by
+    an impulse split the same way (the end far from the corner keeps most of its motion, so a
+    body overhanging a ledge tips off it).
     Frictionless: a body slides off a corner rather than snagging on it. A push that would
     put either end inside a collider is not made (found by the suite: a vertex resting on a
     thin plank's face beside its corner was nudged 3e-8 m into it).
@@ -806,10 +808,16 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
                 continue
             ax, ay, bx, by = qax, qay, qbx, qby
             x[ia, 0], x[ia, 1], x[ib, 0], x[ib, 1] = ax, ay, bx, by
-            for i in (ia, ib):
-                vn = v[i, 0] * nx + v[i, 1] * ny
-                if vn < 0.0:  # into the corner
-                    v[i, 0] -= vn * nx
-                    v[i, 1] -= vn * ny
+            # the edge point on the corner stops moving into it: the impulse acts there,
+            # split as the push is, so the end far from the corner keeps most of its motion
+            # (zeroing both ends' motion into the corner held a block overhanging a ledge
+            # level on the corner instead of letting it tip off)
+            vn = (sa * v[ia, 0] + sb * v[ib, 0]) * nx + (sa * v[ia, 1] + sb * v[ib, 1]) * ny
+            if vn < 0.0:  # into the corner
+                dv = -vn / den
+                v[ia, 0] += sa * wa * dv * nx
+                v[ia, 1] += sa * wa * dv * ny
+                v[ib, 0] += sb * wb * dv * nx
+                v[ib, 1] += sb * wb * dv * ny
             moved += 1
     return moved
