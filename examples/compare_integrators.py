@@ -209,6 +209,12 @@ def main(argv=None) -> None:
     p.add_argument("--video", default="integrators.gif", help="output .mp4/.gif ('' for none; default integrators.gif)")
     p.add_argument("--plot", default="integrators.png", help="output PNG of energy vs time (default integrators.png)")
     args = p.parse_args(argv)
+    if args.plot:
+        import importlib.util
+
+        if importlib.util.find_spec("matplotlib") is None:  # say so before a minute of simulating
+            p.error("the energy plot needs matplotlib: pip install 'deforma[examples]' "
+                    "(or matplotlib), or pass --plot '' for the video only")
     for out in (args.video, args.plot):
         if out:
             Path(out).parent.mkdir(parents=True, exist_ok=True)

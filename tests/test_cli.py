@@ -218,6 +218,15 @@ def test_bad_options_are_usage_errors(capsys):
     assert "expected WIDTHxHEIGHT" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["run", "sample", "--fps", "-3"])
+    # mesh box's --detail is checked by argparse like the other counts (exit 2, the flag named)
+    from deforma.cli import _MAX_DETAIL
+    from deforma.mesh.box import MAX_DETAIL
+
+    assert _MAX_DETAIL == MAX_DETAIL
+    for bad in ("-1", "1001", "x"):
+        with pytest.raises(SystemExit) as e:
+            main(["mesh", "box", "--detail", bad, "-o", "m.png"])
+        assert e.value.code == 2 and "argument --detail" in capsys.readouterr().err
 
 
 def test_mesh_picture_of_a_box(tmp_path, capsys):

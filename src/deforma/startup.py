@@ -1,7 +1,7 @@
 """Start-up of a command: telling the user when Numba compiles, and timing it honestly.
 
 deforma's kernels are ``@njit(cache=True)``: the first use on an install compiles them
-(20 s or more for ``deforma run sample``), later runs load them from Numba's cache. Numba fires
+(20 s to 2 minutes for ``deforma run sample``, by machine), later runs load them from Numba's cache. Numba fires
 its ``numba:compile`` event only when it really compiles, after the cache lookup failed, so a
 listener on that event tells a cold cache from a warm one exactly, at the moment compiling
 starts, and costs nothing on a warm run. Checking the cache's index files ahead would need to
@@ -19,7 +19,7 @@ from typing import Callable
 __all__ = ["CompileWatch", "is_cached_kernel", "seconds_since_process_start"]
 
 #: What ``deforma run`` says on stderr when the first kernel starts compiling.
-COMPILE_MESSAGE = ("deforma: compiling the physics kernels (once per install or upgrade: 20 s or more, "
+COMPILE_MESSAGE = ("deforma: compiling the physics kernels (once per install or upgrade: 20 s to 2 minutes, "
                    "see docs/benchmarks.md#start-up; later runs load them from the cache)...")
 
 _IMPORTED = time.perf_counter()

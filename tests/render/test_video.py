@@ -77,6 +77,20 @@ def test_png_folder_gets_numbered_frames(tmp_path):
     assert np.asarray(Image.open(out / "frame_00003.png")).shape == (48, 64, 3)
 
 
+def test_a_shorter_run_into_the_same_png_folder_leaves_only_its_frames(tmp_path):
+    out = tmp_path / "frames"
+    for n in (6, 3):
+        with open_writer(str(out) + "/", fps=10) as w:
+            for f in moving_frames(n):
+                w.write(f)
+    (out / "notes.txt").write_text("mine")
+    (out / "frame_final.png").write_bytes(b"")  # not a frame number: not ours to delete
+    with open_writer(str(out) + "/", fps=10) as w:
+        for f in moving_frames(2):
+            w.write(f)
+    assert sorted(os.listdir(out)) == ["frame_00000.png", "frame_00001.png", "frame_final.png", "notes.txt"]
+
+
 @pytest.mark.parametrize("name", ["a.mp4", "a.gif"])
 def test_interrupted_write_leaves_the_old_file_and_no_temporary(tmp_path, name):
     out = tmp_path / name

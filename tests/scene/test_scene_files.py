@@ -197,6 +197,8 @@ def test_unknown_scene_lists_the_builtins():
 def test_missing_and_unreadable_files(tmp_path):
     with pytest.raises(SceneError, match="no such scene file"):
         scenes.load(tmp_path / "absent.toml")
+    with pytest.raises(SceneError, match="is a folder, not a scene file"):
+        scenes.load(tmp_path)
     p = tmp_path / "binary.toml"
     p.write_bytes(b"\xff\xfe\x00garbage")
     with pytest.raises(SceneError, match="not a text file"):

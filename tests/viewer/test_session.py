@@ -346,7 +346,7 @@ BEHAVIOUR_VALUES = {"tear_strain": 0.4, "yield_strain": 0.05, "plastic_rate": 0.
 def test_behaviours_and_pressure_apply_to_the_running_world_and_are_saved(tmp_path):
     s = Session("balloon")
     world, b = s.world, s.world.bodies[0]
-    assert [s.get_param(n) for n in (*BEHAVIOUR_VALUES, "pressure")] == [None, None, 1.0, None, 400.0]
+    assert [s.get_param(n) for n in (*BEHAVIOUR_VALUES, "pressure")] == [None, None, 1.0, None, 25.0]
     for name, value in BEHAVIOUR_VALUES.items():
         s.set_param(name, value)
     s.set_param("pressure", 250.0)

@@ -406,7 +406,9 @@ class PngFolderWriter(FrameWriter):
 
     The frames are written into a hidden folder inside it and moved into place when the last
     one is written, so an interrupted or failed run adds no frames (and removes the folder if
-    it made it). Frames from an earlier, longer run are not deleted.
+    it made it). Once a run's frames are in place, frames numbered beyond them (an earlier,
+    longer run's ``frame_NNNNN.png``) are deleted, so the folder holds one run; other files
+    are left alone.
     """
 
     def __init__(self, path, *, fps: float, compress_level: int = 3):
@@ -443,6 +445,10 @@ class PngFolderWriter(FrameWriter):
                 staged = self._staging / self.frame_path(i).name
                 os.chmod(staged, 0o666 & ~mask)
                 os.replace(staged, self.frame_path(i))
+            for old in self.path.glob("frame_*.png"):
+                stem = old.stem[len("frame_"):]
+                if len(stem) == 5 and stem.isdigit() and int(stem) >= self.frames_written:
+                    old.unlink(missing_ok=True)
         finally:
             self._discard()
 

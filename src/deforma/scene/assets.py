@@ -43,6 +43,8 @@ def scene_path(name_or_path) -> Path:
         return scenes[s]
     p = Path(s)
     if p.suffix.lower() == ".toml" or "/" in s or p.exists():
+        if p.is_dir():
+            raise ValueError(f"{s}: is a folder, not a scene file; give a .toml file in it or a built-in scene name")
         if not p.is_file():
             raise ValueError(f"{s}: no such scene file")
         return p
