@@ -751,50 +751,58 @@ class _Ring:
         """
         t = self.cum[:-1]
         t3 = np.concatenate([t - self.length, t, t + self.length])  # the closed arc unrolled
+        v3 = np.concatenate([self.dense[:-1]] * 3)
         kept = set()  # pairs that cannot merge (looked at once)
-        while len(self.s) > 3:
+        # in passes, closest pairs first; a pair next to one merged in this pass waits for the
+        # next pass (its neighbours, the ends of its new segments, have moved): each pass costs
+        # one sort, however many pairs merge
+        while len(self.s) > 4:
             s, n = self.s, len(self.s)
+            p = self.points()
             d = np.diff(np.r_[s, s[0] + self.length])
-            merged = False
-            for i in np.argsort(d, kind="stable"):
-                if d[i] >= gap:
-                    break
-                if (s[i], s[(i + 1) % n]) in kept:
+            order = np.argsort(d, kind="stable")
+            order = order[d[order] < gap]
+            touched = np.zeros(n, bool)
+            drop, add = [], []
+            for i in order:
+                j, before, after = (i + 1) % n, i - 1, (i + 2) % n
+                if touched[i] or touched[j] or touched[before] or touched[after] \
+                        or (s[i], s[j]) in kept or n - len(drop) <= 4:
                     continue
-                # the pair (i, i + 1) between its neighbours (i - 1) and (i + 2), unrolled
-                # along the closed arc so that positions increase
-                lo = s[i - 1] - (self.length if i == 0 else 0.0)
-                hi = s[(i + 2) % n] + (self.length if i + 2 >= n else 0.0)
-                cand = t3[(t3 > lo) & (t3 < hi)]
-                worst = self._deviation(lo, cand, hi) if n > 4 and cand.size else np.full(1, np.inf)
+                # the pair between its neighbours, unrolled along the closed arc so that
+                # positions increase
+                lo = s[before] - (self.length if i == 0 else 0.0)
+                hi = s[after] + (self.length if i + 2 >= n else 0.0)
+                cand, worst = self._deviation(t3, v3, lo, hi, p[before], p[after])
+                if cand.size == 0:
+                    continue
                 k = int(np.argmin(worst))
                 if worst[k] > tolerance:
-                    kept.add((s[i], s[(i + 1) % n]))
+                    kept.add((s[i], s[j]))
                     continue
-                keep = np.ones(n, bool)
-                keep[[i, (i + 1) % n]] = False
-                self.s = np.union1d(s[keep], [cand[k] % self.length])
-                merged = True
-                break
-            if not merged:
+                touched[[i, j]] = True
+                drop += [i, j]
+                add.append(cand[k] % self.length)
+            if not drop:
                 return
+            keep = np.ones(n, bool)
+            keep[drop] = False
+            self.s = np.union1d(s[keep], add)
 
-    def _deviation(self, lo, mids, hi):
-        """The largest distance of the contour from the two segments lo-mid and mid-hi, per mid.
+    def _deviation(self, t3, v3, lo, hi, a, b):
+        """For each contour vertex strictly between arc positions ``lo`` and ``hi`` taken as the
+        middle point: those positions and the largest distance of the contour from the two
+        segments lo-mid and mid-hi.
 
-        Arc positions may run past the ends of ``[0, length)`` (they wrap).
+        ``t3``, ``v3``: the contour's arc positions and vertices three times over (shifted by
+        minus one, zero and one length), so that positions past the ends of ``[0, length)``
+        (a pair across the ring's start) are found by one sorted search; ``a``, ``b``: the
+        points at ``lo`` and ``hi``.
         """
-        t = np.concatenate([self.cum[:-1] - self.length, self.cum[:-1], self.cum[:-1] + self.length])
-        v = np.concatenate([self.dense[:-1]] * 3)
-        inside = (t > lo) & (t < hi)
-        t, v = t[inside], v[inside]
-
-        def at(u):
-            u = np.asarray(u, float) % self.length
-            return np.c_[np.interp(u, self.cum, self.dense[:, 0]), np.interp(u, self.cum, self.dense[:, 1])]
-
-        a, m, b = at([lo])[0], at(mids), at([hi])[0]
-        first = t[None, :] <= mids[:, None]  # which segment each contour vertex is measured to
+        i0, i1 = np.searchsorted(t3, lo, side="right"), np.searchsorted(t3, hi, side="left")
+        t, v = t3[i0:i1], v3[i0:i1]
+        m = v  # the candidate middle points are the contour vertices themselves
+        first = t[None, :] <= t[:, None]  # which segment each contour vertex is measured to
         start = np.where(first[..., None], a, m[:, None, :])
         end = np.where(first[..., None], m[:, None, :], b)
         ab = end - start
@@ -802,7 +810,7 @@ class _Ring:
         length = np.hypot(ab[..., 0], ab[..., 1])
         cross = np.abs(ab[..., 0] * rel[..., 1] - ab[..., 1] * rel[..., 0])
         dist = np.where(length > 0, cross / np.where(length > 0, length, 1.0), np.hypot(rel[..., 0], rel[..., 1]))
-        return dist.max(axis=1) if dist.shape[1] else np.zeros(len(mids))
+        return t, dist.max(axis=1) if len(t) else np.zeros(0)
 
     def _split_far(self, tolerance):
         """Split until every segment is within tolerance; return the arc positions added."""
