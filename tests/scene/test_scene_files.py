@@ -1,7 +1,7 @@
 """Scene files: validation with one clear error, and a round trip that loses nothing."""
 
 import os
-import textwrap
+import re
 
 import numpy as np
 import pytest
@@ -192,6 +192,20 @@ def test_unknown_scene_lists_the_builtins():
     assert "unknown scene 'sampel'; did you mean 'sample'?" in msg
     for name in scenes.builtin_scenes():
         assert name in msg
+
+
+def test_build_errors_name_the_file_as_the_user_does(tmp_path, monkeypatch):
+    # the Scene keeps the absolute path (for its pictures); messages show it relative to the
+    # working folder, as the file was named, like the errors found while reading it
+    (tmp_path / "two.toml").write_text("[[body]]\nposition = [0, 1]\n\n[[body]]\nposition = [0.1, 1]\n")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError, match=r"^two\.toml: body\[1\]: the new body \(1\) would overlap body 0"):
+        scenes.load("two.toml").build()
+    elsewhere = tmp_path / "sub"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    with pytest.raises(SceneError, match=r"^" + re.escape(str(tmp_path / "two.toml")) + r": body\[1\]"):
+        scenes.load(tmp_path / "two.toml").build()
 
 
 def test_missing_and_unreadable_files(tmp_path):

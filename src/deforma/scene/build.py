@@ -175,7 +175,7 @@ def build(scene: Scene):
     """
     from ..physics import World
 
-    source = scene.path or "<scene>"
+    source = _shown(scene.path)
     p = scene.physics
     try:
         world = World(gravity=p.gravity, dt=p.dt, substeps=p.substeps, mass=p.mass, stiffness=p.stiffness,
@@ -263,6 +263,18 @@ def make_colliders(spec) -> list:
             p.velocity, p.angular_velocity = spec.velocity, spec.angular_velocity
         return pieces
     raise TypeError(f"not a collider spec: {spec!r}")
+
+
+def _shown(path) -> str:
+    """A scene file's path for messages: relative to the working folder when it is inside it
+    (as a user types it; the Scene keeps the absolute path to find its pictures), else as is."""
+    if path is None:
+        return "<scene>"
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:  # another drive (Windows)
+        return str(path)
+    return str(path) if rel.startswith(os.pardir) else rel
 
 
 def load_scene(name_or_path):
