@@ -669,6 +669,7 @@ _MIN_PIECE = 9  # pixels: smaller specks and holes are noise, not shape
 _OUTLINE_TOLERANCE = 0.5  # pixels: how far an outline segment may stray from the contour
 _MERGE_GAP = 0.4  # of edge_step: outline points closer than this are merged ...
 _MERGE_TOLERANCE = 1.0  # pixels: ... where the merged outline strays at most this far (a pixel)
+_MERGE_CANDIDATES = 64  # places tried for a merged point at most
 
 
 def _clean(mask):
@@ -744,10 +745,9 @@ class _Ring:
         sides of a rounded tip, a notch's two corners). With an interior point a spacing
         away, such a pair makes a needle triangle whose tiny height sets a finite element's
         stable step (a bunny at ``edge_step=16`` had a 0.9 px high triangle). Each close
-        pair, closest first, becomes one point: the better of its two ends or the contour
-        vertex between its neighbours that keeps both new segments closest to the contour,
-        provided they stay within ``tolerance``; otherwise the pair is kept (a narrow notch
-        needs both its corners).
+        pair, closest first, becomes one point: the contour vertex between its neighbours
+        that keeps both new segments closest to the contour, provided they stay within
+        ``tolerance``; otherwise the pair is kept (a narrow notch needs both its corners).
         """
         t = self.cum[:-1]
         t3 = np.concatenate([t - self.length, t, t + self.length])  # the closed arc unrolled
@@ -790,9 +790,10 @@ class _Ring:
             self.s = np.union1d(s[keep], add)
 
     def _deviation(self, t3, v3, lo, hi, a, b):
-        """For each contour vertex strictly between arc positions ``lo`` and ``hi`` taken as the
-        middle point: those positions and the largest distance of the contour from the two
-        segments lo-mid and mid-hi.
+        """For contour vertices strictly between arc positions ``lo`` and ``hi`` taken as the
+        middle point (all of them, or ``_MERGE_CANDIDATES`` evenly spread over a long
+        stretch, so memory stays bounded at a large ``edge_step``): their positions and the
+        largest distance of the contour from the two segments lo-mid and mid-hi.
 
         ``t3``, ``v3``: the contour's arc positions and vertices three times over (shifted by
         minus one, zero and one length), so that positions past the ends of ``[0, length)``
@@ -801,8 +802,9 @@ class _Ring:
         """
         i0, i1 = np.searchsorted(t3, lo, side="right"), np.searchsorted(t3, hi, side="left")
         t, v = t3[i0:i1], v3[i0:i1]
-        m = v  # the candidate middle points are the contour vertices themselves
-        first = t[None, :] <= t[:, None]  # which segment each contour vertex is measured to
+        pick = np.unique(np.linspace(0, len(t) - 1, _MERGE_CANDIDATES).astype(np.int64)) if len(t) else []
+        tm, m = t[pick], v[pick]  # the candidate middle points
+        first = t[None, :] <= tm[:, None]  # which segment each contour vertex is measured to
         start = np.where(first[..., None], a, m[:, None, :])
         end = np.where(first[..., None], m[:, None, :], b)
         ab = end - start
@@ -810,7 +812,7 @@ class _Ring:
         length = np.hypot(ab[..., 0], ab[..., 1])
         cross = np.abs(ab[..., 0] * rel[..., 1] - ab[..., 1] * rel[..., 0])
         dist = np.where(length > 0, cross / np.where(length > 0, length, 1.0), np.hypot(rel[..., 0], rel[..., 1]))
-        return t, dist.max(axis=1) if len(t) else np.zeros(0)
+        return tm, dist.max(axis=1) if len(t) else np.zeros(0)
 
     def _split_far(self, tolerance):
         """Split until every segment is within tolerance; return the arc positions added."""
