@@ -67,7 +67,7 @@ def test_run_under_xpbd_with_too_few_substeps_says_how_many_hold_the_bodies(tmp_
     code, _, err = run(capsys, "run", str(scene), "--seconds", "0.05")
     assert code == 0, err
     assert "note: under xpbd with substeps = 1 the bodies sag under their own weight" in err
-    assert "22 substeps per dt" in err
+    assert "raise substeps to 22 (world.xpbd_substeps())" in err
     scene.write_text(scene.read_text().replace('integrator = "xpbd"', 'integrator = "xpbd"\nsubsteps = 22'))
     code, _, err = run(capsys, "run", str(scene), "--seconds", "0.05")
     assert code == 0 and "note:" not in err, err

@@ -371,10 +371,11 @@ def _run_scene(a, watch, shown: dict) -> int:
         _check_states_path(a.states)
     world = scene.build()
     n_frames = max(1, int(round(seconds * fps)))
-    if world.integrator == "xpbd" and world.substeps < world.xpbd_substeps():
-        print(f"note: under xpbd with substeps = {world.substeps} the bodies sag under their own weight (a sweep "
-              f"carries the support one mesh row); {world.xpbd_substeps()} substeps per dt, or "
-              f"integrator = \"implicit-euler\", hold them (docs/integrators.md)", file=sys.stderr)
+    from .physics.world import xpbd_advice
+
+    advice = xpbd_advice(world)
+    if advice:
+        print(f"note: {advice} (docs/integrators.md)", file=sys.stderr)
 
     view = writer = None
     if a.output:

@@ -876,10 +876,9 @@ class World:
             self._state.restore()
             hint = ("shorten dt or raise substeps (or use implicit-euler), and start bodies outside colliders; "
                     "a stiffer or denser body keeps its shape better")
-            if self.integrator == "xpbd" and self._substeps < self.xpbd_substeps():
-                hint = (f"under xpbd with substeps = {self._substeps} the bodies sink into themselves (a sweep "
-                        f"carries the support one mesh row): raise substeps to {self.xpbd_substeps()} "
-                        f"(world.xpbd_substeps()) or use implicit-euler, and start bodies outside colliders")
+            advice = xpbd_advice(self)
+            if advice:
+                hint = f"{advice}, and start bodies outside colliders"
             raise SimulationUnstable(f"body {b} lost its shape at step {self.step_count}: {what}; {hint}",
                                      body=body, step=self.step_count, hint=hint)
 
@@ -1085,3 +1084,25 @@ class World:
     def __repr__(self) -> str:
         return (f"World({len(self._bodies)} bodies, {self._model.n_vertices} vertices, "
                 f"{len(self._colliders)} colliders, t={self.time:.4g} s)")
+
+
+def xpbd_advice(world: World) -> str:
+    """What to do when ``world`` runs XPBD with fewer substeps than :meth:`World.xpbd_substeps`
+    asks for, in one clause; ``""`` otherwise (or under another integrator). The viewer,
+    ``deforma run`` and the lost-shape hint all say it in these words.
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World(dt=1 / 60, integrator="xpbd")
+    >>> _ = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=28))
+    >>> xpbd_advice(w)
+    'under xpbd with substeps = 1 the bodies sag under their own weight (a sweep carries the support one mesh row): raise substeps to 22 (world.xpbd_substeps()) or use implicit-euler'
+    """
+    if world.integrator != "xpbd":
+        return ""
+    need = world.xpbd_substeps()
+    if world.substeps >= need:
+        return ""
+    return (f"under xpbd with substeps = {world.substeps} the bodies sag under their own weight (a sweep carries "
+            f"the support one mesh row): raise substeps to {need} (world.xpbd_substeps()) or use implicit-euler")

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..physics import Circle, Material, Polygon, Rect, Segment, available_integrators
+from ..physics.world import xpbd_advice
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 from ..scene.build import pin_mask
@@ -583,14 +584,10 @@ class Session:
     def _xpbd_note(self) -> None:
         # XPBD never blows up, but with too few substeps a body sinks into itself: say so
         # (World.xpbd_substeps says why) rather than raise substeps behind the user's back
-        w = self.world
-        if w.integrator != "xpbd":
-            return
-        need = w.xpbd_substeps()
-        if w.substeps < need:
+        advice = xpbd_advice(self.world)
+        if advice:
             self.note_is_warning = True
-            self.note = (f"under xpbd with substeps = {w.substeps} the bodies sag under their own weight (a sweep "
-                         f"carries the support one mesh row): {need} substeps, or implicit-euler, hold them")
+            self.note = advice
 
     def _rebuild(self, body_spec=None) -> None:
         self.note, self.note_is_warning = "", False
