@@ -178,6 +178,23 @@ def test_xpbd_with_too_few_substeps_says_how_many_hold_the_bodies():
     assert s.note == "" and not s.note_is_warning
 
 
+def test_a_scene_under_xpbd_with_too_few_substeps_says_so_on_load_and_as_they_change(tmp_path):
+    path = tmp_path / "stand.toml"
+    path.write_text('[physics]\ndt = 0.016666666666666666\nintegrator = "xpbd"\n'
+                    '[[body]]\nshape = "box"\ncorners = [[-0.5, 0], [0.5, 0], [0.5, 1], [-0.5, 1]]\ndetail = 28\n'
+                    '[[collider]]\ncenter = [0, -0.2]\nsize = [3, 0.4]\n')
+    s = Session(path)  # a 1 m body with 1/29 m spacing at 1/60 s: 22 substeps
+    assert s.note_is_warning and "raise substeps to 22" in s.note
+    s.set_param("substeps", 8)
+    assert "with substeps = 8" in s.note
+    s.set_param("substeps", 22)
+    assert s.note == "" and not s.note_is_warning
+    s.set_param("dt", 1 / 30)  # twice the step: twice the substeps (2 x 21.4, rounded up)
+    assert "raise substeps to 43" in s.note
+    s.set_param("gravity_y", 0.0)
+    assert s.note == ""
+
+
 def test_unknown_integrator_is_refused_with_the_names():
     s = Session(seed("demo"))
     with pytest.raises(ValueError, match="integrator must be one of .*xpbd.*got 'rk4'"):

@@ -199,6 +199,7 @@ class Session:
         self.note = ""
         #: True when :attr:`note` warns of trouble ahead (shown in red).
         self.note_is_warning = False
+        self._xpbd_note()  # a scene run under XPBD with too few substeps: say so from the start
         #: E, nu, density and damping of the finite-element models: the world's while it has
         #: one; kept while it is springs, so switching back restores them.
         self.material_values = self._initial_material_values(scene.physics)
@@ -332,6 +333,8 @@ class Session:
             self._edit_collider(name, value)
         else:
             raise KeyError(f"unknown parameter {name!r}")
+        if name in ("substeps", "dt", "gravity_x", "gravity_y"):
+            self._xpbd_note()  # what XPBD needs follows the substep and gravity
 
     # -- material -----------------------------------------------------------------------------
     @property
