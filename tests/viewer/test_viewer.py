@@ -337,6 +337,14 @@ def test_loaded_scene_shows_its_integrator(demo, tmp_path):
     demo.load(str(path))
     run(demo, 1)
     assert demo.inspector.integrator_menu.selected_option[0] == "xpbd"
+    # a scene under XPBD with too few substeps for its body says so in the panel on loading
+    stand = tmp_path / "stand.toml"
+    stand.write_text('[physics]\ndt = 0.016666666666666666\nintegrator = "xpbd"\n'
+                     '[[body]]\nshape = "box"\ncorners = [[-0.5, 0], [0.5, 0], [0.5, 1], [-0.5, 1]]\ndetail = 28\n'
+                     '[[collider]]\ncenter = [0, -0.2]\nsize = [3, 0.4]\n')
+    demo.load(str(stand))
+    run(demo, 1)
+    assert demo.inspector.message_is_error and "raise substeps to 22" in demo.inspector.message
 
 
 def test_selected_drop_down_switches_the_object(demo):

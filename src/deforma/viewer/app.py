@@ -310,6 +310,8 @@ class Viewer:
         self.session = scene if isinstance(scene, Session) else Session(scene)
         self.inspector = self._Inspector(self.session, self.window_size[1], save_path=self.save_path,
                                          actions=self._actions)
+        if self.session.note:  # e.g. a scene under XPBD with too few substeps
+            self.inspector.say(self.session.note, error=self.session.note_is_warning)
         self._generation = -1  # forces the view to re-upload meshes
         self.unstable = None
         self.paused = False
