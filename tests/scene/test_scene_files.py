@@ -201,6 +201,9 @@ def test_build_errors_name_the_file_as_the_user_does(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SceneError, match=r"^two\.toml: body\[1\]: the new body \(1\) would overlap body 0"):
         scenes.load("two.toml").build()
+    (tmp_path / "..two.toml").write_text((tmp_path / "two.toml").read_text())  # a name, not the parent folder
+    with pytest.raises(SceneError, match=r"^\.\.two\.toml: body\[1\]"):
+        scenes.load("..two.toml").build()
     elsewhere = tmp_path / "sub"
     elsewhere.mkdir()
     monkeypatch.chdir(elsewhere)

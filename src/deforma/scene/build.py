@@ -274,7 +274,7 @@ def _shown(path) -> str:
         rel = os.path.relpath(path)
     except ValueError:  # another drive (Windows)
         return str(path)
-    return str(path) if rel.startswith(os.pardir) else rel
+    return str(path) if rel.split(os.sep, 1)[0] == os.pardir else rel  # outside it ("..foo.toml" is inside)
 
 
 def load_scene(name_or_path):
