@@ -219,10 +219,10 @@ def test_bad_options_are_usage_errors(capsys):
     with pytest.raises(SystemExit):
         main(["run", "sample", "--fps", "-3"])
     # mesh box's --detail is checked by argparse like the other counts (exit 2, the flag named)
-    from deforma.cli import _MAX_DETAIL
-    from deforma.mesh.box import MAX_DETAIL
+    from deforma.checks import MAX_DETAIL
+    from deforma.mesh.box import MAX_DETAIL as box_limit
 
-    assert _MAX_DETAIL == MAX_DETAIL
+    assert box_limit is MAX_DETAIL == 1000  # one limit for mesh.box and the CLI
     for bad in ("-1", "1001", "x"):
         with pytest.raises(SystemExit) as e:
             main(["mesh", "box", "--detail", bad, "-o", "m.png"])

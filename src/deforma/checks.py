@@ -46,6 +46,10 @@ MAX_GRAVITY = 1e7
 MAX_SUBSTEPS = 1000
 #: Smallest substep (s): dt / substeps below this is refused.
 MIN_SUBSTEP = 1e-7
+#: Largest box ``detail`` (mesh.box, scene files, ``deforma mesh --detail``): (detail + 2)**2
+#: points, about a million, is as far as a mass-spring body is still useful and stays well
+#: inside memory.
+MAX_DETAIL = 1000
 
 
 def number(value, name: str) -> float:

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .checks import MAX_DETAIL
 
 __all__ = ["main"]
 
@@ -119,11 +120,6 @@ def _count(hi):
     return parse
 
 
-#: mesh.box's largest detail (mesh.box.MAX_DETAIL; not imported here: it would load the mesher
-#: and Numba before argparse has even looked at the options)
-_MAX_DETAIL = 1000
-
-
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="deforma", description="Deformable 2D objects: run scenes, draw meshes.")
     p.add_argument("--debug", action="store_true", help="show the full traceback on errors")
@@ -161,7 +157,7 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--threshold", type=float, metavar="T",
                    help="image: how far from the background a pixel must be to be the shape, 0 <= T < 1 of full "
                         "scale in the channel that differs most (default 0.06; for alpha 0.5)")
-    m.add_argument("--detail", type=_count(_MAX_DETAIL), default=8, help="box: n*n interior points (default 8)")
+    m.add_argument("--detail", type=_count(MAX_DETAIL), default=8, help="box: n*n interior points (default 8)")
     m.add_argument("--edges", action=argparse.BooleanOptionalAction, default=True,
                    help="box: points on the sides too (default on, as in mesh.box and scene files; "
                         "--no-edges gives the original's thin side triangles)")

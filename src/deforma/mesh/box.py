@@ -6,13 +6,9 @@ import operator
 
 import numpy as np
 
-from ..checks import MAX_COORDINATE
+from ..checks import MAX_COORDINATE, MAX_DETAIL
 from .delaunay import delaunay
 from .mesh import Mesh
-
-#: Largest ``detail`` accepted: (detail + 2)**2 points, about a million, is as far as a
-#: mass-spring body is still useful and stays well inside memory.
-MAX_DETAIL = 1000
 
 
 def box(corners, *, detail=8, edges=True) -> Mesh:

@@ -60,6 +60,8 @@ from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from ..checks import MAX_DETAIL
+
 # an image body's background: the names and the rule of deforma.mesh.from_image itself
 from ..mesh.image import BACKGROUND_NAMES, check_background
 
@@ -276,7 +278,7 @@ class BoxBody(BodyPhysics):
     shape: str = spec("str", "box", choices=("box", "image", "mesh"), doc="Which kind of body.")
     corners: tuple = spec("quad", ((-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)), unit="m",
                           doc="Four corners in order around a convex quadrilateral.")
-    detail: int = spec("int", 8, lo=0, hi=1000, doc="n: n*n points inside, spread evenly.")
+    detail: int = spec("int", 8, lo=0, hi=MAX_DETAIL, doc="n: n*n points inside, spread evenly.")
     edges: bool = spec("bool", True, doc="Also put n points on each side (on by default, as in mesh.box: "
                                          "without them the triangles along the sides are thin).")
     position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
