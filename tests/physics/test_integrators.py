@@ -188,7 +188,10 @@ def test_dragging_pulls_the_body_toward_the_target(name):
     w.drag(g, (1.0, 0.0))
     for _ in range(300):
         w.step()
-    assert b.center_of_mass[0] > 0.05 and abs(b.center_of_mass[1]) < 0.02
+    # pulled along x: the held patch (above and right of the centre) keeps its offsets, so
+    # the body swings a little in y, far less than it travels in x
+    com = b.center_of_mass
+    assert com[0] > 0.05 and abs(com[1]) < 0.05 * com[0]
     w.release(g)
     p0 = b.velocities.sum(axis=0).copy()
     for _ in range(100):
@@ -345,8 +348,8 @@ def test_implicit_euler_refactors_on_live_changes_and_matches_a_fresh_world():
 
 @pytest.mark.parametrize("name", ALL)
 def test_pull_gives_the_same_momentum_to_first_order(name):
-    # a short pull of a free body: momentum change = impulse sum S (target - x) dt, the same
-    # force law under every integrator (to O(h) over the pull)
+    # a short pull of a free body: momentum change = impulse sum S (target + offset - x) dt,
+    # the same force law under every integrator (to O(h) over the pull)
     w = deforma.World(gravity=(0, 0), dt=1 / 2000, stiffness=2000.0, damping=2.0, integrator=name)
     b = w.add_body(grid_mesh(0.2, 0.2, 5, 5), position=(0, 0))
     g = w.grab((0.01, 0.01), strength=20.0)
@@ -354,7 +357,7 @@ def test_pull_gives_the_same_momentum_to_first_order(name):
     held = b.vertex_slice.start + g.vertices
     impulse = np.zeros(2)
     for _ in range(100):
-        impulse += w.dt * 20.0 * ((1.0, 0.0) - w._state.x[held]).sum(axis=0)
+        impulse += w.dt * 20.0 * ((1.0, 0.0) + g.offsets - w._state.x[held]).sum(axis=0)
         w.step()
     m = b.mass / b.n_vertices
     assert m * b.velocities.sum(axis=0) == pytest.approx(impulse, rel=0.02, abs=1e-4)

@@ -388,18 +388,23 @@ class Body:
 
 
 class Grab:
-    """A mouse grab: vertices of one body pulled toward ``target`` while held.
+    """A mouse grab: vertices of one body held at ``target`` while held.
 
     Made by :meth:`World.grab`. ``vertices`` are body-local indices (empty when the point
-    was off every body, then the grab does nothing).
+    was off every body, then the grab does nothing). ``offsets`` (k, 2), metres: where each
+    held vertex was relative to the grabbed point; vertex ``vertices[i]`` is pulled toward
+    ``target + offsets[i]``, so the held patch moves as a hand would move it, keeping its
+    shape, rather than being squeezed into the one point ``target`` (which crumpled the
+    triangles under a wide grab, and inverted the grabbed triangle under a strong one).
     """
 
-    def __init__(self, world, body, vertices, target, strength):
+    def __init__(self, world, body, vertices, target, strength, offsets=None):
         self._world = world
         self.body = body
         self.vertices = np.asarray(vertices, dtype=np.int64)
         self.target = target
         self.strength = strength
+        self.offsets = np.zeros((len(self.vertices), 2)) if offsets is None else np.asarray(offsets, np.float64)
         self.active = True
 
     def __repr__(self) -> str:

@@ -648,15 +648,17 @@ class World:
         Picks the vertices of the triangle under the point, plus, with ``radius``, every
         vertex of that body within ``radius`` metres. The topmost (last added) body wins.
         A point off every body gives an empty grab that does nothing. A body without
-        triangles (a spring chain) is picked by ``radius`` alone.
+        triangles (a spring chain) is picked by ``radius`` alone. Each held vertex keeps its
+        offset from the grabbed point: it is pulled toward ``target + offset``, so dragging
+        moves the held patch without squeezing it into one point.
 
         Parameters
         ----------
         point : (float, float)
             Metres.
         strength : float, optional
-            Pull in N/m per held vertex: force ``strength * (target - x)``; default
-            ``world.grab_strength``.
+            Pull in N/m per held vertex: force ``strength * (target + offset - x)``;
+            default ``world.grab_strength``.
         radius : float, optional
             Metres (> 0).
 
@@ -694,7 +696,8 @@ class World:
                 near = np.flatnonzero(np.linalg.norm(x - p, axis=1) <= r)
                 picked = np.union1d(picked, near)
             if len(picked):
-                g = Grab(self, body, np.unique(picked), (float(p[0]), float(p[1])), s)
+                picked = np.unique(picked)
+                g = Grab(self, body, picked, (float(p[0]), float(p[1])), s, offsets=x[picked] - p)
                 break
         else:
             g = Grab(self, None, [], (float(p[0]), float(p[1])), s)
@@ -725,12 +728,12 @@ class World:
     def _rebuild_grabs(self):
         n = self._model.n_vertices
         slot = np.full(n, -1, np.int32)
-        rows = [(b.vertex_slice.start + g.vertices, g.strength, g.target) for g in self._grabs
-                if len(g.vertices) for b in [g.body]]
+        rows = [(b.vertex_slice.start + g.vertices, g.strength, np.asarray(g.target) + g.offsets)
+                for g in self._grabs if len(g.vertices) for b in [g.body]]
         if rows:
             idx = np.concatenate([r[0] for r in rows])
             st = np.concatenate([np.full(len(r[0]), r[1]) for r in rows])
-            tg = np.concatenate([np.tile(r[2], (len(r[0]), 1)) for r in rows])
+            tg = np.concatenate([r[2] for r in rows])  # each held vertex's own target
             uniq, inv = np.unique(idx, return_inverse=True)
             pull = np.zeros((len(uniq), 3))
             np.add.at(pull[:, 0], inv, st)
