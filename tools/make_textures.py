@@ -1,4 +1,4 @@
-"""Draw deforma's built-in textures: bunny, donut and armadillo.
+"""Draw deforma's built-in textures: bunny, donut and armadillo (and the tear scene's cloth).
 
 Each picture is made here from hand-made outlines (coordinate lists on a 100 x 100 grid,
 y down, smoothed by closed Catmull-Rom splines) and drawn with Pillow: flat colours,
@@ -12,6 +12,7 @@ mesher treats black as background when there is no alpha).
 Run from the repository root::
 
     python tools/make_textures.py            # writes src/deforma/assets/textures/*.png
+                                             # and src/deforma/assets/scenes/cloth.png
     python tools/make_textures.py --size 512 --out /tmp/textures
 """
 
@@ -344,7 +345,34 @@ def draw_armadillo(size):
     return c.result()
 
 
+def draw_cloth(size):
+    """A tartan for the ``tear`` scene's sheet: a square sett woven in a 2/2 twill.
+
+    Each thread has one colour (the same sequence across and down, as in a tartan); a pixel
+    shows the vertical thread where ``(x + y) // 2`` is even and the horizontal one where it
+    is odd, which draws the diagonal weave. Opaque, and no thread is black, so that the
+    picture is all cloth whichever rule reads it.
+    """
+    navy, blue, green, cream, red = (40, 58, 104), (61, 126, 166), (46, 110, 82), (236, 226, 196), (176, 52, 48)
+    # the sett: (colour, threads); repeated twice across the picture, mirrored about its end
+    sett = [(navy, 24), (blue, 6), (navy, 4), (blue, 20), (cream, 2), (blue, 20), (green, 24), (red, 4), (green, 8)]
+    half = [c for c, n in sett for _ in range(n)]
+    repeat = half + half[::-1]
+    scale = size / (2 * len(repeat))
+    idx = (np.arange(size) / scale).astype(int) % len(repeat)
+    colours = np.array(repeat, np.uint8)[idx]  # (size, 3): the thread colour at each column (and row)
+    yy, xx = np.mgrid[0:size, 0:size]
+    vertical = ((xx + yy) // 2) % 2 == 0
+    rgb = np.where(vertical[..., None], colours[None, :, :], colours[:, None, :])
+    # a touch of shading between threads, so that the weave reads at a glance
+    rgb = (rgb * np.where((xx + yy) % 2 == 0, 1.0, 0.9)[..., None]).astype(np.uint8)
+    alpha = np.full((size, size, 1), 255, np.uint8)
+    return Image.fromarray(np.concatenate([rgb, alpha], axis=2), "RGBA")
+
+
 TEXTURES = {"bunny": draw_bunny, "donut": draw_donut, "armadillo": draw_armadillo}
+# pictures only a scene draws (no shape to mesh), kept next to the scenes that use them
+SCENE_TEXTURES = {"cloth": draw_cloth}
 
 
 def main(argv=None):
@@ -355,10 +383,12 @@ def main(argv=None):
     if not 256 <= args.size <= 512:
         parser.error(f"--size must be in [256, 512], got {args.size}")
     args.out.mkdir(parents=True, exist_ok=True)
-    for name, draw in TEXTURES.items():
-        path = args.out / f"{name}.png"
-        draw(args.size).save(path, optimize=True)
-        print(f"wrote {path}")
+    scenes = args.out.parent / "scenes" if args.out == OUT else args.out
+    for folder, pictures in ((args.out, TEXTURES), (scenes, SCENE_TEXTURES)):
+        for name, draw in pictures.items():
+            path = folder / f"{name}.png"
+            draw(args.size).save(path, optimize=True)
+            print(f"wrote {path}")
 
 
 if __name__ == "__main__":
