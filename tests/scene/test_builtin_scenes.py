@@ -135,8 +135,10 @@ def test_tear_scene_tears_in_two_under_its_scripted_pull():
     scenes.Script(s, w).advance(2.0)
     assert b.n_vertices > n and b.pieces.max() + 1 >= 2
     assert np.isfinite(b.positions).all()
-    # the grab pinches the vertices it holds toward one point: a few triangles there fold
-    assert (signed_areas(b.positions, b.triangles) <= 0).mean() < 0.02
+    # the grab holds its patch whole (it pinched it into a tangle of folded triangles when every
+    # held vertex was pulled to one point); a torn flap may fold over as cloth does (1 triangle
+    # now): a springs sheet has no area term to unfold it
+    assert (signed_areas(b.positions, b.triangles) <= 0).sum() <= 2
 
 
 def test_dent_keeps_its_dent():
