@@ -141,6 +141,55 @@ def test_tear_scene_tears_in_two_under_its_scripted_pull():
     assert (signed_areas(b.positions, b.triangles) <= 0).sum() <= 2
 
 
+def test_torn_sheet_is_drawn_with_its_texture_on_every_piece(gl_ctx, tmp_path):
+    # the tear scene with a gradient picture for its cloth (red along u, green down the
+    # picture), torn by its pull and drawn as deforma run draws it: along the torn edges of
+    # every piece the pixels show the picture where that cloth was before the tear, so the
+    # copies a tear makes carry their texture coordinates into the renderer
+    from PIL import Image
+
+    from deforma.render import Renderer, WorldView
+
+    ramp = np.arange(64) * 4
+    tex = np.zeros((64, 64, 4), np.uint8)
+    tex[..., 0], tex[..., 1], tex[..., 2], tex[..., 3] = ramp[None, :], ramp[:, None], 128, 255
+    Image.fromarray(tex, "RGBA").save(tmp_path / "ramp.png")
+    text = (scenes.builtin_scenes()["tear"]).read_text().replace('texture = "cloth.png"', 'texture = "ramp.png"')
+    assert 'texture = "ramp.png"' in text
+    (tmp_path / "tear.toml").write_text(text)
+    s = scenes.load(tmp_path / "tear.toml")
+    w = s.build()
+    (b,) = w.bodies
+    scenes.Script(s, w).advance(2.5)
+    assert b.pieces.max() + 1 >= 2
+    r = Renderer(gl_ctx, (640, 360), samples=0)
+    view = WorldView(r, w, s)
+    view.wireframe = False
+    img = view.draw().astype(int)
+    # a box's uv is its rest position scaled into the unit square, and a copy keeps the rest
+    # position of the vertex it was split from: the picture every point should show
+    rest = b.topology.rest_positions
+    corners = np.array(s.body[0].corners, float)
+    lo, size = corners.min(axis=0), np.ptp(corners, axis=0)
+    x, t, uv = b.positions, b.triangles, (rest - lo) / size
+    e1, e2 = x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    # the vertices the tear split: an original and its copies share a rest position
+    _, first, count = np.unique(rest.round(9), axis=0, return_inverse=True, return_counts=True)
+    split = count[first] > 1
+    for piece in range(int(b.pieces.max()) + 1):
+        mine = np.flatnonzero((b.pieces[t[:, 0]] == piece) & split[t].any(axis=1))  # along its torn edge
+        assert len(mine) >= 5, piece
+        big = mine[np.argsort(-area[mine])[:5]]  # the largest: their centres far from other edges
+        px = np.floor(r.camera.world_to_pixel(x[t[big]].mean(axis=1), r.size)).astype(int)
+        u, v = uv[t[big]].mean(axis=1).T
+        expected = np.c_[u * 256 - 2, (1 - v) * 256 - 2]  # texel centres: (k + 0.5) / 64 -> 4 k
+        got = img[px[:, 1], px[:, 0], :2]
+        match = np.abs(got - expected).max(axis=1) < 12
+        assert match.sum() >= 4, (piece, got.tolist(), expected.round().tolist())
+    r.release()
+
+
 def test_dent_keeps_its_dent():
     from deforma.physics.elements import signed_areas
 
