@@ -190,10 +190,42 @@ def test_incremental_rebuild_equals_rebuild_from_scratch(model, integrator):
 
 def test_stable_order_is_numpys_stable_argsort():
     rng = np.random.default_rng(3)
-    for n, m in ((1, 5), (7, 100), (1000, 5000)):
+    # small bounds take the counting sort, large ones the combined-key sort
+    for n, m in ((1, 5), (7, 100), (1000, 5000), (10 ** 6, 100), (10 ** 8, 6000)):
         keys = rng.integers(0, n, m)
         assert same(stable_order(keys, n), np.argsort(keys, kind="stable"))
     assert same(stable_order(np.array([3, 1, 3, 0]), 2 ** 62), np.array([3, 1, 0, 2]))  # too big: argsort
+
+
+def reference_edge_table(n, t):
+    """The edge table by NumPy's stable sort and ``unique``: what the compiled pass replaced."""
+    t = np.asarray(t, np.int64)
+    m = len(t)
+    head, tail = t.T.ravel(), t[:, [1, 2, 0]].T.ravel()
+    lo, hi = np.minimum(head, tail), np.maximum(head, tail)
+    order = np.argsort(lo * n + hi, kind="stable")
+    keys, first, inverse, count = np.unique((lo * n + hi)[order], return_index=True, return_inverse=True,
+                                            return_counts=True)
+    two = count == 2
+    tri_pair = np.full((len(keys), 2), -1, np.int64)
+    tri_pair[:, 0] = order[first] % m
+    tri_pair[two, 1] = order[first[two] + 1] % m
+    half_edge = np.empty(3 * m, np.int64)
+    half_edge[order] = inverse.ravel()
+    return keys, np.stack([keys // n, keys % n], axis=1), tri_pair, two, half_edge
+
+
+def test_edge_table_equals_a_plain_numpy_one():
+    from deforma.mesh.delaunay import delaunay
+
+    rng = np.random.default_rng(5)
+    for trial in range(30):
+        pts = rng.random((int(rng.integers(3, 300)), 2))
+        tris = np.asarray(delaunay(pts), np.int64)
+        if trial % 3 == 0:  # an edge in three triangles (a triangle twice): not interior
+            tris = np.r_[tris, tris[:1]]
+        got, want = tearing.edge_table(len(pts), tris), reference_edge_table(len(pts), tris)
+        assert all(same(a, b) for a, b in zip(got, want)), trial
 
 
 def test_lengths_are_numpys_norm():

@@ -34,16 +34,41 @@ def lengths(x, i, j) -> np.ndarray:
 def stable_order(keys, bound):
     """``np.argsort(keys, kind="stable")`` for non-negative integer keys below ``bound``.
 
-    Sorts ``key * len + position`` instead: one plain sort of distinct integers gives the same
-    order about 10x faster than NumPy's stable argsort (timsort for 64-bit integers: 1.4 ms
-    against 0.12 ms for the 14 400 half-edges of a 2500-vertex sheet), which a tear pays for
-    every rebuilt edge table.
+    Keys below a few times their number (vertex indices: a mesh's triangles by vertex) are
+    counted into buckets (:func:`counting_order`, one pass: 0.1 against 0.24 ms for the 2e4
+    triangles of a 1e4-vertex sheet). Others sort ``key * len + position``: one plain sort
+    of distinct integers gives the same order about 10x faster than NumPy's stable argsort
+    (timsort for 64-bit integers: 1.4 ms against 0.12 ms for the 14 400 half-edges of a
+    2500-vertex sheet), which a tear pays for every rebuilt topology.
+
+    Examples
+    --------
+    >>> stable_order([3, 1, 3, 0, 1], 4).tolist()
+    [3, 1, 4, 0, 2]
     """
     keys = np.asarray(keys, dtype=np.int64)
     m = len(keys)
+    if m and bound <= 4 * m + 1024:
+        return counting_order(keys, int(bound))
     if m == 0 or bound * m >= 2 ** 62:  # the combined key would overflow: the slow way
         return np.argsort(keys, kind="stable")
     return np.sort(keys * m + np.arange(m, dtype=np.int64)) % m
+
+
+@njit(cache=True)
+def counting_order(keys, bound):
+    """Stable order (M,) int64 of integer ``keys`` in ``[0, bound)``: a counting sort."""
+    start = np.zeros(bound + 1, np.int64)
+    for k in keys:
+        start[k + 1] += 1
+    for v in range(bound):
+        start[v + 1] += start[v]
+    order = np.empty(keys.shape[0], np.int64)
+    for i in range(keys.shape[0]):
+        k = keys[i]
+        order[start[k]] = i
+        start[k] += 1
+    return order
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,9 +217,9 @@ def element_geometry(topology: BodyTopology):
                          "(use the 'springs' material)")
     c = t.triangles
     order = stable_order(np.minimum(np.minimum(c[:, 0], c[:, 1]), c[:, 2]), t.n_vertices)
-    tri = c[order]
+    tri = np.take(c, order, axis=0)  # take: 4x faster than fancy indexing of rows here
     if t.geometry is not None:  # the same numbers rest_geometry gives, row by row
-        bmat, area = t.geometry[0][order], t.geometry[1][order]
+        bmat, area = np.take(t.geometry[0], order, axis=0), np.take(t.geometry[1], order)
     else:
         bmat, area = rest_geometry(t.rest_positions, tri)
     lumped = np.bincount(tri.ravel(), np.repeat(area / 3.0, 3), minlength=t.n_vertices)
