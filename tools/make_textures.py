@@ -1,4 +1,4 @@
-"""Draw deforma's built-in textures: bunny, donut and armadillo (and the tear scene's cloth).
+"""Draw deforma's built-in textures (bunny, donut, armadillo) and patterns (the tear scene's cloth).
 
 Each picture is made here from hand-made outlines (coordinate lists on a 100 x 100 grid,
 y down, smoothed by closed Catmull-Rom splines) and drawn with Pillow: flat colours,
@@ -12,7 +12,7 @@ mesher treats black as background when there is no alpha).
 Run from the repository root::
 
     python tools/make_textures.py            # writes src/deforma/assets/textures/*.png
-                                             # and src/deforma/assets/scenes/cloth.png
+                                             # and src/deforma/assets/patterns/cloth.png
     python tools/make_textures.py --size 512 --out /tmp/textures
 """
 
@@ -371,8 +371,8 @@ def draw_cloth(size):
 
 
 TEXTURES = {"bunny": draw_bunny, "donut": draw_donut, "armadillo": draw_armadillo}
-# pictures only a scene draws (no shape to mesh), kept next to the scenes that use them
-SCENE_TEXTURES = {"cloth": draw_cloth}
+# patterns: pictures only drawn on a body (no shape to mesh), in assets/patterns
+PATTERNS = {"cloth": draw_cloth}
 
 
 def main(argv=None):
@@ -383,8 +383,9 @@ def main(argv=None):
     if not 256 <= args.size <= 512:
         parser.error(f"--size must be in [256, 512], got {args.size}")
     args.out.mkdir(parents=True, exist_ok=True)
-    scenes = args.out.parent / "scenes" if args.out == OUT else args.out
-    for folder, pictures in ((args.out, TEXTURES), (scenes, SCENE_TEXTURES)):
+    patterns = args.out.parent / "patterns" if args.out == OUT else args.out
+    patterns.mkdir(parents=True, exist_ok=True)
+    for folder, pictures in ((args.out, TEXTURES), (patterns, PATTERNS)):
         for name, draw in pictures.items():
             path = folder / f"{name}.png"
             draw(args.size).save(path, optimize=True)

@@ -590,6 +590,8 @@ def cmd_scenes(a) -> int:
         print(f"  {name:<{width}}  {desc}")
     print("built-in textures (texture = or source = in a scene, deforma mesh NAME):")
     print("  " + (", ".join(scenes.builtin_textures()) or "(none installed)"))
+    print("built-in patterns (texture = only: pictures with no shape to mesh):")
+    print("  " + (", ".join(scenes.builtin_patterns()) or "(none installed)"))
     return 0
 
 

@@ -154,7 +154,7 @@ def test_torn_sheet_is_drawn_with_its_texture_on_every_piece(gl_ctx, tmp_path):
     tex = np.zeros((64, 64, 4), np.uint8)
     tex[..., 0], tex[..., 1], tex[..., 2], tex[..., 3] = ramp[None, :], ramp[:, None], 128, 255
     Image.fromarray(tex, "RGBA").save(tmp_path / "ramp.png")
-    text = (scenes.builtin_scenes()["tear"]).read_text().replace('texture = "cloth.png"', 'texture = "ramp.png"')
+    text = (scenes.builtin_scenes()["tear"]).read_text().replace('texture = "cloth"', 'texture = "ramp.png"')
     assert 'texture = "ramp.png"' in text
     (tmp_path / "tear.toml").write_text(text)
     s = scenes.load(tmp_path / "tear.toml")

@@ -80,6 +80,24 @@ def test_builtin_scene_round_trip_loses_nothing(tmp_path, name):
     # and writing it again gives the same bytes
     path2 = deforma.scene.save_scene(again.build(), tmp_path / "again.toml")
     assert path2.read_text() == path.read_text()
+    # built-in pictures are written by name, never as a path into the installed package
+    assert "assets" not in path.read_text()
+
+
+def test_a_pattern_is_a_texture_by_name_but_no_mesh_source(tmp_path):
+    s = scenes.load(write(tmp_path, """
+        [[body]]
+        texture = "cloth"
+    """))
+    assert s.body[0].texture == "cloth" and s.body[0].texture in scenes.builtin_patterns()
+    assert 'texture = "cloth"' in scenes.save_scene(s, tmp_path / "saved.toml").read_text()
+    assert scenes.load_texture("cloth").shape[2] == 4
+    with pytest.raises(SceneError, match=r"body\[0\]: source .cloth. is a pattern.*texture = .cloth.*armadillo"):
+        scenes.load_scene(write(tmp_path, """
+            [[body]]
+            shape = "image"
+            source = "cloth"
+        """))
 
 
 def test_live_changes_are_saved(tmp_path):

@@ -1,4 +1,4 @@
-"""Built-in scenes (package data under ``deforma/assets/``) and the textures and level pictures scenes name.
+"""Built-in scenes (package data under ``deforma/assets/``) and the textures, patterns and level pictures scenes name.
 
 Pictures are read by one loader, :func:`deforma.mesh.image.load_rgba`, and the built-in
 textures are listed in one place, :func:`deforma.mesh.image.builtin_textures`; this module
@@ -15,7 +15,7 @@ import numpy as np
 
 from ..mesh.image import builtin_textures
 
-__all__ = ["builtin_levels", "builtin_scenes", "builtin_textures", "load_texture", "picture_file", "picture_reference",
+__all__ = ["builtin_levels", "builtin_patterns", "builtin_scenes", "builtin_textures", "load_texture", "picture_file", "picture_reference",
            "resolve_picture", "resolve_texture", "scene_path", "texture_reference"]
 
 
@@ -55,6 +55,28 @@ def scene_path(name_or_path) -> Path:
     raise ValueError(f"unknown scene {s!r}; {hint}built-in scenes: {', '.join(scenes)} (or give a path to a .toml file)")
 
 
+def builtin_patterns() -> dict[str, Path]:
+    """Pictures shipped in ``deforma/assets/patterns`` to draw on a body: name -> file.
+
+    A pattern (the ``tear`` scene's ``cloth``) is a ``texture`` only: it has no shape to mesh,
+    so it is kept apart from the textures, which are pictures of bodies (``source``, ``deforma
+    mesh``, the viewer's objects to drop). A scene names it, and a saved scene writes the name
+    back rather than a path into the installed package.
+
+    Examples
+    --------
+    >>> "cloth" in builtin_patterns()
+    True
+    """
+    folder = _assets() / "patterns"
+    return {p.stem: p for p in sorted(folder.glob("*.png"))} if folder.is_dir() else {}
+
+
+def _drawn() -> dict[str, Path]:
+    """Every built-in picture a ``texture =`` may name: the textures and the patterns."""
+    return {**builtin_textures(), **builtin_patterns()}
+
+
 def builtin_levels() -> dict[str, Path]:
     """Pictures of levels shipped in ``deforma/assets/levels`` for image colliders: name -> file.
 
@@ -89,14 +111,15 @@ def _resolve(value: str, names: dict, what: str, base_dir) -> str:
 
 
 def resolve_texture(value: str, *, base_dir) -> str:
-    """A built-in texture name as is, or an image path made absolute (relative to ``base_dir``).
+    """A built-in texture or pattern name as is, or an image path made absolute (relative to
+    ``base_dir``).
 
     Raises
     ------
     ValueError
         If it is neither a built-in name nor an existing image file.
     """
-    return _resolve(value, builtin_textures(), "texture", base_dir)
+    return _resolve(value, _drawn(), "texture", base_dir)
 
 
 def resolve_picture(value: str, *, base_dir) -> str:
@@ -130,7 +153,7 @@ def picture_reference(value: str, *, base_dir) -> str:
 
 def texture_reference(value: str, *, base_dir) -> str:
     """What to write in a file for a resolved texture: the name, or a path relative to ``base_dir``."""
-    if value in builtin_textures():
+    if value in _drawn():
         return value
     from .schema import relative_path
 
@@ -139,7 +162,7 @@ def texture_reference(value: str, *, base_dir) -> str:
 
 def texture_file(value: str) -> Path:
     """The image file of a resolved texture reference."""
-    return builtin_textures().get(value) or Path(value)
+    return _drawn().get(value) or Path(value)
 
 
 @lru_cache(maxsize=32)

@@ -98,6 +98,12 @@ def make_mesh(spec):
     if isinstance(spec, BoxBody):
         return meshes.box(spec.corners, detail=spec.detail, edges=spec.edges)
     if isinstance(spec, ImageBody):
+        from .assets import builtin_patterns
+
+        if spec.source in builtin_patterns():
+            raise ValueError(f"source {spec.source!r} is a pattern, a picture with no shape to mesh: draw it with "
+                             f"texture = {spec.source!r} on a body; source takes one of "
+                             f"{', '.join(map(repr, meshes.image.BUILTIN_TEXTURES))} or an image file")
         # a built-in name or an absolute path: from_image takes either
         return meshes.from_image(spec.source, resolution=spec.resolution, detect_edges=spec.detect_edges,
                                  edge_step=spec.edge_step, scale=spec.scale, background=spec.background,
