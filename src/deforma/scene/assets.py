@@ -68,7 +68,12 @@ def builtin_patterns() -> dict[str, Path]:
     >>> "cloth" in builtin_patterns()
     True
     """
-    folder = _assets() / "patterns"
+    return _pictures("patterns")
+
+
+def _pictures(kind: str) -> dict[str, Path]:
+    """The PNG pictures in ``deforma/assets/<kind>``, by name (sorted)."""
+    folder = _assets() / kind
     return {p.stem: p for p in sorted(folder.glob("*.png"))} if folder.is_dir() else {}
 
 
@@ -88,8 +93,7 @@ def builtin_levels() -> dict[str, Path]:
     >>> "ramp" in builtin_levels()
     True
     """
-    folder = _assets() / "levels"
-    return {p.stem: p for p in sorted(folder.glob("*.png"))} if folder.is_dir() else {}
+    return _pictures("levels")
 
 
 def _resolve(value: str, names: dict, what: str, base_dir) -> str:
