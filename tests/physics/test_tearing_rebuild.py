@@ -195,6 +195,10 @@ def test_stable_order_is_numpys_stable_argsort():
         keys = rng.integers(0, n, m)
         assert same(stable_order(keys, n), np.argsort(keys, kind="stable"))
     assert same(stable_order(np.array([3, 1, 3, 0]), 2 ** 62), np.array([3, 1, 0, 2]))  # too big: argsort
+    with pytest.raises(ValueError, match="outside"):  # the counting sort indexes by key: it checks them
+        stable_order(np.array([0, 5]), 4)
+    with pytest.raises(ValueError, match="outside"):
+        tearing.edge_table(3, np.array([[0, 1, 3]]))
 
 
 def reference_edge_table(n, t):

@@ -388,7 +388,7 @@ class Body:
 
 
 class Grab:
-    """A mouse grab: vertices of one body held at ``target`` while held.
+    """A mouse grab: vertices of one body pulled along with ``target`` until released.
 
     Made by :meth:`World.grab`. ``vertices`` are body-local indices (empty when the point
     was off every body, then the grab does nothing). ``offsets`` (k, 2), metres: where each

@@ -60,6 +60,8 @@ def counting_order(keys, bound):
     """Stable order (M,) int64 of integer ``keys`` in ``[0, bound)``: a counting sort."""
     start = np.zeros(bound + 1, np.int64)
     for k in keys:
+        if k < 0 or k >= bound:  # Numba does not check indices: refuse rather than write astray
+            raise ValueError("stable_order: a key outside [0, bound)")
         start[k + 1] += 1
     for v in range(bound):
         start[v + 1] += start[v]

@@ -201,6 +201,8 @@ def _edge_table(n, t):
     for k in range(3):
         for f in range(m):
             a, b = t[f, k], t[f, (k + 1) % 3]
+            if min(a, b) < 0 or max(a, b) >= n:  # Numba does not check indices: refuse rather than write astray
+                raise ValueError("edge_table: a triangle's vertex outside [0, n)")
             lo[k * m + f], hi[k * m + f] = min(a, b), max(a, b)
     start = np.zeros(n + 1, np.int64)
     for h in range(nh):
