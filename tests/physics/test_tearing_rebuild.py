@@ -17,7 +17,7 @@ from deforma.physics.model import BodyTopology, Model, element_geometry, lengths
 BODY_FIELDS = ("rest_positions", "springs", "spring_rest_length", "triangles", "boundary_edges",
                "boundary_vertices", "boundary_clearance", "mass_share")
 TEAR_FIELDS = ("triangles", "pairs", "tri_pair", "inner", "boundary", "b", "area", "normal", "keys",
-               "vertex_ptr", "vertex_tris", "tri_edge")
+               "vertex_ptr", "vertex_tris", "tri_edge", "inner_tri")
 MODEL_FIELDS = ("vertex_mass", "vertex_inv_mass", "spring_i", "spring_j", "spring_rest_length", "elem", "elem_b",
                 "elem_area", "vertex_area", "pinned", "body_vertex_offsets", "body_spring_offsets",
                 "body_elem_offsets")
@@ -55,7 +55,7 @@ def reference_tear(topo, x, limit, tips):
     crack starts)."""
     n = len(topo.boundary)
     strain = np.empty(len(topo.inner))
-    tearing.opening_strain(x, topo.triangles, topo.b, topo.tri_pair[topo.inner], topo.normal, strain)
+    tearing.opening_strain(x, topo.triangles, topo.b, topo.inner_tri, topo.normal, strain)
     over = np.flatnonzero(strain > limit)
     used, cut = np.zeros(n, bool), []
     for e in topo.inner[over[np.argsort(-strain[over], kind="stable")]]:

@@ -36,7 +36,8 @@ def limit_springs(x, v, inv_mass, spring_i, spring_j, rest, max_stretch, toleran
     """Shorten springs longer than ``max_stretch * rest`` (``move``) and remove the velocity
     that stretches a spring at its limit further (``stop``), in place on ``x``, ``v``.
 
-    Returns the number of sweeps run and the largest excess strain left (0 when none).
+    Returns the number of sweeps run, the largest excess strain left (0 when none) and how
+    many springs the first sweep found active (within ``ACTIVE`` of their limit or beyond).
 
     Examples
     --------
@@ -44,12 +45,13 @@ def limit_springs(x, v, inv_mass, spring_i, spring_j, rest, max_stretch, toleran
     >>> x = np.array([[0.0, 0.0], [2.0, 0.0]]); v = np.array([[0.0, 0.0], [1.0, 0.0]])
     >>> limit_springs(x, v, np.ones(2), np.array([0], np.int32), np.array([1], np.int32), np.ones(1), 1.1,
     ...               1e-4, 50)
-    (2, 0.0)
+    (2, 0.0, 1)
     >>> x[:, 0].round(12).tolist(), v[:, 0].tolist()  # 1.1 long, centred; no more separating speed
     ([0.45, 1.55], [0.5, 0.5])
     """
     worst = 0.0
     sweeps = 0
+    active = 0
     for sweeps in range(1, max_sweeps + 1):
         worst = 0.0
         m = spring_i.shape[0]
@@ -64,6 +66,8 @@ def limit_springs(x, v, inv_mass, spring_i, spring_j, rest, max_stretch, toleran
             c = length - max_stretch * rest[e]
             if c <= -ACTIVE * rest[e] or w == 0.0:
                 continue
+            if sweeps == 1:
+                active += 1
             nx = dx / length
             ny = dy / length
             if move and c > 0.0:
@@ -82,7 +86,7 @@ def limit_springs(x, v, inv_mass, spring_i, spring_j, rest, max_stretch, toleran
                 v[j, 1] -= wj / w * rate * ny
         if worst <= tolerance:
             break
-    return sweeps, worst if worst > tolerance else 0.0
+    return sweeps, worst if worst > tolerance else 0.0, active
 
 
 @njit(cache=True, inline="always")
@@ -102,8 +106,8 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
     (``move``) and remove the velocity that stretches one at its limit further (``stop``).
 
     ``C = s_i - max_stretch`` for each principal stretch above the limit, gradient ``R v_i
-    v_i^T`` in ``F`` (:mod:`deforma.physics.strain`). Returns the sweeps run and the largest
-    excess stretch left (0 when none).
+    v_i^T`` in ``F`` (:mod:`deforma.physics.strain`). Returns the sweeps run, the largest
+    excess stretch left (0 when none) and how many constraints the first sweep found active.
 
     Examples
     --------
@@ -120,6 +124,7 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
     """
     worst = 0.0
     sweeps = 0
+    active = 0
     for sweeps in range(1, max_sweeps + 1):
         worst = 0.0
         m = elem.shape[0]
@@ -146,6 +151,8 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
                 norm = _dot(wi, wj, wk, g, g)
                 if norm == 0.0:
                     continue
+                if sweeps == 1:
+                    active += 1
                 if move and cons > 0.0:
                     if cons > worst:
                         worst = cons
@@ -156,7 +163,7 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
                     _along(v, i, j, k, wi, wj, wk, g, -rate / norm)
         if worst <= tolerance:
             break
-    return sweeps, worst if worst > tolerance else 0.0
+    return sweeps, worst if worst > tolerance else 0.0, active
 
 
 def attachments(rest, edges, pinned):
@@ -232,18 +239,25 @@ def project_stretch(x, v, x_start, inv_mass, spring_i, spring_j, rest, elem, b, 
     Returns the largest excess left (0 within ``tolerance``).
     """
     before = x.copy()
+    moved = 0
     if anchors is not None:
-        limit_attachments(x, anchors[0], anchors[1], max_stretch)
+        moved = limit_attachments(x, anchors[0], anchors[1], max_stretch)
     worst = 0.0
     for stage in range(2):  # positions, then (after the velocity update) what still stretches
         move, stop = stage == 0, stage == 1
+        active = 0
         if len(spring_i):
-            r = limit_springs(x, v, inv_mass, spring_i, spring_j, rest, max_stretch, tolerance,
-                              sweeps if move else 4, move, stop)[1]
-            worst = max(worst, r if move else 0.0)
+            _, r, n = limit_springs(x, v, inv_mass, spring_i, spring_j, rest, max_stretch, tolerance,
+                                    sweeps if move else 4, move, stop)
+            worst, active = max(worst, r if move else 0.0), active + n
         if len(elem):
-            r = limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, sweeps if move else 4, move, stop)[1]
-            worst = max(worst, r if move else 0.0)
+            _, r, n = limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, sweeps if move else 4, move,
+                                     stop)
+            worst, active = max(worst, r if move else 0.0), active + n
+        if move and not active and not moved:
+            # nothing within ACTIVE of its limit and nothing moved: the velocity update and the
+            # stop stage would change nothing (the common step, a third of the check's cost)
+            return 0.0
         if move:
             c = x - before
             size = np.linalg.norm(c, axis=1)
