@@ -116,6 +116,27 @@ def test_absurd_dt_raises_and_keeps_the_state_before_the_failing_step():
     assert np.all(np.isfinite(b.positions))
 
 
+def test_a_step_limit_set_by_damping_is_named_in_the_hint():
+    # the demo's Neo-Hookean bunny switched to symplectic Euler (as the viewer lets one do):
+    # its material damping (0.01 s, stiffness-proportional) cuts the explicit step 250-fold,
+    # and the hint says so rather than blaming the stiffness alone
+    from deforma import scene as scenes
+
+    w = scenes.load_scene("demo")
+    w.integrator = "symplectic-euler"
+    with pytest.raises(deforma.SimulationUnstable) as info:
+        for _ in range(20):
+            w.step()
+    assert "set by the damping" in info.value.hint and "material_damping" in info.value.hint
+    # a springs body without much damping: the plain hint, no such clause
+    w = deforma.World(dt=0.05, stiffness=5000.0)
+    w.add_body(grid_mesh(0.2, 0.1, 4, 3), position=(0, 0))
+    with pytest.raises(deforma.SimulationUnstable) as info:
+        for _ in range(1000):
+            w.step()
+    assert "raise substeps" in info.value.hint and "damping" not in info.value.hint
+
+
 def test_stable_dt_is_the_true_limit_for_two_masses_on_a_spring():
     # Gershgorin's bound is exact here: omega^2 = k / mu = 2 k / m_vertex
     w = deforma.World(gravity=(0, 0), mass=2.0, stiffness=1e4, damping=0.0, max_speed=1e6)

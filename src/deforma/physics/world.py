@@ -928,18 +928,28 @@ class World:
                     f"(grab strength, explosion): lower it, or raise max_speed if such speeds are intended")
         elif h > stable and self._dt / stable <= MAX_SUBSTEPS:
             need = math.ceil(self._dt / stable)
-            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s: "
+            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s{self._damping_note(stable)}: "
                     f"lower dt or raise substeps to at least {need}")
         elif h > stable:
-            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s by more than "
-                    f"{MAX_SUBSTEPS} substeps can make up: lower the stiffness or damping, raise the mass, "
-                    f"or use an unconditionally stable integrator (implicit-euler, xpbd)")
+            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s{self._damping_note(stable)} "
+                    f"by more than {MAX_SUBSTEPS} substeps can make up: lower the stiffness or damping, raise the "
+                    f"mass, or use an unconditionally stable integrator (implicit-euler, xpbd)")
         else:
             hint = (f"dt/substeps {h:.3g} s is within the stable estimate {stable:.3g} s, so a large "
                     f"force ran away (grab strength, explosion, stiffness): lower it, raise damping "
                     f"or substeps, or raise max_speed if such speeds are intended")
         raise SimulationUnstable(f"body {b} became unstable at step {self.step_count} ({what}); {hint}",
                                  body=body, step=self.step_count, hint=hint)
+
+    def _damping_note(self, stable: float) -> str:
+        """`` (set by damping: ...)`` when damping, not stiffness, makes the explicit step
+        ``stable`` (s) more than 10x shorter: a material's damping (stiffness-proportional,
+        ``material_damping``) easily does, and the hint should name it."""
+        w2, _ = self._explicit_rates()
+        undamped = math.inf if w2 == 0 else 2.0 / math.sqrt(w2)
+        if not stable < 0.1 * undamped:
+            return ""
+        return f" (set by the damping: {undamped:.3g} s without it; lower material_damping or damping)"
 
     # -- diagnostics ------------------------------------------------------------------------
     def stable_dt(self, *, explicit: bool = False) -> float:
@@ -969,6 +979,17 @@ class World:
         m = self._model
         if m.n_vertices == 0 or (not explicit and getattr(self._integrator, "unconditionally_stable", False)):
             return math.inf
+        w2, gamma = self._explicit_rates()
+        if w2 == 0:
+            return math.inf if gamma == 0 else 2 / gamma
+        # (sqrt(gamma^2 + 4 w2) - gamma) / w2, written without the difference of two close
+        # numbers (heavy damping made it 0, and a hint then divided by it)
+        return 4.0 / (math.hypot(gamma, 2.0 * math.sqrt(w2)) + gamma)
+
+    def _explicit_rates(self) -> tuple[float, float]:
+        """``(omega^2, gamma)`` of :meth:`stable_dt`: the largest stiffness and damping rates
+        over the vertices (1/s^2, 1/s)."""
+        m = self._model
         # (float: bincount of no springs gives integers)
         ks = np.bincount(m.spring_i, m.spring_stiffness, m.n_vertices) + \
             np.bincount(m.spring_j, m.spring_stiffness, m.n_vertices).astype(np.float64)
@@ -982,13 +1003,7 @@ class World:
             k = max_stiffness(m.elem_mu, m.elem_lambda)
             ks += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k, m.n_vertices)
             kd += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k * m.elem_damping, m.n_vertices)
-        w2 = float(np.max(2 * ks * m.vertex_inv_mass))
-        gamma = float(np.max(2 * kd * m.vertex_inv_mass))
-        if w2 == 0:
-            return math.inf if gamma == 0 else 2 / gamma
-        # (sqrt(gamma^2 + 4 w2) - gamma) / w2, written without the difference of two close
-        # numbers (heavy damping made it 0, and a hint then divided by it)
-        return 4.0 / (math.hypot(gamma, 2.0 * math.sqrt(w2)) + gamma)
+        return float(np.max(2 * ks * m.vertex_inv_mass)), float(np.max(2 * kd * m.vertex_inv_mass))
 
     def xpbd_substeps(self, strain: float = 0.01) -> int:
         """Substeps per ``dt`` at which XPBD holds the bodies up under their own weight.
