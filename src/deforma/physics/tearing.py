@@ -43,7 +43,7 @@ from numba import njit
 
 from .contacts import find_root
 from .elements import _gradient, rest_geometry
-from .model import lengths, stable_order
+from .model import counting_order, lengths, stable_order
 from .strain import spring_strains
 
 
@@ -209,24 +209,14 @@ def _edge_table(n, t):
             if min(a, b) < 0 or max(a, b) >= n:  # Numba does not check indices: refuse rather than write astray
                 raise ValueError("edge_table: a triangle's vertex outside [0, n)")
             lo[k * m + f], hi[k * m + f] = min(a, b), max(a, b)
-    start = np.zeros(n + 1, np.int64)
-    for h in range(nh):
-        start[lo[h] + 1] += 1
-    for v in range(n):
-        start[v + 1] += start[v]
-    pos = start[:n].copy()
-    order = np.empty(nh, np.int64)
-    for h in range(nh):
-        order[pos[lo[h]]] = h
-        pos[lo[h]] += 1
-    for v in range(n):
-        for i in range(start[v] + 1, start[v + 1]):
-            cur = order[i]
-            j = i - 1
-            while j >= start[v] and hi[order[j]] > hi[cur]:
-                order[j + 1] = order[j]
-                j -= 1
-            order[j + 1] = cur
+    order = counting_order(lo, n)
+    for i in range(1, nh):  # within each run of equal low vertex (few), by high vertex
+        cur = order[i]
+        j = i - 1
+        while j >= 0 and lo[order[j]] == lo[cur] and hi[order[j]] > hi[cur]:
+            order[j + 1] = order[j]
+            j -= 1
+        order[j + 1] = cur
     n_edges = 0
     for i in range(nh):
         if i == 0 or lo[order[i]] != lo[order[i - 1]] or hi[order[i]] != hi[order[i - 1]]:

@@ -23,7 +23,7 @@ from .script import Script
 __all__ = [
     "BoxBody", "CameraSettings", "CircleCollider", "ColliderSpec", "Event", "ImageBody", "ImageCollider",
     "InteractionSettings", "MeshBody", "PhysicsSettings", "PolygonCollider", "Pull", "RectCollider", "RunSettings",
-    "Scene", "SceneError", "SceneInfo", "Script", "SegmentCollider", "body_specs", "build", "builtin_levels", "builtin_patterns",
-    "builtin_scenes", "builtin_textures", "collider_spec", "load", "load_scene", "load_texture", "make_colliders",
+    "Scene", "SceneError", "SceneInfo", "Script", "SegmentCollider", "body_specs", "build", "builtin_levels",
+    "builtin_patterns", "builtin_scenes", "builtin_textures", "collider_spec", "load", "load_scene", "load_texture", "make_colliders",
     "make_mesh", "parse_scene", "save_scene", "scene_of", "with_springs",
 ]

@@ -15,8 +15,8 @@ import numpy as np
 
 from ..mesh.image import builtin_textures
 
-__all__ = ["builtin_levels", "builtin_patterns", "builtin_scenes", "builtin_textures", "load_texture", "picture_file", "picture_reference",
-           "resolve_picture", "resolve_texture", "scene_path", "texture_reference"]
+__all__ = ["builtin_levels", "builtin_patterns", "builtin_scenes", "builtin_textures", "load_texture", "picture_file",
+           "picture_reference", "resolve_picture", "resolve_texture", "scene_path", "texture_reference"]
 
 
 def _assets() -> Path:
