@@ -135,24 +135,40 @@ def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_los
 
 
 def test_the_implicit_matrix_assembly_matches_a_dense_sum():
-    from deforma.physics.implicit import csc_matrix, with_entries
+    from deforma.physics.implicit import element_weights, system_matrix, with_entries
 
+    w = deforma.World(stiffness=300.0, damping=0.7)
+    w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.5), (0, 0.5)), detail=3), position=(0, 1))  # springs
+    rubber = deforma.Material("neo-hookean", youngs_modulus=1e3, poisson_ratio=0.3, density=1.0, damping=0.01)
+    fem = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.5), (0, 0.5)), detail=2), position=(2, 1),
+                     material=rubber)
+    fem.pin([0, 3])
+    m, h = w._model, 0.01
+    n = m.n_vertices
     rng = np.random.default_rng(7)
-    n = 40
-    rows, cols = rng.integers(0, n, 600), rng.integers(0, n, 600)
-    vals = rng.normal(size=600)
-    vals[:50] = 0.0  # stored zeros and entries that cancel must not be kept
-    rows[50:60], cols[50:60], vals[50:60] = 3, 5, 1.0
-    rows[60:70], cols[60:70], vals[60:70] = 3, 5, -1.0
-    pinned = rng.random(n) < 0.2
-    dense = np.zeros((n, n))
-    np.add.at(dense, (rows, cols), vals)
+    grab_slot = np.full(n, -1, np.int32)
+    grab_slot[[2, 20]] = [0, 1]
+    grab_pull = rng.uniform(1, 5, (2, 3))
+    mass = m.vertex_mass * 1.01
+    a, diag = system_matrix(m, grab_slot, grab_pull, h, mass)
+    dense = np.diag(mass)
+    dense[[2, 20], [2, 20]] += h * h * grab_pull[:, 0]
+    ws = h * h * m.spring_stiffness + h * m.spring_damping
+    for i, j, wk in zip(m.spring_i, m.spring_j, ws):
+        dense[[i, j, i, j], [j, i, i, j]] += [-wk, -wk, wk, wk]
+    for tri, b, we in zip(m.elem, m.elem_b, element_weights(m, h)):
+        bb = b.reshape(2, 2)
+        d = np.stack([-bb[0] - bb[1], bb[0], bb[1]])
+        dense[np.ix_(tri, tri)] += we * d @ d.T
+    assert np.allclose(diag, np.diag(dense), rtol=1e-14, atol=0)
+    pinned = m.pinned
+    assert pinned.sum() == 2
     dense[pinned] = 0.0
     dense[pinned, pinned] = 1.0
-    a = csc_matrix(n, rows, cols, vals, pinned)
     assert a.has_canonical_format and np.allclose(a.toarray(), dense, rtol=0, atol=1e-12)
     off = a.indices != np.repeat(np.arange(n), np.diff(a.indptr))
     assert np.all(a.data[off] != 0.0)  # no stored zero off the diagonal
+    assert (dense[~pinned] == 0.0).sum() > 0 and (a.toarray() != 0).sum() == (np.abs(dense) > 1e-12).sum()
     more_r, more_c, more_v = rng.integers(0, n, 80), rng.integers(0, n, 80), rng.normal(size=80)
     b = with_entries(a, more_r, more_c, more_v, pinned)
     keep = ~pinned[more_r]

@@ -17,8 +17,7 @@ motion is never damped, and a mode of angular frequency ``omega`` gets the dampi
 ``beta omega / 2``.
 
 Here: the element forces (:func:`element_forces`, used by the symplectic step), the
-implicit solve's right-hand side (:func:`implicit_element_rhs`) and matrix
-(:func:`element_entries`), the XPBD projection (:func:`project_elements`), and NumPy helpers
+implicit solve's right-hand side (:func:`implicit_element_rhs`), the XPBD projection (:func:`project_elements`), and NumPy helpers
 (deformation gradients, energies, the stable-step bound).
 
 Units: m, s, kg, Pa (N/m per metre of thickness), J.
@@ -128,35 +127,6 @@ def gradient_row_sums(tris, b, area, weight, n):
     out = np.zeros(n)
     np.add.at(out, t.ravel(), ((weight * area)[:, None] * dots).ravel())
     return out
-
-
-@njit(cache=True)
-def element_entries(tris, b, weight, rows, cols, vals, at):
-    """Write the 9 entries per element of ``sum_e weight_e D D^T`` (the matrix of ``sum_e
-    weight_e / 2 |F_e(x) - T_e|^2`` for one coordinate: symmetric, rows sum to zero) into
-    ``rows, cols, vals`` from index ``at`` (coordinate format, duplicates to be summed).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
-    >>> b, a = rest_geometry(x, [[0, 1, 2]])
-    >>> r, c, v = np.zeros(9, np.int64), np.zeros(9, np.int64), np.zeros(9)
-    >>> element_entries(np.array([[0, 1, 2]]), b, np.ones(1), r, c, v, 0)
-    >>> m = np.zeros((3, 3)); np.add.at(m, (r, c), v); m.tolist()
-    [[2.0, -1.0, -1.0], [-1.0, 1.0, 0.0], [-1.0, 0.0, 1.0]]
-    """
-    d = np.empty((3, 2))
-    for e in range(tris.shape[0]):
-        d[1, 0], d[1, 1], d[2, 0], d[2, 1] = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
-        d[0, 0] = -d[1, 0] - d[2, 0]
-        d[0, 1] = -d[1, 1] - d[2, 1]
-        for v in range(3):
-            for u in range(3):
-                rows[at] = tris[e, v]
-                cols[at] = tris[e, u]
-                vals[at] = weight[e] * (d[v, 0] * d[u, 0] + d[v, 1] * d[u, 1])
-                at += 1
 
 
 @njit(cache=True, inline="always")

@@ -16,7 +16,7 @@ matrix ``A = M + L_w + h^2 S_grab`` (``L_w`` the graph Laplacian with spring wei
 direction. Alternating the two (the *local* step per spring, the *global* solve with
 ``A``) lowers the objective every iteration, and ``A`` is factored once (SuperLU,
 symmetric mode with a minimum-degree ordering) and reused until the mass, stiffness,
-damping, grab set or ``h`` change.
+damping or ``h`` change (small changes are corrected, not refactored: see below).
 
 Damping. The spring damping force ``kd ((v_j - v_i) . d) d`` of the symplectic path is
 kept exactly: backward Euler's damping term ``h kd/2 ((x_ij - x_ij^n) . d)^2`` equals
@@ -26,7 +26,7 @@ local/global scheme and the same constant matrix. It damps only the stretch rate
 rigid rotation (a spinning body keeps spinning).
 
 The mouse pull is in the matrix (it changes ``A``'s diagonal, so a new grab or release
-refactors; moving a held grab changes only the right-hand side). Gravity is in ``y``.
+changes the factor; moving a held grab changes only the right-hand side). Gravity is in ``y``.
 
 Contacts are inside the solve (the projective-dynamics way). The vertices whose
 prediction ``y`` lies inside a collider are listed with the plane of the face they would
@@ -37,8 +37,8 @@ position level (the prediction in the first iteration, then where a Jacobi step 
 contact-free system would move the iterate: :func:`free_estimate`), and whose weight joins
 ``A``'s diagonal. A vertex already outside projects to itself, so an inactive contact
 exerts no force at convergence. A new
-contact set refactors; a resting or sliding body keeps its set, and its factor, for many
-steps (docs/integrators.md says why this and not an iterative solve). After the solve the
+contact set changes the factor; a resting or sliding body keeps its set, and its factor, for
+many steps (docs/integrators.md says why this and not an iterative solve). After the solve the
 shared collider response (:func:`~deforma.physics.colliders.finish_position_step`) and the
 body contact stage run as in the symplectic path, so nothing ends inside a collider or
 across an outline; the stage's impulses change velocities only, not positions
@@ -50,11 +50,14 @@ the edge point, ``k_c/2 |D x - q|^2`` with ``D x = x_p - (1 - s) x_a - s x_b``, 
 coefficients sum to zero (linear momentum kept exactly); :func:`body_contact_rhs` is its
 local step. A pair closer than its target at the start of the substep is held there rather
 than pushed apart (:func:`~deforma.physics.contacts.hold_start_distance`). Its entries join
-the matrix, so a new set of pairs refactors; a pair keeps the ``s`` it had when the matrix
+the matrix, so a new set of pairs changes the factor; a pair keeps the ``s`` it had when the matrix
 was built. The contact-free matrix is assembled once per Model
-(:func:`system_entries`, :func:`csc_matrix`) and a refactor merges the contacts' entries
-into it (:func:`with_entries`), each in one compiled pass: with SciPy's sparse sums this
-took 1.5 ms per refactor of the ``pile`` (2458 vertices), now 0.56 ms.
+(:func:`system_matrix`) and a new contact set merges the contacts' entries into it
+(:func:`with_entries`), each in one compiled pass: with SciPy's sparse sums this took 1.5
+ms per refactor of the ``pile`` (2458 vertices), now 0.56 ms. A new contact set, a grab or
+a tear is then taken into the factor by a low-rank correction while it is small
+(:mod:`~deforma.physics.updated_factor`), and the matrix is factored again once the
+changes add up.
 
 With a fixed number of iterations per substep (``iterations``, default 3) the solution is
 approximate where springs turn (the local step lags one iteration); along a spring it is
@@ -74,8 +77,9 @@ from numba import njit
 
 from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, hold_start_distance
-from .elements import element_entries, implicit_element_rhs, max_stiffness
+from .elements import implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
+from .updated_factor import UpdatedFactor
 
 if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
     import scipy.sparse as sp
@@ -284,42 +288,133 @@ def element_weights(model, h: float) -> np.ndarray:
     return model.elem_area * (h * h + h * model.elem_damping) * max_stiffness(model.elem_mu, model.elem_lambda)
 
 
-def system_entries(model, grab_slot, grab_pull, h: float, mass=None):
-    """The constant global matrix ``M + L_w + K_w + h^2 S_grab`` (N x N, kg) in coordinate
-    format: ``(rows, cols, vals)``, duplicates to be summed (:func:`csc_matrix`).
+def system_matrix(model, grab_slot, grab_pull, h: float, mass=None):
+    """The constant global matrix ``M + L_w + K_w + h^2 S_grab`` (N x N, kg), canonical CSC,
+    each pinned row the identity's, and its diagonal before the pinning (N,).
 
     ``L_w`` is the graph Laplacian of the springs weighted by ``h^2 ks + h kd``, ``K_w`` the
     elements' ``sum_e w_e D D^T`` (:func:`element_weights`); the x and y coordinates share
     it, so one N x N factor serves both. ``mass`` replaces ``M``'s diagonal (the solve uses
-    ``M (1 + h air_drag)``). Pinned vertices are handled by :func:`csc_matrix`.
+    ``M (1 + h air_drag)``). A pinned row's equation is ``x_p = b_p`` (the caller puts the
+    pinned position in ``b_p``), while the free rows keep their coupling to it, so that it
+    acts on them as a known position.
 
     Examples
     --------
     >>> from deforma.physics.model import BodyTopology, Model
     >>> t = BodyTopology.from_arrays([[0, 0], [1, 0]], [[0, 1]])
     >>> m = Model([t], masses=[2.0], stiffness=[100.0], damping=[0.0])
-    >>> a = csc_matrix(2, *system_entries(m, np.full(2, -1, np.int32), np.zeros((0, 3)), 0.1))
-    >>> a.toarray().round(9).tolist()
-    [[2.0, -1.0], [-1.0, 2.0]]
+    >>> a, diag = system_matrix(m, np.full(2, -1, np.int32), np.zeros((0, 3)), 0.1)
+    >>> a.toarray().round(9).tolist(), diag.round(9).tolist()
+    ([[2.0, -1.0], [-1.0, 2.0]], [2.0, 2.0])
     """
+    import scipy.sparse as sp
+
     n = model.n_vertices
-    w = h * h * model.spring_stiffness + h * model.spring_damping
-    i, j = model.spring_i, model.spring_j
     diag = (model.vertex_mass if mass is None else mass).copy()
-    np.add.at(diag, i, w)
-    np.add.at(diag, j, w)
     held = np.flatnonzero(grab_slot >= 0)
     diag[held] += h * h * grab_pull[grab_slot[held], 0]
-    m = n + 2 * len(i) + 9 * model.n_elements
-    rows, cols, vals = np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m)
-    rows[:n] = cols[:n] = np.arange(n)
-    vals[:n] = diag
-    e = n + len(i)
-    rows[n:e], cols[n:e], vals[n:e] = i, j, -w
-    rows[e:e + len(i)], cols[e:e + len(i)], vals[e:e + len(i)] = j, i, -w
-    if model.n_elements:
-        element_entries(model.elem, model.elem_b, element_weights(model, h), rows, cols, vals, n + 2 * len(i))
-    return rows, cols, vals
+    ptr, ind, val = _assemble(diag, model.spring_i, model.spring_j,
+                              h * h * model.spring_stiffness + h * model.spring_damping,
+                              model.elem, model.elem_b, element_weights(model, h), model.pinned)
+    a = sp.csc_matrix((val, ind, ptr), shape=(n, n))
+    a.has_sorted_indices = True
+    return a, diag
+
+
+@njit(cache=True)
+def _assemble(diag, si, sj, sw, tris, b, ew, pinned):
+    """CSC arrays of :func:`system_matrix` (``diag`` comes in as the masses and grabs and
+    leaves as the whole diagonal before pinning), column by column: each vertex's springs and
+    elements are summed into a dense work column, whose touched rows are then sorted. One
+    pass over the incidences; the coordinate-format build it replaced sorted 1.9e5 entries
+    (4-5 ms on a 1e4-vertex sheet, at every tear). Entries that sum to exactly zero off the
+    diagonal are dropped (a right triangle's two legs do not couple: a stored zero would
+    cost the factor fill)."""
+    n = diag.shape[0]
+    ns, nt = si.shape[0], tris.shape[0]
+    start = np.zeros(n + 1, np.int64)  # per vertex: its springs (s) and element corners (-1 - 3 e - c)
+    for k in range(ns):
+        start[si[k] + 1] += 1
+        start[sj[k] + 1] += 1
+    for e in range(nt):
+        for c in range(3):
+            start[tris[e, c] + 1] += 1
+    for v in range(n):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    inc = np.empty(start[n], np.int64)
+    for k in range(ns):
+        inc[fill[si[k]]] = k
+        fill[si[k]] += 1
+        inc[fill[sj[k]]] = k
+        fill[sj[k]] += 1
+    for e in range(nt):
+        for c in range(3):
+            inc[fill[tris[e, c]]] = -1 - 3 * e - c
+            fill[tris[e, c]] += 1
+    ke = np.empty((nt, 3, 3))  # w_e D_v . D_u
+    for e in range(nt):
+        d1x, d1y, d2x, d2y = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+        dx = (-d1x - d2x, d1x, d2x)
+        dy = (-d1y - d2y, d1y, d2y)
+        for v in range(3):
+            for u in range(3):
+                ke[e, v, u] = ew[e] * (dx[v] * dx[u] + dy[v] * dy[u])
+    work = np.zeros(n)
+    seen = np.zeros(n, np.bool_)
+    rows = np.empty(n, np.int64)
+    ptr = np.zeros(n + 1, np.int64)
+    ind = np.empty(n + 2 * ns + 6 * nt, np.int64)
+    val = np.empty(n + 2 * ns + 6 * nt)
+    out = 0
+    for j in range(n):
+        m = 1
+        rows[0] = j
+        seen[j] = True
+        work[j] = diag[j]
+        for p in range(start[j], start[j + 1]):
+            k = inc[p]
+            if k >= 0:
+                o = sj[k] if si[k] == j else si[k]
+                work[j] += sw[k]
+                if not seen[o]:
+                    seen[o] = True
+                    rows[m] = o
+                    m += 1
+                work[o] -= sw[k]
+            else:
+                e, c = (-1 - k) // 3, (-1 - k) % 3
+                for v in range(3):
+                    o = tris[e, v]
+                    if not seen[o]:
+                        seen[o] = True
+                        rows[m] = o
+                        m += 1
+                    work[o] += ke[e, v, c]
+        diag[j] = work[j]
+        for a in range(1, m):  # insertion sort: a column holds a vertex's few neighbours
+            r = rows[a]
+            q = a - 1
+            while q >= 0 and rows[q] > r:
+                rows[q + 1] = rows[q]
+                q -= 1
+            rows[q + 1] = r
+        for a in range(m):
+            r = rows[a]
+            v = work[r]
+            work[r] = 0.0
+            seen[r] = False
+            if r == j:
+                ind[out] = r
+                val[out] = 1.0 if pinned[j] else v
+                out += 1
+            elif v != 0.0 and not pinned[r]:
+                ind[out] = r
+                val[out] = v
+                out += 1
+        ptr[j + 1] = out
+    return ptr, ind[:out], val[:out]
 
 
 @njit(cache=True, inline="always")
@@ -390,13 +485,14 @@ def _merge(ptr, ind, val, rows, cols, vals, pinned):
 
 
 def with_entries(a, rows, cols, vals, pinned) -> sp.csc_matrix:
-    """The canonical CSC matrix ``a`` (from :func:`csc_matrix`, pinned rows already the
+    """The canonical CSC matrix ``a`` (from :func:`system_matrix`, pinned rows already the
     identity's) plus the entries ``(rows, cols, vals)``, none added to a ``pinned`` row: the
     contacts' terms on the contact-free matrix, merged column by column.
 
     Examples
     --------
-    >>> a = csc_matrix(2, np.array([0, 1]), np.array([0, 1]), np.array([2.0, 3.0]))
+    >>> import scipy.sparse as sp
+    >>> a = sp.csc_matrix(np.diag([2.0, 3.0]))
     >>> b = with_entries(a, np.array([0, 1]), np.array([1, 0]), np.array([-1.0, -1.0]), np.zeros(2, bool))
     >>> b.toarray().tolist()
     [[2.0, -1.0], [-1.0, 3.0]]
@@ -409,31 +505,6 @@ def with_entries(a, rows, cols, vals, pinned) -> sp.csc_matrix:
     out = sp.csc_matrix((val, ind, ptr), shape=a.shape)
     out.has_sorted_indices = True
     return out
-
-
-def csc_matrix(n: int, rows, cols, vals, pinned=None) -> sp.csc_matrix:
-    """The N x N sparse matrix (CSC, canonical: rows sorted, no duplicates) with entries
-    ``(rows, cols, vals)`` summed where they repeat, each ``pinned`` row replaced by the
-    identity's: its equation becomes ``x_p = b_p`` (the caller puts the pinned position in
-    ``b_p``), while the free rows keep their coupling to it, so that it acts on them as a
-    known position. One compiled pass (:func:`with_entries` on the pinned rows' identity):
-    SciPy's coordinate-to-CSC conversion, the element products and the row replacement took
-    4-5 ms on a 2500-vertex sheet, at every tear and every new contact set.
-
-    Examples
-    --------
-    >>> a = csc_matrix(2, np.array([0, 1, 0, 0]), np.array([0, 1, 1, 1]), np.array([2.0, 3.0, 1.0, 1.0]),
-    ...                np.array([False, True]))
-    >>> a.toarray().tolist()  # the two (0, 1) entries summed; row 1 pinned
-    [[2.0, 2.0], [0.0, 1.0]]
-    """
-    import scipy.sparse as sp
-
-    pin = np.zeros(n, np.bool_) if pinned is None else np.asarray(pinned, dtype=np.bool_)
-    ptr = np.zeros(n + 1, np.int64)
-    np.cumsum(pin, out=ptr[1:])
-    identity = sp.csc_matrix((np.ones(int(ptr[-1])), np.flatnonzero(pin), ptr), shape=(n, n))  # the pinned rows
-    return with_entries(identity, rows, cols, vals, pin)
 
 
 @register_integrator("implicit-euler")
@@ -455,8 +526,12 @@ class ImplicitEuler:
         entry of its vertex (default 10; in (0, 1e12); larger holds contacts tighter in
         few iterations).
     factorizations : int
-        How many times the matrix was factored (refactoring follows parameter, ``h``,
-        grab, contact-set and ``contact_weight`` changes).
+        How many times the matrix was factored: at the start, and after changes of the
+        parameters, ``h`` or ``contact_weight``, and after small changes (tears, contact
+        sets, grabs) have added up (:mod:`~deforma.physics.updated_factor`).
+    updates : int
+        How many times a small change of the matrix was taken into the factor by a low-rank
+        correction instead of factoring again.
 
     Examples
     --------
@@ -472,10 +547,12 @@ class ImplicitEuler:
         self.iterations = 3
         self.contact_weight = 10.0
         self.factorizations = 0
+        self.updates = 0
         self._key = None
         self._touching = None
         self._triples = None
-        self._lu = None
+        self._factor = None
+        self._ref = None  # each vertex's row in the factor's reference matrix (None: unknown)
         self._scratch_n = -1
 
     def _base_if_needed(self, model, inputs, h):
@@ -489,13 +566,19 @@ class ImplicitEuler:
                 and np.array_equal(old[4], inputs.grab_pull[:, 0]):
             return
         key = (model, model.version, h, inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy(), inputs.air_drag)
+        # The factor stays usable through a change of the matrix when each vertex's row in its
+        # reference matrix is known: the same Model, or one a tear rebuilt from it (each vertex
+        # then comes from a vertex of the old one). Anything else factors again.
+        if old is None or self._ref is None:
+            self._ref = None
+        elif model is not old[0]:
+            torn = model.torn_from
+            self._ref = self._ref[torn[1]] if torn is not None and torn[0] == old[0].serial else None
         # Air drag -c v joins backward Euler as (1 + h c) M (x - y) / h^2 = f(x) + M g with
         # y = x_n + (h v_n + h^2 g) / (1 + h c): the heavier mass is in the matrix, so that
         # forces (not only gravity) balance at rest as they do without drag.
         self._mass = model.vertex_mass * (1.0 + h * inputs.air_drag)
-        rows, cols, vals = system_entries(model, inputs.grab_slot, inputs.grab_pull, h, self._mass)
-        self._diag = np.bincount(rows[rows == cols], vals[rows == cols], minlength=model.n_vertices)
-        self._a = csc_matrix(model.n_vertices, rows, cols, vals, model.pinned)  # pinned rows: the identity's
+        self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, self._mass)
         self._rows = self._a.tocsr()  # its rows, for free_estimate (not its columns: next to a pinned row they differ)
         self._key = key
         self._wk = h * h * model.spring_stiffness
@@ -506,14 +589,12 @@ class ImplicitEuler:
 
     def _factor_if_needed(self, model, touching, triples, s):
         # The vertices in collider contact add their weight to the diagonal, the body
-        # contacts their vertex-to-edge-point springs: a new set refactors. A body contact
-        # keeps the edge parameter s it had when the matrix was built (it is in the
+        # contacts their vertex-to-edge-point springs: a new set changes the matrix. A body
+        # contact keeps the edge parameter s it had when the matrix was built (it is in the
         # matrix), so a resting heap, whose s only jitters, keeps its factor.
         if self._touching is not None and self._weight_used == self.contact_weight \
                 and np.array_equal(self._touching, touching) and np.array_equal(self._triples, triples):
             return
-        import scipy.sparse.linalg as spla
-
         self._weight_used = self.contact_weight
         self._touching = touching.copy()
         self._triples = triples.copy()
@@ -528,11 +609,16 @@ class ImplicitEuler:
             vals = np.concatenate([self._contact_weight,
                                    (self._pair_weight[:, None, None] * co[:, :, None] * co[:, None, :]).ravel()])
             a = with_entries(a, rows, cols, vals, model.pinned)
-        # A is symmetric positive definite (but for pinned rows, which are the identity's): no
-        # pivoting needed, and a symmetric ordering (minimum degree on A + A^T) gave 40% less
-        # fill than COLAMD on a 1e5 mesh.
-        self._lu = spla.splu(a, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                             options=dict(SymmetricMode=True))
+        # A small change (a tear, a new contact set, a grab) is taken into the factor by a
+        # low-rank correction; a large one, or one whose rows are unknown, factors again.
+        if self._ref is not None and self._factor.update(a, self._ref):
+            self.updates += 1
+            return
+        if self._factor is None:
+            self._factor = UpdatedFactor(a)
+        else:
+            self._factor.refactor(a)
+        self._ref = np.arange(model.n_vertices)
         self.factorizations += 1
 
     def advance(self, model, state, inputs, h, substeps):
@@ -603,7 +689,7 @@ class ImplicitEuler:
                 body_contact_rhs(z, x_n, self._triples, self._s, self._pair_weight, buf.normal, buf.target, buf.mu,
                                  n_body, b)
                 b[self._pinned] = x_n[self._pinned]  # pinned: x_p = where it is
-                x[...] = self._lu.solve(b)
+                x[...] = self._factor.solve(b)
             bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
             if bad:
                 return bad
@@ -615,33 +701,3 @@ class ImplicitEuler:
                              inputs.hits, float(h), False) < 0:
                 return 0  # the contact buffer is too small; the world grows it and repeats the step
         return 0
-
-    def __deepcopy__(self, memo):
-        # copy.deepcopy(world): SciPy's SuperLU factor can be neither copied nor pickled, so the
-        # copy gets everything else and a stand-in that factors the same matrix again (same
-        # contact set, weights and edge parameters s, hence the same factor, bit for bit) the
-        # first time the copy solves with it. A changed contact set refactors as usual first.
-        import copy
-
-        new = type(self).__new__(type(self))
-        memo[id(self)] = new
-        for name, value in self.__dict__.items():
-            if name != "_lu":
-                new.__dict__[name] = copy.deepcopy(value, memo)
-        new._lu = None if self._lu is None else _FactorOnFirstSolve(new)
-        return new
-
-
-class _FactorOnFirstSolve:
-    """A copied :class:`ImplicitEuler`'s factor until its first solve (see ``__deepcopy__``)."""
-
-    def __init__(self, owner):
-        self.owner = owner
-
-    def solve(self, b):
-        o = self.owner
-        touching, factorizations = o._touching, o.factorizations
-        o._touching = None  # what makes _factor_if_needed factor again, from the stored set
-        o._factor_if_needed(o._key[0], touching, o._triples, o._s)
-        o.factorizations = factorizations  # the copy counts what the original counted
-        return o._lu.solve(b)

@@ -14,6 +14,7 @@ pascals (Lamé parameters), seconds (element damping).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +22,8 @@ from numba import njit
 
 from .elements import rest_geometry
 from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology, clear_against, rest_clearance
+
+_SERIALS = itertools.count()  # Model.serial
 
 
 def lengths(x, i, j) -> np.ndarray:
@@ -359,6 +362,14 @@ class Model:
         Incremented by every change of a parameter or rest shape made in place (the
         ``set_*`` methods, plasticity): a solver that keeps something built from the
         Model (a factored matrix) compares it instead of the arrays.
+    serial : int
+        A number no other Model built in this process has (a copy made by ``copy.deepcopy``
+        keeps it).
+    torn_from : (int, (N,) int64) or None
+        Set by the world when a tear rebuilt this Model from another: that Model's
+        ``serial``, and for each vertex the vertex of that Model it comes from (a copy or
+        itself). A solver that keeps something built for the old Model (implicit Euler's
+        factor) carries it over instead of starting again.
     pressure_a, pressure_b : (P,) int32
         Directed outline edges (global vertex indices, gas on the left) of the bodies that
         hold a gas (:mod:`deforma.physics.pressure`); ``body_pressure_offsets`` (B + 1,) says
@@ -383,6 +394,8 @@ class Model:
                  pressure=None):
         self.topologies = list(topologies)
         self.version = 0
+        self.serial = next(_SERIALS)
+        self.torn_from = None
         self._attachments = {}  # body -> its long-range attachments, until the pins change
         nb = len(self.topologies)
         materials = [None] * nb if materials is None else list(materials)

@@ -838,8 +838,11 @@ class World:
             body._apply_tear(cut)
             torn = True
         if torn:
-            self._rebuild(np.concatenate([self._state.x[b.vertex_slice][b._tear_source] for b in self._bodies]),
-                          np.concatenate([self._state.v[b.vertex_slice][b._tear_source] for b in self._bodies]))
+            old = self._model
+            off = old.body_vertex_offsets
+            source = np.concatenate([np.arange(off[i], off[i + 1])[b._tear_source] for i, b in enumerate(self._bodies)])
+            self._rebuild(self._state.x[source], self._state.v[source])
+            self._model.torn_from = (old.serial, source)
             for body in self._bodies:
                 body._tear_source = slice(None)
 
