@@ -42,8 +42,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import float64, int64, njit
-from numba.typed import List
+from numba import njit
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -78,16 +77,21 @@ def factor(a: "sp.csc_matrix"):
 
 
 @njit(cache=True)
-def _blocks(ptr, ind, val, ref, copy, n0, rptr, rind, rval, tol, limit):
+def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
     """The blocks of ``T^T A T`` against ``A_R`` (see the module docstring).
 
-    ``(ptr, ind, val)``: ``A`` (CSC, n x n); ``ref``, ``copy``: the vertex map (``copy[i]
-    = -1`` for a primary); ``(rptr, rind, rval)``: ``A_R`` (CSC, n0 x n0). Returns
-    ``Delta``'s entries above ``tol`` (rows, cols, vals), then ``B``'s, ``C``'s and ``D``'s
-    entries (COO, duplicates to be summed), or ``Delta`` with ``limit + 1`` entries when it
-    has more than ``limit`` (the caller refactors; no need to finish).
+    ``(ptr, ind, val)``: ``A`` (CSC, n x n); ``ref``: each row's reference row; ``copies``:
+    the rows that are copies, in order; ``(rptr, rind, rval)``: ``A_R`` (CSC, n0 x n0).
+    Returns ``Delta``'s entries above ``tol`` as ``(rows, cols, vals)`` (stopping once it
+    has more than ``limit``: the caller refactors), ``B`` as CSC arrays (n0 x nc), ``C``
+    as CSR arrays (nc x n0), both with sorted indices and no duplicates, and ``D`` (nc x nc).
+    One pass over ``A`` and ``A_R``, no sorting but of a column's few rows.
     """
     n = ptr.shape[0] - 1
+    nc = copies.shape[0]
+    copy = np.full(n, -1, np.int64)
+    for c in range(nc):
+        copy[copies[c]] = c
     # current columns grouped by reference vertex (a counting sort)
     start = np.zeros(n0 + 1, np.int64)
     for j in range(n):
@@ -102,10 +106,22 @@ def _blocks(ptr, ind, val, ref, copy, n0, rptr, rind, rval, tol, limit):
     work = np.zeros(n0)
     seen = np.zeros(n0, np.bool_)
     touched = np.empty(n0, np.int64)
-    dr, dc, dv = List.empty_list(int64), List.empty_list(int64), List.empty_list(float64)
-    br, bc, bv = List.empty_list(int64), List.empty_list(int64), List.empty_list(float64)
-    cr, cc, cv = List.empty_list(int64), List.empty_list(int64), List.empty_list(float64)
-    xr, xc, xv = List.empty_list(int64), List.empty_list(int64), List.empty_list(float64)
+    d = np.zeros((nc, nc))
+    # C's entries (row c = copy c's row of A, columns summed by reference vertex): those of
+    # A's rows that are copies, bucketed by copy first
+    c_count = np.zeros(nc + 1, np.int64)
+    for p in range(ptr[n]):
+        if copy[ind[p]] >= 0:
+            c_count[copy[ind[p]] + 1] += 1
+    for c in range(nc):
+        c_count[c + 1] += c_count[c]
+    c_fill = c_count[:-1].copy()
+    c_col = np.empty(c_count[nc], np.int64)
+    c_val = np.empty(c_count[nc])
+    dr = np.empty(limit + n0 + 1, np.int64)
+    dc = np.empty(limit + n0 + 1, np.int64)
+    dv = np.empty(limit + n0 + 1)
+    nd = 0
     for a in range(n0):
         nt = 0
         for g in range(start[a], start[a + 1]):
@@ -113,26 +129,19 @@ def _blocks(ptr, ind, val, ref, copy, n0, rptr, rind, rval, tol, limit):
             cj = copy[j]
             for p in range(ptr[j], ptr[j + 1]):
                 i = ind[p]
-                v = val[p]
                 ri = ref[i]
-                ci = copy[i]
                 if not seen[ri]:
                     seen[ri] = True
                     touched[nt] = ri
                     nt += 1
-                work[ri] += v
-                if cj >= 0:
-                    br.append(ri)
-                    bc.append(cj)
-                    bv.append(v)
+                work[ri] += val[p]
+                ci = copy[i]
                 if ci >= 0:
-                    cr.append(ci)
-                    cc.append(a)
-                    cv.append(v)
+                    c_col[c_fill[ci]] = a
+                    c_val[c_fill[ci]] = val[p]
+                    c_fill[ci] += 1
                     if cj >= 0:
-                        xr.append(ci)
-                        xc.append(cj)
-                        xv.append(v)
+                        d[ci, cj] += val[p]
         for p in range(rptr[a], rptr[a + 1]):
             ri = rind[p]
             if not seen[ri]:
@@ -143,30 +152,67 @@ def _blocks(ptr, ind, val, ref, copy, n0, rptr, rind, rval, tol, limit):
         for t in range(nt):
             ri = touched[t]
             if abs(work[ri]) > tol:
-                dr.append(ri)
-                dc.append(a)
-                dv.append(work[ri])
+                dr[nd], dc[nd], dv[nd] = ri, a, work[ri]
+                nd += 1
             work[ri] = 0.0
             seen[ri] = False
-        if len(dr) > limit:
+        if nd > limit:
             break
-    return (_ints(dr), _ints(dc), _floats(dv), _ints(br), _ints(bc), _floats(bv), _ints(cr), _ints(cc), _floats(cv),
-            _ints(xr), _ints(xc), _floats(xv))
+    # B's columns: each copy's column of A, rows summed by reference vertex
+    b_ptr = np.zeros(nc + 1, np.int64)
+    for c in range(nc):
+        b_ptr[c + 1] = b_ptr[c] + ptr[copies[c] + 1] - ptr[copies[c]]
+    b_ind = np.empty(b_ptr[nc], np.int64)
+    b_val = np.empty(b_ptr[nc])
+    out = 0
+    for c in range(nc):
+        j = copies[c]
+        nt = 0
+        for p in range(ptr[j], ptr[j + 1]):
+            ri = ref[ind[p]]
+            if not seen[ri]:
+                seen[ri] = True
+                touched[nt] = ri
+                nt += 1
+            work[ri] += val[p]
+        out = _emit_sorted(touched, nt, work, seen, b_ind, b_val, out)
+        b_ptr[c + 1] = out
+    # C's rows, canonical the same way
+    cc_ptr = np.zeros(nc + 1, np.int64)
+    out = 0
+    for c in range(nc):
+        nt = 0
+        for p in range(c_count[c], c_count[c + 1]):
+            a = c_col[p]
+            if not seen[a]:
+                seen[a] = True
+                touched[nt] = a
+                nt += 1
+            work[a] += c_val[p]
+        out = _emit_sorted(touched, nt, work, seen, c_col, c_val, out)  # in place: out <= p
+        cc_ptr[c + 1] = out
+    return dr[:nd], dc[:nd], dv[:nd], b_ptr, b_ind[:b_ptr[nc]], b_val[:b_ptr[nc]], cc_ptr, c_col[:out], \
+        c_val[:out], d
 
 
-@njit(cache=True)
-def _ints(items):
-    out = np.empty(len(items), np.int64)
-    for k in range(len(items)):
-        out[k] = items[k]
-    return out
-
-
-@njit(cache=True)
-def _floats(items):
-    out = np.empty(len(items), np.float64)
-    for k in range(len(items)):
-        out[k] = items[k]
+@njit(cache=True, inline="always")
+def _emit_sorted(touched, nt, work, seen, ind, val, out):
+    """Write the ``nt`` touched rows of ``work`` (sorted, an insertion sort: a column's few
+    rows) to ``ind, val`` from ``out``, clearing them; returns the new end."""
+    for a in range(1, nt):
+        r = touched[a]
+        q = a - 1
+        while q >= 0 and touched[q] > r:
+            touched[q + 1] = touched[q]
+            q -= 1
+        touched[q + 1] = r
+    for a in range(nt):
+        r = touched[a]
+        ind[out] = r
+        val[out] = work[r]
+        out += 1
+        work[r] = 0.0
+        seen[r] = False
     return out
 
 
@@ -291,7 +337,6 @@ class UpdatedFactor:
         when the correction would be too large or ill-conditioned: factor ``a`` instead
         (:meth:`refactor`)."""
         import scipy.linalg as sla
-        import scipy.sparse as sp
 
         n, n0 = a.shape[0], self._n0
         ref = np.ascontiguousarray(ref, dtype=np.int64)
@@ -301,17 +346,14 @@ class UpdatedFactor:
         first[ref[::-1]] = np.arange(n - 1, -1, -1)  # the lowest current index of each reference vertex
         if (first < 0).any():
             raise ValueError("ref must reach every row of the reference")
-        copy = np.full(n, -1, np.int64)
         copies = np.flatnonzero(first[ref] != np.arange(n))
-        copy[copies] = np.arange(len(copies))
         nc = len(copies)
         most = min(self.max_rank, int(self.max_share * n0))
         if nc > most:
             return False
-        blocks = _blocks(a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, ref, copy, n0,
-                         self._a.indptr.astype(np.int64), self._a.indices.astype(np.int64), self._a.data,
-                         self._tol, 2 * most * most)
-        dr, dc, dv, br, bc, bv, cr, cc, cv, xr, xc, xv = blocks
+        dr, dc, dv, b_ptr, b_ind, b_val, c_ptr, c_ind, c_val, d = _blocks(
+            a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, ref, copies, n0,
+            self._a.indptr.astype(np.int64), self._a.indices.astype(np.int64), self._a.data, self._tol, 2 * most * most)
         r = np.union1d(dr, dc)
         ko = len(r)
         k = ko + nc
@@ -322,29 +364,30 @@ class UpdatedFactor:
             return True
         delta = np.zeros((ko, ko))
         np.add.at(delta, (np.searchsorted(r, dr), np.searchsorted(r, dc)), dv)
-        b = sp.csc_matrix((bv, (br, bc)), shape=(n0, nc))
-        c = sp.csr_matrix((cv, (cr, cc)), shape=(nc, n0))
-        c.sum_duplicates()
-        d = np.zeros((nc, nc))
-        np.add.at(d, (xr, xc), xv)
+        b = (b_ptr, b_ind, b_val)
         keys = [("row", int(x)) for x in r] + [
-            b.indices[b.indptr[j]:b.indptr[j + 1]].tobytes() + b.data[b.indptr[j]:b.indptr[j + 1]].tobytes()
-            for j in range(nc)]
+            b_ind[b_ptr[j]:b_ptr[j + 1]].tobytes() + b_val[b_ptr[j]:b_ptr[j + 1]].tobytes() for j in range(nc)]
         slots = self._columns(keys, b)
         q = self._store
-        at_r = q[r][:, slots]              # rows r of [Z V]
-        at_c = c @ q[:, slots]             # C [Z V]
+        at_r = q[np.ix_(r, slots)]  # rows r of [Z V]
+        cols, at = np.unique(c_ind, return_inverse=True)  # C [Z V], from the few rows of [Z V] that C reads
+        c_dense = np.zeros((nc, len(cols)))
+        c_dense[np.repeat(np.arange(nc), np.diff(c_ptr)), at] = c_val  # canonical: no duplicates
+        at_c = c_dense @ q[np.ix_(cols, slots)]
         m = np.empty((k, k))
         m[:ko] = delta @ at_r
         m[:ko, :ko] += np.eye(ko)
         m[ko:, :ko] = -at_c[:, :ko]
         m[ko:, ko:] = d - at_c[:, ko:]
-        if not np.all(np.isfinite(m)) or np.linalg.cond(m) > MAX_CONDITION:
+        if not np.all(np.isfinite(m)):
             return False
         lu, piv = sla.lu_factor(m, check_finite=False)
+        rcond, info = sla.lapack.dgecon(lu, np.abs(m).sum(axis=0).max())  # LAPACK's estimate, from the LU
+        if info != 0 or not rcond * MAX_CONDITION > 1.0:
+            return False
         self._small = (lu, piv.astype(np.int64))
         self._slots = slots
-        self._delta, self._r, self._c = delta, r, c
+        self._delta, self._r, self._c = delta, r, (c_ptr, c_ind, c_val)
         self._ref, self._copies, self._primary = ref, copies, first
         self.rank = k
         return True
@@ -355,25 +398,26 @@ class UpdatedFactor:
 
     def _columns(self, keys, b) -> np.ndarray:
         """Slots of the store holding the solved column of each key (``("row", r)``: the
-        identity's column ``r``; bytes: copy ``j``'s column of ``b``), solving the missing
+        identity's column ``r``; bytes: copy ``j``'s column of ``B``, CSC arrays ``b``), solving the missing
         ones in one batch; columns no key names may be dropped to make room."""
         missing = [t for t, key in enumerate(keys) if key not in self._slot]
         if missing:
             rhs = np.zeros((self._n0, len(missing)), order="F")
+            b_ptr, b_ind, b_val = b
             nr = sum(isinstance(key, tuple) for key in keys)
             for col, t in enumerate(missing):
                 if t < nr:
                     rhs[keys[t][1], col] = 1.0
                 else:
                     j = t - nr
-                    lo, hi = b.indptr[j], b.indptr[j + 1]
-                    rhs[b.indices[lo:hi], col] += b.data[lo:hi]
+                    lo, hi = b_ptr[j], b_ptr[j + 1]
+                    rhs[b_ind[lo:hi], col] = b_val[lo:hi]
             self.solves += len(missing)
             solved = self._lu.solve(rhs)
             used = set(self._slot[key] for key in keys if key in self._slot)
             free = [t for t in range(self._store.shape[1]) if t not in used]
-            if len(free) < len(missing):  # grow the store (at most 2 max_rank columns: older ones are dropped)
-                cap = max(len(used) + len(missing), min(2 * self._store.shape[1], 2 * self.max_rank))
+            if len(free) < len(missing):  # grow the store (to max_rank + 16 columns: older ones are dropped)
+                cap = max(len(used) + len(missing), min(2 * self._store.shape[1], self.max_rank + 16))
                 grown = np.empty((self._n0, cap), order="F")
                 grown[:, :self._store.shape[1]] = self._store
                 free += list(range(self._store.shape[1], cap))
@@ -394,8 +438,7 @@ class UpdatedFactor:
         b2 = b.reshape(len(b), -1)
         u = self._lu.solve(_gather(b2, self._primary, self._ref, self._copies))
         lu, piv = self._small
-        s = _reduced(u, b2, self._r, self._delta, self._copies, self._c.indptr.astype(np.int64),
-                     self._c.indices.astype(np.int64), self._c.data, lu, piv)
+        s = _reduced(u, b2, self._r, self._delta, self._copies, *self._c, lu, piv)
         x = _finish(u, self._store, self._slots, s, self._ref, self._copies, len(self._r))
         return x.reshape(b.shape)
 
