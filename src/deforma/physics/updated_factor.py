@@ -82,8 +82,8 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
 
     ``(ptr, ind, val)``: ``A`` (CSC, n x n); ``ref``: each row's reference row; ``copies``:
     the rows that are copies, in order; ``(rptr, rind, rval)``: ``A_R`` (CSC, n0 x n0).
-    Returns ``Delta``'s entries above ``tol`` as ``(rows, cols, vals)`` (stopping once it
-    has more than ``limit``: the caller refactors), ``B`` as CSC arrays (n0 x nc), ``C``
+    Returns ``Delta``'s entries above ``tol`` as ``(rows, cols, vals)`` (stopping once they
+    touch more than ``limit`` rows: the caller refactors), ``B`` as CSC arrays (n0 x nc), ``C``
     as CSR arrays (nc x n0), both with sorted indices and no duplicates, and ``D`` (nc x nc).
     One pass over ``A`` and ``A_R``, no sorting but of a column's few rows.
     """
@@ -118,10 +118,14 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
     c_fill = c_count[:-1].copy()
     c_col = np.empty(c_count[nc], np.int64)
     c_val = np.empty(c_count[nc])
-    dr = np.empty(limit + n0 + 1, np.int64)
-    dc = np.empty(limit + n0 + 1, np.int64)
-    dv = np.empty(limit + n0 + 1)
+    # Delta's entries: at most n0 in a column, and the columns before the one where the dirty
+    # rows pass limit have at most limit rows each
+    dr = np.empty((limit + 1) * (limit + 1) + n0, np.int64)
+    dc = np.empty(dr.shape[0], np.int64)
+    dv = np.empty(dr.shape[0])
     nd = 0
+    dirty = np.zeros(n0, np.bool_)
+    n_dirty = 0
     for a in range(n0):
         nt = 0
         for g in range(start[a], start[a + 1]):
@@ -154,9 +158,13 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
             if abs(work[ri]) > tol:
                 dr[nd], dc[nd], dv[nd] = ri, a, work[ri]
                 nd += 1
+                for q in (ri, a):
+                    if not dirty[q]:
+                        dirty[q] = True
+                        n_dirty += 1
             work[ri] = 0.0
             seen[ri] = False
-        if nd > limit:
+        if n_dirty > limit:
             break
     # B's columns: each copy's column of A, rows summed by reference vertex
     b_ptr = np.zeros(nc + 1, np.int64)
@@ -353,7 +361,7 @@ class UpdatedFactor:
             return False
         dr, dc, dv, b_ptr, b_ind, b_val, c_ptr, c_ind, c_val, d = _blocks(
             a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, ref, copies, n0,
-            self._a.indptr.astype(np.int64), self._a.indices.astype(np.int64), self._a.data, self._tol, 2 * most * most)
+            self._a.indptr.astype(np.int64), self._a.indices.astype(np.int64), self._a.data, self._tol, most - nc)
         r = np.union1d(dr, dc)
         ko = len(r)
         k = ko + nc
