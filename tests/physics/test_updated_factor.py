@@ -93,6 +93,20 @@ def test_a_large_change_is_declined_and_the_old_solve_kept():
     before = f.solve(b)
     assert not f.update(spring_matrix(n, springs, np.full(len(springs), 20.0), np.ones(n)), np.arange(n))
     assert np.array_equal(f.solve(b), before)  # nothing changed
+    # split vertices and too many changed entries: declined too (it stops reading early)
+    springs2 = springs.copy()
+    springs2[springs2 == 5] = n
+    springs2[springs2 == 7] = n + 1
+    mass2 = np.concatenate([np.ones(n), [1.0, 1.0]])
+    big = spring_matrix(n + 2, springs2, np.full(len(springs2), 30.0), mass2)
+    ref = np.concatenate([np.arange(n), [5, 7]])
+    assert not f.update(big, ref)
+    f.max_share = 1.0
+    f.max_rank = 4
+    assert not f.update(big, ref)
+    f.refactor(big)
+    x = f.solve(np.ones((n + 2, 2)))
+    assert np.allclose(big @ x, 1.0)
     with pytest.raises(ValueError, match="every row of the reference"):
         f.update(a[:n - 1, :n - 1].tocsc(), np.arange(n - 1))
 

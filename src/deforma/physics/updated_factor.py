@@ -164,8 +164,9 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
                         n_dirty += 1
             work[ri] = 0.0
             seen[ri] = False
-        if n_dirty > limit:
-            break
+        if n_dirty > limit:  # the caller declines: B and C are not needed (and C is not complete)
+            return dr[:nd], dc[:nd], dv[:nd], np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0), \
+                np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 0))
     # B's columns: each copy's column of A, rows summed by reference vertex
     b_ptr = np.zeros(nc + 1, np.int64)
     for c in range(nc):
