@@ -10,10 +10,10 @@ with ``--quick``) of corotated elements at 1/600 s, under each integrator:
   vertices moved by the script), pulled apart until it tears across (implicit Euler; XPBD
   at one substep is too soft for such a clamp: the strain piles up next to the moving one,
   which tears a wedge off, rather than across the sheet); the median step that tears (the
-  cut, the split vertices, the rebuilt model and the new factorisation) against the median
-  step that does not (the goal: at most 2x); and the same under symplectic Euler at the
-  substeps its stable step needs (no factorisation: the tear's own bookkeeping against
-  a step of many substeps).
+  cut, the split vertices, the rebuilt model and matrix, and the factor's low-rank
+  correction) against the median step that does not (the goal: at most 2x); and the same
+  under symplectic Euler at the substeps its stable step needs (no factor: the tear's own
+  bookkeeping against a step of many substeps).
 """
 
 from __future__ import annotations
