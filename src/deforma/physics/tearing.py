@@ -17,6 +17,10 @@ between its copies in proportion to the area of their fans, so mass and momentum
 exactly. Every triangle is kept (none is deleted or created): the torn mesh is a valid mesh
 (every edge in one or two triangles) with the texture on both sides.
 
+No cut leaves a chip: a cut that would leave fewer than ``MIN_PIECE`` triangles joined on
+one side (while the other has at least as many) waits, and the triangles stay on as a flap
+(:func:`_chip`).
+
 One crack runs at a time in a body: while a crack's tip advanced in the last step, only the
 tips advance, and a new crack starts (at the most stretched outline edge) only once every
 tip has stopped. A real crack relieves the material beside it faster than the solver can
@@ -318,7 +322,7 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None, tips=()):
     >>> t = tear_mesh(topo, x, 0.5)
     >>> t.cut.tolist(), t.source.tolist(), t.tips.tolist()  # the cell's diagonal 1-5 cut: both ends split
     ([[1, 5]], [0, 1, 2, 3, 4, 5, 1, 5], [])
-    >>> pieces(8, [], t.triangles).tolist()  # triangle (1, 2, 5) came off
+    >>> pieces(8, [], t.triangles).tolist()  # triangle (1, 2, 5) came off (the rest is no larger a piece)
     [0, 0, 1, 0, 0, 1, 1, 0]
     """
     t = topo.triangles
@@ -337,7 +341,8 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None, tips=()):
     is_tip = np.zeros(n, np.bool_)
     tips = np.asarray(tips, dtype=np.int64)
     is_tip[tips[(tips >= 0) & (tips < n)]] = True
-    cut = _choose_cuts(inner[over[np.argsort(-strain[over], kind="stable")]], topo.pairs, topo.boundary, is_tip, n)
+    cut = _choose_cuts(inner[over[np.argsort(-strain[over], kind="stable")]], topo.pairs, topo.boundary, is_tip, n,
+                       topo.tri_pair, topo.tri_edge)
     if not len(cut):
         return None
     ends = topo.pairs[cut].ravel()
@@ -352,17 +357,21 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None, tips=()):
 
 
 @njit(cache=True)
-def _choose_cuts(candidates, pairs, boundary, is_tip, n):
+def _choose_cuts(candidates, pairs, boundary, is_tip, n, tri_pair, tri_edge):
     """Edges to cut, from ``candidates`` (strongest first): each touching the outline, no
-    vertex in two cuts this step; while any vertex ``is_tip``, only edges at a tip (the
-    running cracks advance), else the strongest one (a new crack starts)."""
+    vertex in two cuts this step, none that would cut off a chip (:func:`_chip`); while any
+    vertex ``is_tip``, only edges at a tip (the running cracks advance), else the strongest
+    one (a new crack starts)."""
     running = is_tip.any()
     used = np.zeros(n, np.bool_)
     out = np.empty(len(candidates), np.int64)
+    seen = np.full(tri_edge.shape[0], -1, np.int64)
     c = 0
     for e in candidates:
         a, b = pairs[e, 0], pairs[e, 1]
         if used[a] or used[b] or not (boundary[a] or boundary[b]):
+            continue
+        if _chip(e, tri_pair, tri_edge, seen):
             continue
         if running and not (is_tip[a] or is_tip[b]):
             continue
@@ -373,6 +382,49 @@ def _choose_cuts(candidates, pairs, boundary, is_tip, n):
         out[c] = e
         c += 1
     return out[:c]
+
+
+#: A cut never leaves a piece of fewer triangles than this on one side while the other side
+#: has at least as many: see :func:`_chip`.
+MIN_PIECE = 4
+
+
+@njit(cache=True)
+def _chip(e, tri_pair, tri_edge, seen):
+    """Whether cutting interior edge ``e`` would cut off a chip: fewer than ``MIN_PIECE``
+    triangles joined to one side across uncut edges, and at least that many on the other.
+
+    A crack running along the outline or next to a clamp cut one or two triangles loose at a
+    time, which flew about as confetti (15 single triangles off the clamped 1e4-vertex sheet
+    of ``benchmarks/bench_behaviours.py`` under symplectic Euler). Such a triangle now stays,
+    a flap on its last edges, as a torn cloth's frayed edge does. Both sides are searched
+    no further than ``MIN_PIECE`` triangles; ``seen`` (M,) is scratch marks, -1 at first
+    and left with this call's own (``2 e`` and ``2 e + 1``: distinct for every edge).
+    """
+    size = np.zeros(2, np.int64)
+    stack = np.empty(MIN_PIECE, np.int64)
+    for side in range(2):
+        stamp = 2 * e + side  # marks of other calls and of the other side read as unseen
+        f0 = tri_pair[e, side]
+        seen[f0] = stamp
+        stack[0] = f0
+        top, count = 1, 1
+        while top > 0 and count < MIN_PIECE:
+            top -= 1
+            f = stack[top]
+            for k in range(3):
+                g = tri_edge[f, k]
+                if g == e or tri_pair[g, 1] < 0:
+                    continue
+                h = tri_pair[g, 0] if tri_pair[g, 1] == f else tri_pair[g, 1]
+                if seen[h] != stamp and count < MIN_PIECE:
+                    seen[h] = stamp
+                    stack[top] = h
+                    top += 1
+                    count += 1
+        size[side] = count
+    small, large = min(size[0], size[1]), max(size[0], size[1])
+    return small < MIN_PIECE and large >= MIN_PIECE
 
 
 @njit(cache=True)
