@@ -160,3 +160,35 @@ def test_a_copy_of_a_world_with_an_updated_factor_steps_as_the_original():
     pull(w, body, right, 20, start=120)
     pull(twin, twin.bodies[0], right, 20, start=120)
     np.testing.assert_array_equal(body.positions, twin.bodies[0].positions)
+
+
+def test_a_tear_in_the_first_of_two_bodies_keeps_the_second_bodys_rows():
+    # the copies are appended to the torn body, so every vertex of the bodies after it moves
+    # down in the world's numbering: the map to the reference rows must follow
+    def world(max_rank):
+        mat = deforma.Material("corotated", youngs_modulus=2e4, poisson_ratio=0.3, density=2.0, tear_strain=0.2)
+        w = deforma.World(gravity=(0.0, -9.8), integrator="implicit-euler", material=mat, dt=1 / 600)
+        sheet = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=20, edges=True), position=None)
+        hanging = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.5), (0, 0.5)), detail=6), position=(1.0, 3.0),
+                             material=deforma.Material("neo-hookean", youngs_modulus=5e3, poisson_ratio=0.3,
+                                                       density=1.0))
+        x = sheet.positions
+        right = np.flatnonzero(x[:, 0] > 2.0 - 1e-9)
+        sheet.pin(np.concatenate([np.flatnonzero(x[:, 0] < 1e-9), right]))
+        hanging.pin([0, 1])  # it swings under gravity: its rows carry a motion of their own
+        w.step()
+        w._integrator._factor.max_rank = max_rank
+        return w, sheet, hanging, right
+
+    w, sheet, hanging, right = world(64)
+    again, sheet2, hanging2, _ = world(0)
+    n0 = sheet.n_vertices
+    for k in range(120):
+        pull(w, sheet, right, 1, start=k)
+        pull(again, sheet2, right, 1, start=k)
+        if len(w.contacts.vertex) or len(again.contacts.vertex):
+            break
+        assert np.abs(hanging.positions - hanging2.positions).max() < 1e-10
+        assert np.abs(sheet.positions - sheet2.positions).max() < 1e-10
+    assert sheet.n_vertices >= n0 + 10 and w._integrator.updates >= 10  # it tore, and the factor was corrected
+    assert w._integrator.factorizations == 1
