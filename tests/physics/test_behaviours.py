@@ -297,22 +297,32 @@ def test_below_tear_strain_nothing_tears():
     assert body.n_vertices == n0 and body.pieces.max() == 0
 
 
+def clamped_sheet(integrator, detail, steps):
+    """benchmarks/bench_behaviours.py's sheet (2 m x 1 m, clamped at both sides) with
+    ``tear_strain`` 0.2, the right clamp pulled away faster and faster for ``steps`` steps
+    (symplectic Euler at the substeps its stable step needs); ``(world, body, left, right)``."""
+    mat = deforma.Material("corotated", youngs_modulus=2e4, poisson_ratio=0.3, density=2.0, tear_strain=0.2)
+    w = deforma.World(gravity=(0.0, 0.0), integrator=integrator, material=mat)
+    body = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=detail, edges=True), position=None)
+    x = body.positions
+    left, right = np.flatnonzero(x[:, 0] < 1e-9), np.flatnonzero(x[:, 0] > 2.0 - 1e-9)
+    body.pin(np.concatenate([left, right]))
+    if integrator == "symplectic-euler":
+        w.substeps = int(np.ceil(w.dt / (0.9 * w.stable_dt())))
+    for k in range(steps):
+        x = body.positions
+        x[right, 0] += 0.5 / 600 * (1 + k / 100)
+        body.positions = x
+        w.step()
+    return w, body, left, right
+
+
 def test_a_sheet_pulled_apart_by_two_clamps_tears_across_once_instead_of_shattering():
     # benchmarks/bench_behaviours.py's sheet (2 m x 1 m, 2500 vertices, clamped at both sides, the
     # right clamp pulled away faster and faster). Evenly stretched past tear_strain, every outline
     # vertex used to start a crack in the same step: 7 pieces here, 2172 at 1e4 vertices. One
     # crack runs at a time: it tears across once, next to a clamp, where the strain is highest.
-    mat = deforma.Material("corotated", youngs_modulus=2e4, poisson_ratio=0.3, density=2.0, tear_strain=0.2)
-    w = deforma.World(gravity=(0.0, 0.0), integrator="implicit-euler", material=mat)
-    body = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=48, edges=True), position=None)
-    x = body.positions
-    left, right = np.flatnonzero(x[:, 0] < 1e-9), np.flatnonzero(x[:, 0] > 2.0 - 1e-9)
-    body.pin(np.concatenate([left, right]))
-    for k in range(300):
-        x = body.positions
-        x[right, 0] += 0.5 / 600 * (1 + k / 100)
-        body.positions = x
-        w.step()
+    w, body, left, right = clamped_sheet("implicit-euler", 48, 300)
     sizes = np.bincount(body.pieces[body.triangles[:, 0]])
     assert len(sizes) == 2 and sizes.min() >= 2 * 48  # the sheet, and the strip along one clamp
     assert body.pieces[left].max() != body.pieces[right].min()  # apart: the clamps hold different pieces
@@ -325,18 +335,7 @@ def test_a_crack_along_a_clamp_cuts_off_no_loose_chips():
     # which flew off. A cut that would leave fewer than MIN_PIECE triangles on one side holds.
     from deforma.physics.tearing import MIN_PIECE
 
-    mat = deforma.Material("corotated", youngs_modulus=2e4, poisson_ratio=0.3, density=2.0, tear_strain=0.2)
-    w = deforma.World(gravity=(0.0, 0.0), integrator="symplectic-euler", material=mat)
-    body = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=30, edges=True), position=None)
-    x = body.positions
-    left, right = np.flatnonzero(x[:, 0] < 1e-9), np.flatnonzero(x[:, 0] > 2.0 - 1e-9)
-    body.pin(np.concatenate([left, right]))
-    w.substeps = int(np.ceil(w.dt / (0.9 * w.stable_dt())))
-    for k in range(400):
-        x = body.positions
-        x[right, 0] += 0.5 / 600 * (1 + k / 100)
-        body.positions = x
-        w.step()
+    w, body, _, _ = clamped_sheet("symplectic-euler", 30, 400)
     pieces = body.pieces
     assert pieces.max() >= 2  # it tore
     triangles = np.bincount(pieces[body.triangles[:, 0]])

@@ -79,6 +79,7 @@ from .colliders import advance_colliders, contact_planes, finish_position_step, 
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, hold_start_distance
 from .elements import implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
+from .model import accumulate, sort_few
 from .updated_factor import UpdatedFactor
 
 if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
@@ -369,37 +370,19 @@ def _assemble(diag, si, sj, sw, tris, b, ew, pinned):
     val = np.empty(n + 2 * ns + 6 * nt)
     out = 0
     for j in range(n):
-        m = 1
-        rows[0] = j
-        seen[j] = True
-        work[j] = diag[j]
+        m = accumulate(work, seen, rows, 0, j, diag[j])
         for p in range(start[j], start[j + 1]):
             k = inc[p]
             if k >= 0:
                 o = sj[k] if si[k] == j else si[k]
                 work[j] += sw[k]
-                if not seen[o]:
-                    seen[o] = True
-                    rows[m] = o
-                    m += 1
-                work[o] -= sw[k]
+                m = accumulate(work, seen, rows, m, o, -sw[k])
             else:
                 e, c = (-1 - k) // 3, (-1 - k) % 3
                 for v in range(3):
-                    o = tris[e, v]
-                    if not seen[o]:
-                        seen[o] = True
-                        rows[m] = o
-                        m += 1
-                    work[o] += ke[e, v, c]
+                    m = accumulate(work, seen, rows, m, tris[e, v], ke[e, v, c])
         diag[j] = work[j]
-        for a in range(1, m):  # insertion sort: a column holds a vertex's few neighbours
-            r = rows[a]
-            q = a - 1
-            while q >= 0 and rows[q] > r:
-                rows[q + 1] = rows[q]
-                q -= 1
-            rows[q + 1] = r
+        sort_few(rows, m)  # a column holds a vertex's few neighbours
         for a in range(m):
             r = rows[a]
             v = work[r]

@@ -76,6 +76,30 @@ def counting_order(keys, bound):
     return order
 
 
+@njit(cache=True, inline="always")
+def sort_few(keys, count):
+    """Sort ``keys[:count]`` in place: an insertion sort, for the few rows of one column."""
+    for a in range(1, count):
+        r = keys[a]
+        q = a - 1
+        while q >= 0 and keys[q] > r:
+            keys[q + 1] = keys[q]
+            q -= 1
+        keys[q + 1] = r
+
+
+@njit(cache=True, inline="always")
+def accumulate(work, seen, touched, count, row, value):
+    """``work[row] += value``, listing ``row`` in ``touched`` the first time (``seen``):
+    a dense work column with the list of its rows; returns the new ``count``."""
+    if not seen[row]:
+        seen[row] = True
+        touched[count] = row
+        count += 1
+    work[row] += value
+    return count
+
+
 @dataclass(frozen=True, eq=False)
 class BodyTopology:
     """The constant shape of one body, in body-local vertex indices.

@@ -44,6 +44,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
+from .model import accumulate, sort_few
+
 if TYPE_CHECKING:
     import scipy.sparse as sp
 
@@ -133,12 +135,7 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
             cj = copy[j]
             for p in range(ptr[j], ptr[j + 1]):
                 i = ind[p]
-                ri = ref[i]
-                if not seen[ri]:
-                    seen[ri] = True
-                    touched[nt] = ri
-                    nt += 1
-                work[ri] += val[p]
+                nt = accumulate(work, seen, touched, nt, ref[i], val[p])
                 ci = copy[i]
                 if ci >= 0:
                     c_col[c_fill[ci]] = a
@@ -147,12 +144,7 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
                     if cj >= 0:
                         d[ci, cj] += val[p]
         for p in range(rptr[a], rptr[a + 1]):
-            ri = rind[p]
-            if not seen[ri]:
-                seen[ri] = True
-                touched[nt] = ri
-                nt += 1
-            work[ri] -= rval[p]
+            nt = accumulate(work, seen, touched, nt, rind[p], -rval[p])
         for t in range(nt):
             ri = touched[t]
             if abs(work[ri]) > tol:
@@ -178,12 +170,7 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
         j = copies[c]
         nt = 0
         for p in range(ptr[j], ptr[j + 1]):
-            ri = ref[ind[p]]
-            if not seen[ri]:
-                seen[ri] = True
-                touched[nt] = ri
-                nt += 1
-            work[ri] += val[p]
+            nt = accumulate(work, seen, touched, nt, ref[ind[p]], val[p])
         out = _emit_sorted(touched, nt, work, seen, b_ind, b_val, out)
         b_ptr[c + 1] = out
     # C's rows, canonical the same way
@@ -192,12 +179,7 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
     for c in range(nc):
         nt = 0
         for p in range(c_count[c], c_count[c + 1]):
-            a = c_col[p]
-            if not seen[a]:
-                seen[a] = True
-                touched[nt] = a
-                nt += 1
-            work[a] += c_val[p]
+            nt = accumulate(work, seen, touched, nt, c_col[p], c_val[p])
         out = _emit_sorted(touched, nt, work, seen, c_col, c_val, out)  # in place: out <= p
         cc_ptr[c + 1] = out
     return dr[:nd], dc[:nd], dv[:nd], b_ptr, b_ind[:b_ptr[nc]], b_val[:b_ptr[nc]], cc_ptr, c_col[:out], \
@@ -208,13 +190,7 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
 def _emit_sorted(touched, nt, work, seen, ind, val, out):
     """Write the ``nt`` touched rows of ``work`` (sorted, an insertion sort: a column's few
     rows) to ``ind, val`` from ``out``, clearing them; returns the new end."""
-    for a in range(1, nt):
-        r = touched[a]
-        q = a - 1
-        while q >= 0 and touched[q] > r:
-            touched[q + 1] = touched[q]
-            q -= 1
-        touched[q + 1] = r
+    sort_few(touched, nt)
     for a in range(nt):
         r = touched[a]
         ind[out] = r
