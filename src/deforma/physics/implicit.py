@@ -556,7 +556,8 @@ class ImplicitEuler:
             self._ref = None
         elif model is not old[0]:
             torn = model.torn_from
-            self._ref = self._ref[torn[1]] if torn is not None and torn[0] == old[0].serial else None
+            ok = torn is not None and torn[0] == old[0].serial and len(torn[1]) == model.n_vertices
+            self._ref = self._ref[torn[1]] if ok else None
         # Air drag -c v joins backward Euler as (1 + h c) M (x - y) / h^2 = f(x) + M g with
         # y = x_n + (h v_n + h^2 g) / (1 + h c): the heavier mass is in the matrix, so that
         # forces (not only gravity) balance at rest as they do without drag.

@@ -14,7 +14,7 @@ pascals (Lamé parameters), seconds (element damping).
 
 from __future__ import annotations
 
-import itertools
+import uuid
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,8 +22,6 @@ from numba import njit
 
 from .elements import rest_geometry
 from .contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology, clear_against, rest_clearance
-
-_SERIALS = itertools.count()  # Model.serial
 
 
 def lengths(x, i, j) -> np.ndarray:
@@ -387,8 +385,8 @@ class Model:
         ``set_*`` methods, plasticity): a solver that keeps something built from the
         Model (a factored matrix) compares it instead of the arrays.
     serial : int
-        A number no other Model built in this process has (a copy made by ``copy.deepcopy``
-        keeps it).
+        A number no other Model has (a random 128-bit identifier; a copy made by
+        ``copy.deepcopy`` or a pickle keeps it).
     torn_from : (int, (N,) int64) or None
         Set by the world when a tear rebuilt this Model from another: that Model's
         ``serial``, and for each vertex the vertex of that Model it comes from (a copy or
@@ -418,7 +416,7 @@ class Model:
                  pressure=None):
         self.topologies = list(topologies)
         self.version = 0
-        self.serial = next(_SERIALS)
+        self.serial = uuid.uuid4().int  # unique across processes too (a pickled world's Models)
         self.torn_from = None
         self._attachments = {}  # body -> its long-range attachments, until the pins change
         nb = len(self.topologies)
