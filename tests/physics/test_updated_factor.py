@@ -85,6 +85,35 @@ def test_a_split_alone_adds_only_the_copies_columns():
     assert f.rank == 1 and f.solves == 1
 
 
+def split(n, springs, v, moved_count=3):
+    """``springs`` with vertex ``v``'s first ``moved_count`` springs moved to a copy ``n``,
+    the masses (v keeps 0.6) and the map to the reference rows."""
+    moved = np.flatnonzero((springs == v).any(axis=1))[:moved_count]
+    springs = springs.copy()
+    springs[moved] = np.where(springs[moved] == v, n, springs[moved])
+    mass = np.ones(n + 1)
+    mass[v], mass[n] = 0.6, 0.4
+    return springs, mass, np.append(np.arange(n), v)
+
+
+def test_a_declined_update_leaves_the_correction_in_use_as_it_was(monkeypatch):
+    import deforma.physics.updated_factor as updated
+
+    n, springs = grid(10)
+    w = np.full(len(springs), 10.0)
+    f = UpdatedFactor(spring_matrix(n, springs, w, np.ones(n)))
+    f.max_share = 1.0
+    s1, m1, ref1 = split(n, springs, 55)
+    a1 = spring_matrix(n + 1, s1, w, m1)
+    assert f.update(a1, ref1)
+    b = np.ones((n + 1, 2))
+    before = f.solve(b)
+    monkeypatch.setattr(updated, "MAX_CONDITION", 0.0)  # every correction now ill-conditioned
+    s2, m2, ref2 = split(n, springs, 33)
+    assert not f.update(spring_matrix(n + 1, s2, w, m2), ref2)  # its columns were solved, then declined
+    assert np.array_equal(f.solve(b), before)
+
+
 def test_a_large_change_is_declined_and_the_old_solve_kept():
     n, springs = grid(10)
     a = spring_matrix(n, springs, np.full(len(springs), 10.0), np.ones(n))

@@ -51,10 +51,10 @@ if TYPE_CHECKING:
 
 __all__ = ["UpdatedFactor", "factor"]
 
-#: Columns of ``[Z V]`` past which :meth:`UpdatedFactor.update` declines. One product with
-#: 64 columns costs about 0.3 ms on a 1e4-vertex sheet, one refactor 15 ms, one column about
-#: 0.35 ms (measured on 2 cores): with a crack adding a column or two per step this keeps
-#: the amortised cost near its minimum (about 1 ms a step).
+#: Columns of ``[Z V]`` past which :meth:`UpdatedFactor.update` declines. On a 1e4-vertex
+#: sheet (2 cores) the product with 64 columns costs about 0.3 ms per solve, a solved column
+#: about 0.35 ms and a factorisation 15 ms: 64 columns cost a factorisation's time or more
+#: to solve, and the product about a third of the solve it corrects.
 MAX_RANK = 64
 
 #: :meth:`UpdatedFactor.update` also declines past this share of the matrix's rows in
@@ -406,9 +406,11 @@ class UpdatedFactor:
             self.solves += len(missing)
             solved = self._lu.solve(rhs)
             used = set(self._slot[key] for key in keys if key in self._slot)
+            if self._ref is not None:  # the correction in use keeps its columns until replaced
+                used.update(int(t) for t in self._slots)
             free = [t for t in range(self._store.shape[1]) if t not in used]
-            if len(free) < len(missing):  # grow the store (to max_rank + 16 columns: older ones are dropped)
-                cap = max(len(used) + len(missing), min(2 * self._store.shape[1], self.max_rank + 16))
+            if len(free) < len(missing):  # grow the store (to 2 max_rank + 16 columns: older ones are dropped)
+                cap = max(len(used) + len(missing), min(2 * self._store.shape[1], 2 * self.max_rank + 16))
                 grown = np.empty((self._n0, cap), order="F")
                 grown[:, :self._store.shape[1]] = self._store
                 free += list(range(self._store.shape[1], cap))
