@@ -371,12 +371,12 @@ def _choose_cuts(candidates, pairs, boundary, is_tip, n, tri_pair, tri_edge):
         a, b = pairs[e, 0], pairs[e, 1]
         if used[a] or used[b] or not (boundary[a] or boundary[b]):
             continue
-        if _chip(e, tri_pair, tri_edge, seen):
-            continue
         if running and not (is_tip[a] or is_tip[b]):
             continue
         if not running and c == 1:
             break
+        if _chip(e, tri_pair, tri_edge, seen):  # last: the search for the only edges that could be cut
+            continue
         used[a] = True
         used[b] = True
         out[c] = e

@@ -309,6 +309,8 @@ class UpdatedFactor:
 
     def _reference(self, a):
         self._a = a
+        # its CSC arrays as the blocks pass reads them, made once rather than at every update
+        self._a64 = (a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data)
         self._lu = factor(a)
         self._n0 = a.shape[0]
         self._tol = ROUNDING * float(np.abs(a.diagonal()).max(initial=0.0))
@@ -344,7 +346,7 @@ class UpdatedFactor:
             return False
         dr, dc, dv, b_ptr, b_ind, b_val, c_ptr, c_ind, c_val, d = _blocks(
             a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, ref, copies, n0,
-            self._a.indptr.astype(np.int64), self._a.indices.astype(np.int64), self._a.data, self._tol, most - nc)
+            *self._a64, self._tol, most - nc)
         r = np.union1d(dr, dc)
         ko = len(r)
         k = ko + nc
