@@ -79,7 +79,7 @@ from .colliders import advance_colliders, contact_planes, finish_position_step, 
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, hold_start_distance
 from .elements import implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
-from .model import accumulate, sort_few
+from .model import sort_few
 from .updated_factor import UpdatedFactor
 
 if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
@@ -370,17 +370,32 @@ def _assemble(diag, si, sj, sw, tris, b, ew, pinned):
     val = np.empty(n + 2 * ns + 6 * nt)
     out = 0
     for j in range(n):
-        m = accumulate(work, seen, rows, 0, j, diag[j])
+        # the work column, written out here rather than through a helper: a compiled helper
+        # that writes arrays costs reference counting at every call (2.5 against 0.27 ms
+        # for the 1.8e5 entries of a 1e4-vertex sheet)
+        rows[0] = j
+        seen[j] = True
+        work[j] = diag[j]
+        m = 1
         for p in range(start[j], start[j + 1]):
             k = inc[p]
             if k >= 0:
                 o = sj[k] if si[k] == j else si[k]
                 work[j] += sw[k]
-                m = accumulate(work, seen, rows, m, o, -sw[k])
+                if not seen[o]:
+                    seen[o] = True
+                    rows[m] = o
+                    m += 1
+                work[o] -= sw[k]
             else:
                 e, c = (-1 - k) // 3, (-1 - k) % 3
                 for v in range(3):
-                    m = accumulate(work, seen, rows, m, tris[e, v], ke[e, v, c])
+                    r = tris[e, v]
+                    if not seen[r]:
+                        seen[r] = True
+                        rows[m] = r
+                        m += 1
+                    work[r] += ke[e, v, c]
         diag[j] = work[j]
         sort_few(rows, m)  # a column holds a vertex's few neighbours
         for a in range(m):

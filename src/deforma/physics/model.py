@@ -86,18 +86,6 @@ def sort_few(keys, count):
         keys[q + 1] = r
 
 
-@njit(cache=True, inline="always")
-def accumulate(work, seen, touched, count, row, value):
-    """``work[row] += value``, listing ``row`` in ``touched`` the first time (``seen``):
-    a dense work column with the list of its rows; returns the new ``count``."""
-    if not seen[row]:
-        seen[row] = True
-        touched[count] = row
-        count += 1
-    work[row] += value
-    return count
-
-
 @dataclass(frozen=True, eq=False)
 class BodyTopology:
     """The constant shape of one body, in body-local vertex indices.

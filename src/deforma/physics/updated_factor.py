@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from .model import accumulate, sort_few
+from .model import sort_few
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -135,7 +135,12 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
             cj = copy[j]
             for p in range(ptr[j], ptr[j + 1]):
                 i = ind[p]
-                nt = accumulate(work, seen, touched, nt, ref[i], val[p])
+                r = ref[i]
+                if not seen[r]:  # written out, not a helper: implicit._assemble says why
+                    seen[r] = True
+                    touched[nt] = r
+                    nt += 1
+                work[r] += val[p]
                 ci = copy[i]
                 if ci >= 0:
                     c_col[c_fill[ci]] = a
@@ -144,7 +149,12 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
                     if cj >= 0:
                         d[ci, cj] += val[p]
         for p in range(rptr[a], rptr[a + 1]):
-            nt = accumulate(work, seen, touched, nt, rind[p], -rval[p])
+            r = rind[p]
+            if not seen[r]:
+                seen[r] = True
+                touched[nt] = r
+                nt += 1
+            work[r] -= rval[p]
         for t in range(nt):
             ri = touched[t]
             if abs(work[ri]) > tol:
@@ -170,7 +180,12 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
         j = copies[c]
         nt = 0
         for p in range(ptr[j], ptr[j + 1]):
-            nt = accumulate(work, seen, touched, nt, ref[ind[p]], val[p])
+            r = ref[ind[p]]
+            if not seen[r]:
+                seen[r] = True
+                touched[nt] = r
+                nt += 1
+            work[r] += val[p]
         out = _emit_sorted(touched, nt, work, seen, b_ind, b_val, out)
         b_ptr[c + 1] = out
     # C's rows, canonical the same way
@@ -179,7 +194,12 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
     for c in range(nc):
         nt = 0
         for p in range(c_count[c], c_count[c + 1]):
-            nt = accumulate(work, seen, touched, nt, c_col[p], c_val[p])
+            r = c_col[p]
+            if not seen[r]:
+                seen[r] = True
+                touched[nt] = r
+                nt += 1
+            work[r] += c_val[p]
         out = _emit_sorted(touched, nt, work, seen, c_col, c_val, out)  # in place: out <= p
         cc_ptr[c + 1] = out
     return dr[:nd], dc[:nd], dv[:nd], b_ptr, b_ind[:b_ptr[nc]], b_val[:b_ptr[nc]], cc_ptr, c_col[:out], \
