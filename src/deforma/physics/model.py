@@ -182,16 +182,18 @@ class BodyTopology:
         return cls(x, np.ascontiguousarray(s), rest, t, edges, verts, clearance, mass_share)
 
     @classmethod
-    def _trusted(cls, x, springs, triangles, boundary_edges, *, mass_share=None, geometry=None) -> "BodyTopology":
+    def _trusted(cls, x, springs, triangles, boundary_edges, *, mass_share=None, geometry=None,
+                 spring_rest_length=None) -> "BodyTopology":
         """A topology from arrays known to be valid: what :meth:`from_arrays` would make of
         ``(x, springs, triangles)`` when ``springs`` are already unique ``(low, high)`` pairs
         sorted by ``low * N + high``, ``triangles`` counter-clockwise and ``boundary_edges``
         the edges in one triangle, directed and ordered as :func:`_boundary` finds them. A
         torn body (:mod:`deforma.physics.tearing`) has these from its tear and skips the
-        checks and sorts of :meth:`from_arrays`, most of the cost of a tear."""
+        checks and sorts of :meth:`from_arrays`, most of the cost of a tear;
+        ``spring_rest_length``, when given, the springs' lengths in ``x`` as measured here."""
         x = np.asarray(x, dtype=np.float64)
         s = np.ascontiguousarray(springs, dtype=np.int32)
-        rest = lengths(x, s[:, 0], s[:, 1])
+        rest = lengths(x, s[:, 0], s[:, 1]) if spring_rest_length is None else spring_rest_length
         t = np.array(triangles, dtype=np.int32)  # its own, as from_arrays makes it
         edges, verts, clearance = _outline(x, np.ascontiguousarray(boundary_edges, dtype=np.int32))
         return cls(x, s, rest, t, edges, verts, clearance, mass_share, geometry)
