@@ -76,6 +76,7 @@ class Body:
         self._pinned = np.zeros(topology.n_vertices, bool)
         self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
+        self._tear_fresh = np.zeros(0, np.int64)  # and the vertices whose springs, elements or mass it changed
         self._cracks = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
 
     def _tear_view(self):

@@ -289,7 +289,7 @@ def element_weights(model, h: float) -> np.ndarray:
     return model.elem_area * (h * h + h * model.elem_damping) * max_stiffness(model.elem_mu, model.elem_lambda)
 
 
-def system_matrix(model, grab_slot, grab_pull, h: float, mass=None):
+def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None):
     """The constant global matrix ``M + L_w + K_w + h^2 S_grab`` (N x N, kg), canonical CSC,
     each pinned row the identity's, and its diagonal before the pinning (N,).
 
@@ -299,6 +299,13 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None):
     ``M (1 + h air_drag)``). A pinned row's equation is ``x_p = b_p`` (the caller puts the
     pinned position in ``b_p``), while the free rows keep their coupling to it, so that it
     acts on them as a known position.
+
+    ``patch = (a, diag, source, fresh)``: ``model`` is a torn copy of the Model whose matrix
+    and diagonal are ``a`` and ``diag`` (same ``h``, mass factor and grabs), vertex ``i``
+    a copy of its vertex ``source[i]``, and only the ``fresh`` vertices (N,) bool have
+    springs, elements or a mass the tear changed (:attr:`Model.torn_from`). Their columns
+    are assembled; every other column is the old one, its rows renumbered: the same numbers,
+    as it sums the same terms in the same order.
 
     Examples
     --------
@@ -315,61 +322,83 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None):
     diag = (model.vertex_mass if mass is None else mass).copy()
     held = np.flatnonzero(grab_slot >= 0)
     diag[held] += h * h * grab_pull[grab_slot[held], 0]
+    if patch is None:
+        fresh, source, first = np.ones(n, np.bool_), np.zeros(0, np.int64), np.zeros(0, np.int64)
+        old = (np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+    else:
+        a, old_diag, source, fresh = patch
+        source = np.ascontiguousarray(source, dtype=np.int64)
+        first = np.empty(a.shape[0], np.int64)
+        first[source[::-1]] = np.arange(n - 1, -1, -1)  # an old vertex's lowest new index: itself, not a copy
+        old = (a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, old_diag)
     ptr, ind, val = _assemble(diag, model.spring_i, model.spring_j,
                               h * h * model.spring_stiffness + h * model.spring_damping,
-                              model.elem, model.elem_b, element_weights(model, h), model.pinned)
+                              model.elem, model.elem_b, element_weights(model, h), model.pinned,
+                              np.ascontiguousarray(fresh, dtype=np.bool_), source, first, *old)
     a = sp.csc_matrix((val, ind, ptr), shape=(n, n))
     a.has_sorted_indices = True
     return a, diag
 
 
 @njit(cache=True)
-def _assemble(diag, si, sj, sw, tris, b, ew, pinned):
+def _assemble(diag, si, sj, sw, tris, b, ew, pinned, fresh, source, first, optr, oind, oval, odiag):
     """CSC arrays of :func:`system_matrix` (``diag`` comes in as the masses and grabs and
-    leaves as the whole diagonal before pinning), column by column: each vertex's springs and
-    elements are summed into a dense work column, whose touched rows are then sorted. One
-    pass over the incidences; the coordinate-format build it replaced sorted 1.9e5 entries
-    (4-5 ms on a 1e4-vertex sheet, at every tear). Entries that sum to exactly zero off the
-    diagonal are dropped (a right triangle's two legs do not couple: a stored zero would
-    cost the factor fill)."""
+    leaves as the whole diagonal before pinning), column by column: each ``fresh`` vertex's
+    springs and elements are summed into a dense work column, whose touched rows are then
+    sorted; any other column is copied from the old matrix ``(optr, oind, oval)`` (diagonal
+    ``odiag``), column ``source[j]``, rows renumbered by ``first``. One pass over the
+    incidences; the coordinate-format build it replaced sorted 1.9e5 entries (4-5 ms on a
+    1e4-vertex sheet, at every tear). Entries that sum to exactly zero off the diagonal are
+    dropped (a right triangle's two legs do not couple: a stored zero would cost the factor
+    fill)."""
     n = diag.shape[0]
     ns, nt = si.shape[0], tris.shape[0]
-    start = np.zeros(n + 1, np.int64)  # per vertex: its springs (s) and element corners (-1 - 3 e - c)
+    start = np.zeros(n + 1, np.int64)  # per fresh vertex: its springs (s) and element corners (-1 - 3 e - c)
     for k in range(ns):
-        start[si[k] + 1] += 1
-        start[sj[k] + 1] += 1
+        if fresh[si[k]]:
+            start[si[k] + 1] += 1
+        if fresh[sj[k]]:
+            start[sj[k] + 1] += 1
     for e in range(nt):
         for c in range(3):
-            start[tris[e, c] + 1] += 1
+            if fresh[tris[e, c]]:
+                start[tris[e, c] + 1] += 1
     for v in range(n):
         start[v + 1] += start[v]
     fill = start[:-1].copy()
     inc = np.empty(start[n], np.int64)
     for k in range(ns):
-        inc[fill[si[k]]] = k
-        fill[si[k]] += 1
-        inc[fill[sj[k]]] = k
-        fill[sj[k]] += 1
+        if fresh[si[k]]:
+            inc[fill[si[k]]] = k
+            fill[si[k]] += 1
+        if fresh[sj[k]]:
+            inc[fill[sj[k]]] = k
+            fill[sj[k]] += 1
     for e in range(nt):
         for c in range(3):
-            inc[fill[tris[e, c]]] = -1 - 3 * e - c
-            fill[tris[e, c]] += 1
-    ke = np.empty((nt, 3, 3))  # w_e D_v . D_u
-    for e in range(nt):
-        d1x, d1y, d2x, d2y = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
-        dx = (-d1x - d2x, d1x, d2x)
-        dy = (-d1y - d2y, d1y, d2y)
-        for v in range(3):
-            for u in range(3):
-                ke[e, v, u] = ew[e] * (dx[v] * dx[u] + dy[v] * dy[u])
+            if fresh[tris[e, c]]:
+                inc[fill[tris[e, c]]] = -1 - 3 * e - c
+                fill[tris[e, c]] += 1
     work = np.zeros(n)
     seen = np.zeros(n, np.bool_)
     rows = np.empty(n, np.int64)
     ptr = np.zeros(n + 1, np.int64)
-    ind = np.empty(n + 2 * ns + 6 * nt, np.int64)
-    val = np.empty(n + 2 * ns + 6 * nt)
+    size = n + 2 * ns + 6 * nt
+    ind = np.empty(size, np.int64)
+    val = np.empty(size)
     out = 0
     for j in range(n):
+        if not fresh[j]:
+            o = source[j]
+            if out + optr[o + 1] - optr[o] > size:  # Numba does not check indices: refuse rather than write astray
+                raise ValueError("_assemble: a kept column has more entries than its vertex's incidences allow")
+            for p in range(optr[o], optr[o + 1]):
+                ind[out] = first[oind[p]]
+                val[out] = oval[p]
+                out += 1
+            diag[j] = odiag[o]
+            ptr[j + 1] = out
+            continue
         # the work column, written out here rather than through a helper: a compiled helper
         # that writes arrays costs reference counting at every call (2.5 against 0.27 ms
         # for the 1.8e5 entries of a 1e4-vertex sheet)
@@ -389,13 +418,18 @@ def _assemble(diag, si, sj, sw, tris, b, ew, pinned):
                 work[o] -= sw[k]
             else:
                 e, c = (-1 - k) // 3, (-1 - k) % 3
+                d1x, d1y, d2x, d2y = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+                dxc = -d1x - d2x if c == 0 else (d1x if c == 1 else d2x)
+                dyc = -d1y - d2y if c == 0 else (d1y if c == 1 else d2y)
                 for v in range(3):
                     r = tris[e, v]
                     if not seen[r]:
                         seen[r] = True
                         rows[m] = r
                         m += 1
-                    work[r] += ke[e, v, c]
+                    dxv = -d1x - d2x if v == 0 else (d1x if v == 1 else d2x)
+                    dyv = -d1y - d2y if v == 0 else (d1y if v == 1 else d2y)
+                    work[r] += ew[e] * (dxv * dxc + dyv * dyc)  # w_e D_v . D_c
         diag[j] = work[j]
         sort_few(rows, m)  # a column holds a vertex's few neighbours
         for a in range(m):
@@ -573,17 +607,25 @@ class ImplicitEuler:
         # The factor stays usable through a change of the matrix when each vertex's row in its
         # reference matrix is known: the same Model, or one a tear rebuilt from it (each vertex
         # then comes from a vertex of the old one). Anything else factors again.
+        torn = model.torn_from if old is not None and model is not old[0] else None
+        if torn is not None and not (torn[0] == old[0].serial and len(torn[1]) == model.n_vertices):
+            torn = None
         if old is None or self._ref is None:
             self._ref = None
         elif model is not old[0]:
-            torn = model.torn_from
-            ok = torn is not None and torn[0] == old[0].serial and len(torn[1]) == model.n_vertices
-            self._ref = self._ref[torn[1]] if ok else None
+            self._ref = self._ref[torn[1]] if torn is not None else None
         # Air drag -c v joins backward Euler as (1 + h c) M (x - y) / h^2 = f(x) + M g with
         # y = x_n + (h v_n + h^2 g) / (1 + h c): the heavier mass is in the matrix, so that
         # forces (not only gravity) balance at rest as they do without drag.
-        self._mass = model.vertex_mass * (1.0 + h * inputs.air_drag)
-        self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, self._mass)
+        mass = model.vertex_mass * (1.0 + h * inputs.air_drag)
+        patch = None
+        if torn is not None and self._patchable(old, model, torn, inputs, h):
+            # a tear: only the columns of the vertices it touched are assembled again
+            source = torn[1]
+            fresh = torn[2] | (mass != self._mass[source]) | (model.pinned != old[0].pinned[source])
+            patch = (self._a, self._diag, source, fresh)
+        self._mass = mass
+        self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, mass, patch)
         self._rows = self._a.tocsr()  # its rows, for free_estimate (not its columns: next to a pinned row they differ)
         self._key = key
         self._wk = h * h * model.spring_stiffness
@@ -591,6 +633,19 @@ class ImplicitEuler:
         self._we = element_weights(model, h)
         self._pinned = np.flatnonzero(model.pinned)
         self._touching = None  # the contact terms must be added again
+
+    @staticmethod
+    def _patchable(old, model, torn, inputs, h) -> bool:
+        """Whether the matrix of ``old``'s Model (the key it was built for) is that of the torn
+        ``model`` but for the vertices the tear touched: neither Model changed in place since
+        (a parameter, a plastic rest shape), the same ``h``, air drag and grabs."""
+        was = old[0]
+        if old[1] != was.version or torn[3] != model.version or old[2] != h or old[5] != inputs.air_drag:
+            return False
+        if not (np.array_equal(was.elem_b, was.elem_b0) and np.array_equal(was.elem_area, was.elem_area0)):
+            return False  # a plastic rest shape is in the old matrix; the new Model starts from the mesh's
+        source = torn[1]
+        return np.array_equal(old[3][source], inputs.grab_slot) and np.array_equal(old[4], inputs.grab_pull[:, 0])
 
     def _factor_if_needed(self, model, touching, triples, s):
         # The vertices in collider contact add their weight to the diagonal, the body

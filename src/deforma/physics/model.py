@@ -377,11 +377,14 @@ class Model:
     serial : int
         A number no other Model has (a random 128-bit identifier; a copy made by
         ``copy.deepcopy`` or a pickle keeps it).
-    torn_from : (int, (N,) int64) or None
+    torn_from : (int, (N,) int64, (N,) bool, int) or None
         Set by the world when a tear rebuilt this Model from another: that Model's
-        ``serial``, and for each vertex the vertex of that Model it comes from (a copy or
-        itself). A solver that keeps something built for the old Model (implicit Euler's
-        factor) carries it over instead of starting again.
+        ``serial``; for each vertex the vertex of that Model it comes from (a copy or
+        itself); the vertices whose springs or elements the tear changed (the corners of
+        the triangles it renumbered, the ends of the springs it snapped: every other vertex
+        has the same ones, in the same order); and this Model's ``version`` then. A solver
+        that keeps something built for the old Model (implicit Euler's factor and matrix)
+        carries it over instead of starting again.
     pressure_a, pressure_b : (P,) int32
         Directed outline edges (global vertex indices, gas on the left) of the bodies that
         hold a gas (:mod:`deforma.physics.pressure`); ``body_pressure_offsets`` (B + 1,) says

@@ -829,12 +829,15 @@ class World:
                 if not keep.all():
                     body.topology = BodyTopology.from_arrays(topo.rest_positions, topo.springs[keep],
                                                              mass_share=topo.mass_share)
+                    body._tear_fresh = np.unique(topo.springs[~keep])
                     torn = True
                 continue
             cut = _tearing.tear_mesh(body._tear_view(), x, limit, tips=body._crack_tips())
             if cut is None:
                 body._cracks = None  # every crack stopped: a new one may start
                 continue
+            changed = np.flatnonzero((cut.triangles != topo.triangles).any(axis=1))
+            body._tear_fresh = np.union1d(cut.triangles[changed], topo.triangles[changed])  # old and new corners
             body._apply_tear(cut)
             torn = True
         if torn:
@@ -842,9 +845,13 @@ class World:
             off = old.body_vertex_offsets
             source = np.concatenate([np.arange(off[i], off[i + 1])[b._tear_source] for i, b in enumerate(self._bodies)])
             self._rebuild(self._state.x[source], self._state.v[source])
-            self._model.torn_from = (old.serial, source)
-            for body in self._bodies:
+            new_off = self._model.body_vertex_offsets
+            fresh = np.zeros(self._model.n_vertices, bool)
+            for i, body in enumerate(self._bodies):
+                fresh[new_off[i] + body._tear_fresh] = True
                 body._tear_source = slice(None)
+                body._tear_fresh = np.zeros(0, np.int64)
+            self._model.torn_from = (old.serial, source, fresh, self._model.version)
 
     def _check_shape(self) -> None:
         """Refuse a state in which a body has lost its shape: a spring stretched
