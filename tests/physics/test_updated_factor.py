@@ -221,3 +221,38 @@ def test_a_tear_in_the_first_of_two_bodies_keeps_the_second_bodys_rows():
         assert np.abs(sheet.positions - sheet2.positions).max() < 1e-10
     assert sheet.n_vertices >= n0 + 10 and w._integrator.updates >= 10  # it tore, and the factor was corrected
     assert w._integrator.factorizations == 1
+
+
+def test_the_columns_implicit_euler_names_hold_every_change(monkeypatch):
+    # After a tear or a new contact set, implicit Euler names the reference columns that may
+    # have changed (those it assembled again, those of either contact set), and the update
+    # compares only those: on a tearing sheet whose pieces touch, and on the pile, every
+    # update finds exactly what a comparison of every column finds
+    from deforma import scene as scenes
+    from deforma.physics import updated_factor
+
+    full = updated_factor._blocks
+    named = [0]
+
+    def checked(*args):
+        out = full(*args)
+        n0 = args[5]
+        if len(args[-1]) < n0:
+            everything = full(*args[:-1], np.arange(n0))
+            stopped = len(out[3]) != len(args[4]) + 1  # past the limit: the update declines
+            assert stopped == (len(everything[3]) != len(args[4]) + 1)
+            if not stopped:
+                for a, b in zip(out, everything):
+                    np.testing.assert_array_equal(a, b)
+            named[0] += 1
+        return out
+
+    monkeypatch.setattr(updated_factor, "_blocks", checked)
+    w, body, right = tearing_sheet()
+    pull(w, body, right, 200)
+    assert body.pieces.max() >= 1 and named[0] > 20
+    before = named[0]
+    pile = scenes.load("pile").build()
+    for _ in range(60):
+        pile.step()
+    assert named[0] > before + 10

@@ -591,6 +591,7 @@ class ImplicitEuler:
         self._triples = None
         self._factor = None
         self._ref = None  # each vertex's row in the factor's reference matrix (None: unknown)
+        self._dirty = None  # the vertices whose contact-free columns may differ from the reference's (None: any)
         self._scratch_n = -1
 
     def _base_if_needed(self, model, inputs, h):
@@ -624,6 +625,8 @@ class ImplicitEuler:
             source = torn[1]
             fresh = torn[2] | (mass != self._mass[source]) | (model.pinned != old[0].pinned[source])
             patch = (self._a, self._diag, source, fresh)
+        # a patched column is the reference's where it was before; an assembled one may differ
+        self._dirty = self._dirty[patch[2]] | patch[3] if patch is not None and self._dirty is not None else None
         self._mass = mass
         self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, mass, patch)
         self._rows = self._a.tocsr()  # its rows, for free_estimate (not its columns: next to a pinned row they differ)
@@ -678,14 +681,23 @@ class ImplicitEuler:
             a = with_entries(a, rows, cols, vals, model.pinned)
         # A small change (a tear, a new contact set, a grab) is taken into the factor by a
         # low-rank correction; a large one, or one whose rows are unknown, factors again.
-        if self._ref is not None and self._factor.update(a, self._ref):
-            self.updates += 1
-            return
+        listed = np.concatenate([touching, triples.ravel()])
+        if self._ref is not None:
+            cols = None
+            if self._dirty is not None:  # what may differ: changed columns, and those of either's contacts
+                mask = self._dirty.copy()
+                mask[listed] = True
+                cols = np.union1d(self._ref[mask], self._ref_contacts)
+            if self._factor.update(a, self._ref, cols):
+                self.updates += 1
+                return
         if self._factor is None:
             self._factor = UpdatedFactor(a)
         else:
             self._factor.refactor(a)
         self._ref = np.arange(model.n_vertices)
+        self._dirty = np.zeros(model.n_vertices, bool)
+        self._ref_contacts = np.unique(listed)
         self.factorizations += 1
 
     def advance(self, model, state, inputs, h, substeps):

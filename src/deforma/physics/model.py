@@ -232,14 +232,10 @@ def element_geometry(topology: BodyTopology):
     if not len(t.triangles):
         raise ValueError("a finite-element material needs a mesh with triangles; this body has only springs "
                          "(use the 'springs' material)")
-    c = t.triangles
-    order = stable_order(np.minimum(np.minimum(c[:, 0], c[:, 1]), c[:, 2]), t.n_vertices)
-    tri = np.take(c, order, axis=0)  # take: 4x faster than fancy indexing of rows here
-    if t.geometry is not None:  # the same numbers rest_geometry gives, row by row
-        bmat, area = np.take(t.geometry[0], order, axis=0), np.take(t.geometry[1], order)
-    else:
-        bmat, area = rest_geometry(t.rest_positions, tri)
-    lumped = np.bincount(tri.ravel(), np.repeat(area / 3.0, 3), minlength=t.n_vertices)
+    # rest_geometry gives the same numbers row by row, in any order of the rows
+    bmat, area = t.geometry if t.geometry is not None else rest_geometry(t.rest_positions, t.triangles)
+    tri, bmat, area, lumped = _sorted_elements(t.triangles, np.ascontiguousarray(bmat), np.ascontiguousarray(area),
+                                               t.n_vertices)
     if not np.all(lumped > 0):
         k = int(np.flatnonzero(lumped <= 0)[0])
         raise ValueError(f"vertex {k} belongs to no triangle: a finite-element body gets its mass from "
@@ -257,6 +253,37 @@ def _boundary(x: np.ndarray, t: np.ndarray):
     lo, hi = directed.min(axis=1), directed.max(axis=1)
     _, inverse, counts = np.unique(lo * len(x) + hi, return_inverse=True, return_counts=True)
     return _outline(x, np.ascontiguousarray(directed[counts[inverse.ravel()] == 1], dtype=np.int32))
+
+
+@njit(cache=True)
+def _sorted_elements(c, b, area, n):
+    """Triangles ``c`` (M, 3) over ``n`` vertices, their ``b`` (M, 4) and ``area`` (M,) in
+    the order of their lowest vertex (stable), and each vertex's third of its triangles'
+    areas (summed in that order): one compiled pass each, where NumPy's gathers and
+    bincount took 0.7 ms for a 1e4-vertex sheet, at every tear."""
+    m = c.shape[0]
+    low = np.empty(m, np.int64)
+    for f in range(m):
+        for k in range(3):
+            if c[f, k] < 0 or c[f, k] >= n:  # Numba does not check indices: refuse rather than write astray
+                raise ValueError("element_geometry: a triangle's vertex outside [0, n)")
+        low[f] = min(c[f, 0], c[f, 1], c[f, 2])
+    order = counting_order(low, n)
+    tri = np.empty((m, 3), c.dtype)
+    bs = np.empty((m, 4))
+    ar = np.empty(m)
+    lumped = np.zeros(n)
+    for i in range(m):
+        f = order[i]
+        for k in range(3):
+            tri[i, k] = c[f, k]
+        for k in range(4):
+            bs[i, k] = b[f, k]
+        ar[i] = area[f]
+        third = area[f] / 3.0
+        for k in range(3):
+            lumped[c[f, k]] += third
+    return tri, bs, ar, lumped
 
 
 def _outline(x: np.ndarray, edges: np.ndarray):

@@ -79,15 +79,17 @@ def factor(a: "sp.csc_matrix"):
 
 
 @njit(cache=True)
-def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
+def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit, cols):
     """The blocks of ``T^T A T`` against ``A_R`` (see the module docstring).
 
     ``(ptr, ind, val)``: ``A`` (CSC, n x n); ``ref``: each row's reference row; ``copies``:
-    the rows that are copies, in order; ``(rptr, rind, rval)``: ``A_R`` (CSC, n0 x n0).
+    the rows that are copies, in order; ``(rptr, rind, rval)``: ``A_R`` (CSC, n0 x n0);
+    ``cols``: the reference columns to compare (sorted; every other column group is taken to
+    be its reference column: no copy in it or among its rows, no change).
     Returns ``Delta``'s entries above ``tol`` as ``(rows, cols, vals)`` (stopping once they
     touch more than ``limit`` rows: the caller refactors), ``B`` as CSC arrays (n0 x nc), ``C``
     as CSR arrays (nc x n0), both with sorted indices and no duplicates, and ``D`` (nc x nc).
-    One pass over ``A`` and ``A_R``, no sorting but of a column's few rows.
+    One pass over those columns of ``A`` and ``A_R``, no sorting but of a column's few rows.
     """
     n = ptr.shape[0] - 1
     nc = copies.shape[0]
@@ -112,9 +114,12 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
     # C's entries (row c = copy c's row of A, columns summed by reference vertex): those of
     # A's rows that are copies, bucketed by copy first
     c_count = np.zeros(nc + 1, np.int64)
-    for p in range(ptr[n]):
-        if copy[ind[p]] >= 0:
-            c_count[copy[ind[p]] + 1] += 1
+    for a in cols:
+        for g in range(start[a], start[a + 1]):
+            j = group[g]
+            for p in range(ptr[j], ptr[j + 1]):
+                if copy[ind[p]] >= 0:
+                    c_count[copy[ind[p]] + 1] += 1
     for c in range(nc):
         c_count[c + 1] += c_count[c]
     c_fill = c_count[:-1].copy()
@@ -128,7 +133,7 @@ def _blocks(ptr, ind, val, ref, copies, n0, rptr, rind, rval, tol, limit):
     nd = 0
     dirty = np.zeros(n0, np.bool_)
     n_dirty = 0
-    for a in range(n0):
+    for a in cols:
         nt = 0
         for g in range(start[a], start[a + 1]):
             j = group[g]
@@ -344,11 +349,15 @@ class UpdatedFactor:
         self.rank = 0
         self._ref = None  # the current matrix is A_R itself
 
-    def update(self, a: "sp.csc_matrix", ref: np.ndarray) -> bool:
+    def update(self, a: "sp.csc_matrix", ref: np.ndarray, cols=None) -> bool:
         """Solve with ``a`` from now on, where current vertex ``i`` comes from reference vertex
         ``ref[i]`` (every reference vertex at least once). Returns False, changing nothing,
         when the correction would be too large or ill-conditioned: factor ``a`` instead
-        (:meth:`refactor`)."""
+        (:meth:`refactor`).
+
+        ``cols``: when the caller knows them, the reference vertices whose columns may differ
+        (those of every changed entry, copy or copy's neighbour); only they are compared.
+        """
         import scipy.linalg as sla
 
         n, n0 = a.shape[0], self._n0
@@ -364,9 +373,14 @@ class UpdatedFactor:
         most = min(self.max_rank, int(self.max_share * n0))
         if nc > most:
             return False
+        if cols is not None:
+            cols = np.unique(np.asarray(cols, dtype=np.int64))
+            if len(cols) and (cols[0] < 0 or cols[-1] >= n0):
+                raise ValueError("cols must be rows of the reference")
         dr, dc, dv, b_ptr, b_ind, b_val, c_ptr, c_ind, c_val, d = _blocks(
             a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, ref, copies, n0,
-            *self._a64, self._tol, most - nc)
+            *self._a64, self._tol, most - nc,
+            np.arange(n0) if cols is None else np.ascontiguousarray(cols, dtype=np.int64))
         r = np.union1d(dr, dc)
         ko = len(r)
         k = ko + nc

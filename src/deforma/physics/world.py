@@ -836,7 +836,8 @@ class World:
             if cut is None:
                 body._cracks = None  # every crack stopped: a new one may start
                 continue
-            changed = np.flatnonzero((cut.triangles != topo.triangles).any(axis=1))
+            d = cut.triangles != topo.triangles
+            changed = np.flatnonzero(d[:, 0] | d[:, 1] | d[:, 2])
             body._tear_fresh = np.union1d(cut.triangles[changed], topo.triangles[changed])  # old and new corners
             body._apply_tear(cut)
             torn = True
