@@ -1,5 +1,7 @@
 """Material behaviours beyond elasticity: the stretch limit, plasticity, gas pressure, tearing."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -172,6 +174,67 @@ def test_plastic_springs_keep_a_dent():
     m = w._model
     assert (m.spring_rest_length / m.spring_rest_length0).max() > 1.1
     assert np.ptp(body.positions[:, 0]) > 1.1  # it stays longer
+
+
+@pytest.mark.parametrize("model", ["corotated", "springs"])
+def test_a_dent_survives_a_rebuilt_model(model):
+    # The rest shape plasticity moves lives in the Model's arrays, which a new body, a
+    # removed one or a new material rebuilds from the meshes: the dent must come along
+    if model == "springs":
+        mat = deforma.Material("springs", yield_strain=0.02, plastic_rate=1.0)
+        w = deforma.World(gravity=(0.0, 0.0), integrator="implicit-euler", material=mat, stiffness=100.0)
+    else:
+        mat = deforma.Material("corotated", youngs_modulus=1e4, poisson_ratio=0.3, density=1.0, yield_strain=0.02,
+                               plastic_rate=1.0)
+        w = deforma.World(gravity=(0.0, 0.0), integrator="implicit-euler", material=mat)
+    other = w.add_body(strip(0.2, 0.2, (2, 2)), position=(3.0, 3.0))
+    bar = w.add_body(strip(1.0, 0.2, (6, 2)), position=None)
+    x = bar.positions
+    x[:, 1] += 0.3 * x[:, 0] ** 2  # bent far beyond yield
+    bar.positions = x
+    for _ in range(5):
+        w.step()
+    dent = w._model.rest_shape(1)
+    assert any(part is not None for part in dent)
+    w.remove_body(other)  # the bar moves to index 0
+    w.add_body(strip(0.2, 0.2, (2, 2)), position=(3.0, 3.0))
+    w.material = dataclasses.replace(mat, yield_strain=0.03)  # a new material of the same kind
+    kept = w._model.rest_shape(0)
+    for a, b in zip(dent, kept):
+        assert (a is None) == (b is None)
+        if a is not None:
+            for u, v in zip(a, b):
+                np.testing.assert_array_equal(u, v)
+    m = w._model
+    if model == "springs":
+        assert (m.spring_rest_length != m.spring_rest_length0).any()
+    else:
+        assert (m.elem_b != m.elem_b0).any()
+
+
+def test_a_dent_survives_a_tear():
+    # a torn body keeps its triangles, in order: each keeps the rest shape it flowed to
+    mat = deforma.Material("corotated", youngs_modulus=2e4, poisson_ratio=0.3, density=2.0, tear_strain=0.2,
+                           yield_strain=0.05, plastic_rate=0.5)
+    w = deforma.World(gravity=(0.0, 0.0), integrator="implicit-euler", material=mat)
+    body = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=12, edges=True), position=None)
+    x = body.positions
+    right = np.flatnonzero(x[:, 0] > 2.0 - 1e-9)
+    body.pin(np.concatenate([np.flatnonzero(x[:, 0] < 1e-9), right]))
+    tears = 0
+    for k in range(300):
+        x = body.positions
+        x[right, 0] += 0.5 / 600 * (1 + k / 100)
+        body.positions = x
+        old, n = w._model, body.n_vertices
+        w.step()
+        if body.n_vertices != n:
+            before, after = old.rest_shape(0)[1], w._model.rest_shape(0)[1]
+            assert before is not None  # it had flowed
+            np.testing.assert_array_equal(before[0], after[0])
+            np.testing.assert_array_equal(before[1], after[1])
+            tears += 1
+    assert tears >= 3
 
 
 # -- pressure ----------------------------------------------------------------------------------

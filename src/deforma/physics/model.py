@@ -216,7 +216,8 @@ class BodyTopology:
 
 
 def element_geometry(topology: BodyTopology):
-    """A body's triangles as finite elements: ``(triangles, B, rest areas, lumped vertex areas)``.
+    """A body's triangles as finite elements: ``(triangles, B, rest areas, lumped vertex areas,
+    order)``, ``order`` (M,) each element's row in ``topology.triangles``.
 
     Triangles are sorted by their lowest vertex (a run of them touches a narrow band of
     vertices); ``B`` and the areas come from :func:`~deforma.physics.elements.rest_geometry`;
@@ -234,14 +235,14 @@ def element_geometry(topology: BodyTopology):
                          "(use the 'springs' material)")
     # rest_geometry gives the same numbers row by row, in any order of the rows
     bmat, area = t.geometry if t.geometry is not None else rest_geometry(t.rest_positions, t.triangles)
-    tri, bmat, area, lumped = _sorted_elements(t.triangles, np.ascontiguousarray(bmat), np.ascontiguousarray(area),
-                                               t.n_vertices)
+    tri, bmat, area, lumped, order = _sorted_elements(t.triangles, np.ascontiguousarray(bmat),
+                                                      np.ascontiguousarray(area), t.n_vertices)
     if not np.all(lumped > 0):
         k = int(np.flatnonzero(lumped <= 0)[0])
         raise ValueError(f"vertex {k} belongs to no triangle: a finite-element body gets its mass from "
                          f"its triangles' area, so every vertex must be a corner of one (or use the "
                          f"'springs' material)")
-    return tri, bmat, area, lumped
+    return tri, bmat, area, lumped, order
 
 
 def _boundary(x: np.ndarray, t: np.ndarray):
@@ -259,8 +260,8 @@ def _boundary(x: np.ndarray, t: np.ndarray):
 def _sorted_elements(c, b, area, n):
     """Triangles ``c`` (M, 3) over ``n`` vertices, their ``b`` (M, 4) and ``area`` (M,) in
     the order of their lowest vertex (stable), and each vertex's third of its triangles'
-    areas (summed in that order): one compiled pass each, where NumPy's gathers and
-    bincount took 0.7 ms for a 1e4-vertex sheet, at every tear."""
+    areas (summed in that order), and the order: one compiled pass each, where NumPy's
+    gathers and bincount took 0.7 ms for a 1e4-vertex sheet, at every tear."""
     m = c.shape[0]
     low = np.empty(m, np.int64)
     for f in range(m):
@@ -283,7 +284,7 @@ def _sorted_elements(c, b, area, n):
         third = area[f] / 3.0
         for k in range(3):
             lumped[c[f, k]] += third
-    return tri, bs, ar, lumped
+    return tri, bs, ar, lumped, order
 
 
 def _outline(x: np.ndarray, edges: np.ndarray):
@@ -459,6 +460,7 @@ class Model:
         self.elem = np.empty((ntot, 3), np.int32)
         self.elem_b = np.empty((ntot, 4), np.float64)
         self.elem_area = np.empty(ntot, np.float64)
+        self.elem_source = np.empty(ntot, np.int64)
         self.vertex_area = np.zeros(n, np.float64)
         for b, t in enumerate(self.topologies):
             s0, s1 = self.body_spring_offsets[b], self.body_spring_offsets[b + 1]
@@ -469,7 +471,8 @@ class Model:
                 self.spring_rest_length[s0:s1] = t.spring_rest_length
                 continue
             t0, t1 = self.body_elem_offsets[b], self.body_elem_offsets[b + 1]
-            tri, bmat, area, lumped = element_geometry(t)
+            tri, bmat, area, lumped, order = element_geometry(t)
+            self.elem_source[t0:t1] = order
             self.elem[t0:t1] = tri + v0
             self.elem_b[t0:t1] = bmat
             self.elem_area[t0:t1] = area
@@ -538,6 +541,52 @@ class Model:
         for b in range(nb):
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
+
+    def rest_shape(self, body: int):
+        """Body ``body``'s rest shape where plasticity moved it, in its topology's order:
+        ``(springs (E, 2), rest lengths (E,))`` and ``(B (M, 4), rest areas (M,))`` (``None``
+        for a part still as built, or a body without it). A rebuilt Model starts from the
+        mesh's rest shape; :meth:`take_rest_shape` gives it this one back, so that dents
+        survive a tear, a new body or a new material."""
+        s0, s1 = self.body_spring_offsets[body], self.body_spring_offsets[body + 1]
+        t0, t1 = self.body_elem_offsets[body], self.body_elem_offsets[body + 1]
+        springs = elements = None
+        if not np.array_equal(self.spring_rest_length[s0:s1], self.spring_rest_length0[s0:s1]):
+            springs = (self.topologies[body].springs, self.spring_rest_length[s0:s1].copy())
+        if not (np.array_equal(self.elem_b[t0:t1], self.elem_b0[t0:t1])
+                and np.array_equal(self.elem_area[t0:t1], self.elem_area0[t0:t1])):
+            order = self.elem_source[t0:t1]
+            b = np.empty((t1 - t0, 4))
+            area = np.empty(t1 - t0)
+            b[order], area[order] = self.elem_b[t0:t1], self.elem_area[t0:t1]
+            elements = (b, area)
+        return springs, elements
+
+    def take_rest_shape(self, body: int, shape, source=None) -> None:
+        """Give body ``body`` the rest shape ``shape`` (:meth:`rest_shape` of the Model before,
+        for the same body), where its vertex ``i`` is the old vertex ``source[i]`` (a tear's
+        copies: ``None`` for the same vertices). A spring takes the rest length of the old
+        spring between its ends' sources; the elements, those of the old triangles in the
+        same rows (a tear keeps them in order). Bumps :attr:`version`."""
+        springs, elements = shape
+        topo = self.topologies[body]
+        s0, s1 = self.body_spring_offsets[body], self.body_spring_offsets[body + 1]
+        t0, t1 = self.body_elem_offsets[body], self.body_elem_offsets[body + 1]
+        if springs is not None and s1 > s0:
+            old, rest = springs
+            src = np.arange(topo.n_vertices) if source is None else np.asarray(source)
+            n_old = int(max(old.max(initial=0), src.max(initial=0))) + 1
+            lo, hi = np.sort(src[topo.springs], axis=1).T
+            key = lo.astype(np.int64) * n_old + hi
+            old_key = old[:, 0].astype(np.int64) * n_old + old[:, 1]  # sorted: a topology's springs are
+            at = np.minimum(np.searchsorted(old_key, key), len(old_key) - 1)
+            found = old_key[at] == key
+            self.spring_rest_length[s0:s1][found] = rest[at[found]]
+        if elements is not None and t1 - t0 == len(elements[1]):
+            order = self.elem_source[t0:t1]
+            self.elem_b[t0:t1] = elements[0][order]
+            self.elem_area[t0:t1] = elements[1][order]
+        self.version += 1
 
     def _pressure(self, pressure) -> None:
         from .pressure import enclosed_area, outline_loops

@@ -485,6 +485,17 @@ class World:
         return body._index
 
     def _rebuild(self, x, v):
+        # the rest shapes plasticity moved live in the Model's arrays: take them over, body by
+        # body (a torn body's vertices through the tear's source), so dents survive a rebuild
+        old = getattr(self, "_model", None)
+        shapes = {}
+        if old is not None:
+            for i, body in enumerate(getattr(self, "_model_bodies", ())):
+                was_fem = old.materials[i] is not None and old.materials[i].is_fem
+                if body._world is self and was_fem == body.is_fem:  # springs and elements do not convert
+                    shape = old.rest_shape(i)
+                    if any(part is not None for part in shape):
+                        shapes[body] = shape
         tops = [b.topology for b in self._bodies]
         self._model = Model(tops, masses=[b._param("mass") for b in self._bodies],
                             stiffness=[b.stiffness for b in self._bodies],
@@ -493,6 +504,10 @@ class World:
                             pinned=[b._pinned for b in self._bodies],
                             contact=[self._contact_parameters(b) for b in self._bodies],
                             pressure=[b._overrides["pressure"] for b in self._bodies])
+        for body, shape in shapes.items():
+            src = body._tear_source
+            self._model.take_rest_shape(body._index, shape, None if isinstance(src, slice) else src)
+        self._model_bodies = list(self._bodies)
         self._state = State(x, v, self._model.body_vertex_offsets)
         self._grabs_dirty = True
         self._make_contact_scratch()
