@@ -693,10 +693,8 @@ def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
     rest_length = None
     if np.array_equal(topology.springs, tear_topology.pairs):  # its springs are its triangles' edges
         # a kept edge keeps its rest length; the new ones are measured as _trusted measures them
-        rest_length = np.empty(len(origin))
-        kept = origin >= 0
-        rest_length[kept] = topology.spring_rest_length[origin[kept]]
-        new = ~kept
+        rest_length = np.take(topology.spring_rest_length, np.maximum(origin, 0))
+        new = np.flatnonzero(origin < 0)
         rest_length[new] = lengths(rest, tt.pairs[new, 0].astype(np.int32), tt.pairs[new, 1].astype(np.int32))
     body = BodyTopology._trusted(rest, tt.pairs, cut.triangles, _outline_edges(tt.triangles, tt.tri_edge, tt.tri_pair),
                                  mass_share=share, geometry=(tt.b, tt.area), spring_rest_length=rest_length)
