@@ -271,6 +271,32 @@ def _reduced(u, b, r, delta, copies, cptr, cind, cval, lu, piv):
 
 
 @njit(cache=True)
+def _small_system(store, slots, r, delta, cptr, cind, cval, d):
+    """The small system's matrix (see the module docstring) from the solved columns ``[Z V]``
+    (the store's ``slots``): ``[[I + Delta Z_r, Delta V_r], [-C Z, D - C V]]``, with ``C``
+    as CSR arrays. Compiled: a few rows of ``[Z V]`` each, where NumPy's gathers and BLAS
+    products cost more than the sums."""
+    ko, nc, k = r.shape[0], cptr.shape[0] - 1, slots.shape[0]
+    m = np.zeros((k, k))
+    for i in range(ko):
+        for t in range(k):
+            col = slots[t]
+            acc = 0.0
+            for j in range(ko):
+                acc += delta[i, j] * store[r[j], col]
+            m[i, t] = acc
+        m[i, i] += 1.0
+    for i in range(nc):
+        for t in range(k):
+            col = slots[t]
+            acc = 0.0
+            for p in range(cptr[i], cptr[i + 1]):
+                acc += cval[p] * store[cind[p], col]
+            m[ko + i, t] = (d[i, t - ko] if t >= ko else 0.0) - acc
+    return m
+
+
+@njit(cache=True)
 def _finish(u, store, slots, s, ref, copies, ko):
     """``x = T (U - [Z V] s)``: the correction, then each vertex its reference row plus,
     for a copy, its own unknown."""
@@ -406,17 +432,7 @@ class UpdatedFactor:
         keys = [("row", int(x)) for x in r] + [
             b_ind[b_ptr[j]:b_ptr[j + 1]].tobytes() + b_val[b_ptr[j]:b_ptr[j + 1]].tobytes() for j in range(nc)]
         slots = self._columns(keys, b)
-        q = self._store
-        at_r = q[np.ix_(r, slots)]  # rows r of [Z V]
-        cols, at = np.unique(c_ind, return_inverse=True)  # C [Z V], from the few rows of [Z V] that C reads
-        c_dense = np.zeros((nc, len(cols)))
-        c_dense[np.repeat(np.arange(nc), np.diff(c_ptr)), at] = c_val  # canonical: no duplicates
-        at_c = c_dense @ q[np.ix_(cols, slots)]
-        m = np.empty((k, k))
-        m[:ko] = delta @ at_r
-        m[:ko, :ko] += np.eye(ko)
-        m[ko:, :ko] = -at_c[:, :ko]
-        m[ko:, ko:] = d - at_c[:, ko:]
+        m = _small_system(self._store, slots, r, delta, c_ptr, c_ind, c_val, d)
         if not np.all(np.isfinite(m)):
             return False
         lu, piv = sla.lu_factor(m, check_finite=False)
