@@ -641,12 +641,11 @@ class ImplicitEuler:
     def _patchable(old, model, torn, inputs, h) -> bool:
         """Whether the matrix of ``old``'s Model (the key it was built for) is that of the torn
         ``model`` but for the vertices the tear touched: neither Model changed in place since
-        (a parameter, a plastic rest shape), the same ``h``, air drag and grabs."""
+        (a parameter, plastic flow; the new Model took over the old one's rest shape), the same
+        ``h``, air drag and grabs."""
         was = old[0]
         if old[1] != was.version or torn[3] != model.version or old[2] != h or old[5] != inputs.air_drag:
             return False
-        if not (np.array_equal(was.elem_b, was.elem_b0) and np.array_equal(was.elem_area, was.elem_area0)):
-            return False  # a plastic rest shape is in the old matrix; the new Model starts from the mesh's
         source = torn[1]
         return np.array_equal(old[3][source], inputs.grab_slot) and np.array_equal(old[4], inputs.grab_pull[:, 0])
 
