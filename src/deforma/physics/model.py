@@ -578,7 +578,7 @@ class Model:
             n_old = int(max(old.max(initial=0), src.max(initial=0))) + 1
             lo, hi = np.sort(src[topo.springs], axis=1).T
             key = lo.astype(np.int64) * n_old + hi
-            old_key = old[:, 0].astype(np.int64) * n_old + old[:, 1]  # sorted: a topology's springs are
+            old_key = old[:, 0].astype(np.int64) * n_old + old[:, 1]  # sorted, as a topology keeps its springs
             at = np.minimum(np.searchsorted(old_key, key), len(old_key) - 1)
             found = old_key[at] == key
             self.spring_rest_length[s0:s1][found] = rest[at[found]]
