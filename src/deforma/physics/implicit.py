@@ -629,7 +629,7 @@ class ImplicitEuler:
         self._dirty = self._dirty[patch[2]] | patch[3] if patch is not None and self._dirty is not None else None
         self._mass = mass
         self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, mass, patch)
-        self._rows = self._a.tocsr()  # its rows, for free_estimate (not its columns: next to a pinned row they differ)
+        self._rows = None  # its rows, for free_estimate, made when a contact first needs them
         self._key = key
         self._wk = h * h * model.spring_stiffness
         self._wd = h * model.spring_damping
@@ -759,7 +759,9 @@ class ImplicitEuler:
                 # later ones of where the contact-free system would move the iterate
                 # (free_estimate says why not of the iterate itself).
                 z = y
-                if it > 0:
+                if it > 0 and len(self._listed):  # without contacts nothing reads z
+                    if self._rows is None:  # not its columns: next to a pinned row they differ
+                        self._rows = self._a.tocsr()
                     z = self._z
                     free_estimate(self._rows.indptr, self._rows.indices, self._rows.data, x, b, self._listed,
                                   model.pinned, z)
