@@ -1,5 +1,6 @@
 """Fixtures shared by the test packages."""
 
+import numpy as np
 import pytest
 
 
@@ -15,3 +16,26 @@ def gl_ctx():
     ctx = create_headless_context()
     yield ctx
     ctx.release()
+
+
+@pytest.fixture
+def patched_matrices(monkeypatch):
+    """Check every matrix implicit Euler patches after a tear against the one assembled from
+    scratch (the same arrays, bit for bit); returns the list of the checked patches' fresh
+    vertex masks, which grows as the test runs."""
+    from deforma.physics import implicit
+
+    full = implicit.system_matrix
+    checked = []
+
+    def system_matrix(m, grab_slot, grab_pull, h, mass=None, patch=None):
+        a, diag = full(m, grab_slot, grab_pull, h, mass, patch)
+        if patch is not None:
+            b, diag_b = full(m, grab_slot, grab_pull, h, mass)
+            for got, want in ((a.indptr, b.indptr), (a.indices, b.indices), (a.data, b.data), (diag, diag_b)):
+                np.testing.assert_array_equal(got, want)
+            checked.append(patch[3])
+        return a, diag
+
+    monkeypatch.setattr(implicit, "system_matrix", system_matrix)
+    return checked
