@@ -181,10 +181,10 @@ class World:
         self.material = material
 
     def __deepcopy__(self, memo):
-        # everything is copied as usual (the implicit integrator drops its SuperLU factor, see
-        # ImplicitEuler.__deepcopy__); what is keyed by id() is re-keyed to the copies, or the
-        # copy would repack its colliders a step earlier than this world (rounding apart) and
-        # forget which bodies had lost their shape
+        # everything is copied as usual (implicit Euler's factor is factored again at the
+        # copy's first solve, see UpdatedFactor.__deepcopy__); what is keyed by id() is
+        # re-keyed to the copies, or the copy would repack its colliders a step earlier than
+        # this world (rounding apart) and forget which bodies had lost their shape
         import copy
 
         new = type(self).__new__(type(self))
