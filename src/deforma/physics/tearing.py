@@ -72,6 +72,8 @@ class Tear:
         The cracks' tips after this tear: the far ends of the cuts that ran into the mesh
         (vertices that were inside it and are now on the outline, not split). Pass them to the
         next :func:`tear_mesh` so the cracks go on from there.
+    changed : (C,) int64
+        The triangles whose corners were renumbered (moved onto a copy), in order.
     """
 
     triangles: np.ndarray
@@ -79,6 +81,7 @@ class Tear:
     mass_share: np.ndarray
     cut: np.ndarray
     tips: np.ndarray
+    changed: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,13 +131,8 @@ class TearTopology:
     inner_tri: np.ndarray
 
     @classmethod
-    def of(cls, rest, tris, b=None, area=None) -> "TearTopology":
-        """Build from rest positions (N, 2) and counter-clockwise triangles (M, 3).
-
-        ``b`` and ``area``: the triangles' rest geometry when already known (a torn mesh keeps
-        its triangles, in order, with corners at the same rest positions, so its geometry is
-        the mesh's before the tear; :func:`rest_geometry` otherwise).
-        """
+    def of(cls, rest, tris) -> "TearTopology":
+        """Build from rest positions (N, 2) and counter-clockwise triangles (M, 3)."""
         rest = np.asarray(rest, dtype=np.float64)
         t = np.asarray(tris, dtype=np.int64)
         n = len(rest)
@@ -142,17 +140,11 @@ class TearTopology:
         boundary = np.zeros(n, bool)
         boundary[pairs[~two].ravel()] = True
         inner = np.flatnonzero(two)
-        a, c = pairs[inner, 0], pairs[inner, 1]
-        length = lengths(rest, a, c)
-        normal = np.empty((len(inner), 2))
-        normal[:, 0] = -(rest[c, 1] - rest[a, 1]) / length  # (-dy, dx) / length
-        normal[:, 1] = (rest[c, 0] - rest[a, 0]) / length
-        if b is None or area is None:
-            b, area = rest_geometry(rest, t)
+        b, area = rest_geometry(rest, t)
         # the triangles around each vertex (CSR), in triangle order
         ptr = np.zeros(n + 1, np.int64)
         np.cumsum(np.bincount(t.ravel(), minlength=n), out=ptr[1:])
-        return cls(t, pairs, tri_pair, inner, boundary, b, area, np.ascontiguousarray(normal), keys, ptr,
+        return cls(t, pairs, tri_pair, inner, boundary, b, area, _rest_normals(rest, pairs[inner]), keys, ptr,
                    stable_order(t.ravel(), n) // 3, np.ascontiguousarray(half_edge.reshape(3, -1).T),
                    np.ascontiguousarray(tri_pair[inner]))
 
@@ -161,16 +153,24 @@ class TearTopology:
         n = len(self.boundary)
         return int(np.searchsorted(self.keys, min(a, b) * n + max(a, b)))
 
-    def torn(self, rest, cut: "Tear") -> "TearTopology":
-        """The topology of the torn mesh ``cut`` (rest positions ``rest``, (N', 2)): the same
-        arrays as ``TearTopology.of(rest, cut.triangles)``, patched where the tear changed the
-        mesh (:func:`torn_edges`)."""
-        return _torn(self, rest, cut)[0]
+
+def _rest_normals(rest, pairs):
+    """Unit normal (K, 2) of each edge ``(a, c)`` of ``pairs`` (K, 2) at rest: ``(-dy, dx) / length``."""
+    a, c = pairs[:, 0], pairs[:, 1]
+    length = lengths(rest, a, c)
+    normal = np.empty((len(pairs), 2))
+    normal[:, 0] = -(rest[c, 1] - rest[a, 1]) / length
+    normal[:, 1] = (rest[c, 0] - rest[a, 0]) / length
+    return normal
 
 
 def _torn(topo: TearTopology, rest, cut: "Tear"):
-    """:meth:`TearTopology.torn` and, for each edge of the torn mesh, the edge of ``topo`` it
-    is (``-1`` for an edge of a split triangle: its numbers are new)."""
+    """The :class:`TearTopology` of the torn mesh ``cut`` (rest positions ``rest``, (N', 2)):
+    the same arrays as ``TearTopology.of(rest, cut.triangles)``, patched where the tear
+    changed the mesh (:func:`torn_edges`; a torn mesh keeps its triangles, in order, with
+    corners at the same rest positions, so its rest geometry is the mesh's before the tear);
+    and, for each edge of the torn mesh, the edge of ``topo`` it is (``-1`` for an edge of a
+    split triangle: its numbers are new)."""
     rest = np.asarray(rest, dtype=np.float64)
     t = np.ascontiguousarray(cut.triangles, dtype=np.int64)
     keys, pairs, tri_pair, two, tri_edge, origin, ptr, vtris = torn_edges(
@@ -178,12 +178,7 @@ def _torn(topo: TearTopology, rest, cut: "Tear"):
         np.ascontiguousarray(cut.source, dtype=np.int64))
     boundary, inner, inner_tri, normal, fresh = _torn_inner(two, pairs, tri_pair, origin, topo.tri_pair, topo.normal,
                                                             len(rest))
-    # the rebuilt interior edges' normals, computed as TearTopology.of computes them (the same numbers)
-    e = inner[fresh]
-    a, c = pairs[e, 0], pairs[e, 1]
-    length = lengths(rest, a, c)
-    normal[fresh, 0] = -(rest[c, 1] - rest[a, 1]) / length
-    normal[fresh, 1] = (rest[c, 0] - rest[a, 0]) / length
+    normal[fresh] = _rest_normals(rest, pairs[inner[fresh]])  # the rebuilt interior edges'
     tt = TearTopology(t, pairs, tri_pair, inner, boundary, topo.b, topo.area, normal, keys, ptr, vtris, tri_edge,
                       inner_tri)
     return tt, origin
@@ -540,11 +535,12 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None, tips=()):
     new_tips = np.unique(ends[~topo.boundary[ends]])  # cuts that ran in from the outline
     is_cut = np.zeros(len(topo.pairs), np.bool_)
     is_cut[cut] = True
-    new_t, source, share = _split_vertices(t, topo.tri_edge, topo.tri_pair, is_cut, topo.vertex_ptr,
+    new_t, source, share, renumbered = _split_vertices(t, topo.tri_edge, topo.tri_pair, is_cut, topo.vertex_ptr,
                                            topo.vertex_tris, topo.area, np.unique(topo.pairs[cut].ravel()), n)
     if len(source) == n:
         return None
-    return Tear(new_t.astype(np.int32), source, share, topo.pairs[cut].astype(np.int32), new_tips)
+    return Tear(new_t.astype(np.int32), source, share, topo.pairs[cut].astype(np.int32), new_tips,
+                np.flatnonzero(renumbered))
 
 
 @njit(cache=True)
@@ -621,13 +617,15 @@ def _chip(e, tri_pair, tri_edge, seen):
 @njit(cache=True)
 def _split_vertices(tris, tri_edge, tri_pair, is_cut, vertex_ptr, vertex_tris, area, verts, n):
     """Split each vertex of ``verts`` into one copy per fan (triangles around it joined across
-    uncut edges): ``(triangles, source, mass share)`` of the torn mesh.
+    uncut edges): ``(triangles, source, mass share)`` of the torn mesh, and which triangles
+    it renumbered (M,) bool.
 
     The first fan (in triangle order) keeps the vertex, each other fan gets a copy appended
     after the ``n`` vertices, vertex by vertex; a copy's share of the vertex's mass is its
     fan's area over the area of all its fans (summed fan by fan, triangle by triangle).
     """
     new_t = tris.copy()
+    renumbered = np.zeros(tris.shape[0], np.bool_)
     cap = n
     for v in verts:
         cap += vertex_ptr[v + 1] - vertex_ptr[v]
@@ -687,8 +685,9 @@ def _split_vertices(tris, tri_edge, tri_pair, is_cut, vertex_ptr, vertex_tris, a
                     for c in range(3):
                         if new_t[f, c] == v:
                             new_t[f, c] = m
+                            renumbered[f] = True
             m += 1
-    return new_t, source[:m], share[:m]
+    return new_t, source[:m], share[:m], renumbered
 
 
 def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
@@ -713,7 +712,7 @@ def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
         # a kept edge keeps its rest length; the new ones are measured as _trusted measures them
         rest_length = np.take(topology.spring_rest_length, np.maximum(origin, 0))
         new = np.flatnonzero(origin < 0)
-        rest_length[new] = lengths(rest, tt.pairs[new, 0].astype(np.int32), tt.pairs[new, 1].astype(np.int32))
+        rest_length[new] = lengths(rest, tt.pairs[new, 0], tt.pairs[new, 1])
     body = BodyTopology._trusted(rest, tt.pairs, cut.triangles, _outline_edges(tt.triangles, tt.tri_edge, tt.tri_pair),
                                  mass_share=share, geometry=(tt.b, tt.area), spring_rest_length=rest_length)
     return body, tt

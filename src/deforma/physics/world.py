@@ -851,9 +851,7 @@ class World:
             if cut is None:
                 body._cracks = None  # every crack stopped: a new one may start
                 continue
-            d = cut.triangles != topo.triangles
-            changed = np.flatnonzero(d[:, 0] | d[:, 1] | d[:, 2])
-            body._tear_fresh = np.union1d(cut.triangles[changed], topo.triangles[changed])  # old and new corners
+            body._tear_fresh = np.union1d(cut.triangles[cut.changed], topo.triangles[cut.changed])  # old, new corners
             body._apply_tear(cut)
             torn = True
         if torn:
