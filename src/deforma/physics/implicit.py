@@ -79,7 +79,7 @@ from .colliders import advance_colliders, contact_planes, finish_position_step, 
 from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, hold_start_distance
 from .elements import implicit_element_rhs, max_stiffness
 from .integrators import register_integrator
-from .model import sort_few
+from .model import first_index, sort_few
 from .updated_factor import UpdatedFactor
 
 if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
@@ -328,8 +328,7 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None):
     else:
         a, old_diag, source, fresh = patch
         source = np.ascontiguousarray(source, dtype=np.int64)
-        first = np.empty(a.shape[0], np.int64)
-        first[source[::-1]] = np.arange(n - 1, -1, -1)  # an old vertex's lowest new index: itself, not a copy
+        first = first_index(source, a.shape[0])
         old = (a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, old_diag)
     ptr, ind, val = _assemble(diag, model.spring_i, model.spring_j,
                               h * h * model.spring_stiffness + h * model.spring_damping,
@@ -539,7 +538,7 @@ def with_entries(a, rows, cols, vals, pinned) -> sp.csc_matrix:
     return out
 
 
-def _rows(t) -> np.ndarray:
+def _row_items(t) -> np.ndarray:
     """The rows of an integer array (M, 3) as single comparable items (for set operations)."""
     t = np.ascontiguousarray(t, dtype=np.int64)
     return t.view(np.dtype((np.void, 3 * t.itemsize))).ravel()
@@ -662,7 +661,7 @@ class ImplicitEuler:
             # a pair that stays keeps its s: only the pairs that come or go change the matrix,
             # so the factor's correction covers them (a heap changes its pairs a few at a time,
             # and new s for all of them made each change touch every pair's rows)
-            _, new, old = np.intersect1d(_rows(triples), _rows(self._triples), return_indices=True)
+            _, new, old = np.intersect1d(_row_items(triples), _row_items(self._triples), return_indices=True)
             s[new] = self._s[old]
         self._weight_used = self.contact_weight
         self._touching = touching.copy()

@@ -74,6 +74,20 @@ def counting_order(keys, bound):
     return order
 
 
+def first_index(source, n_old) -> np.ndarray:
+    """For each of ``n_old`` old vertices, the lowest ``i`` with ``source[i]`` equal to it
+    (-1 where none): after a tear, the vertex itself rather than one of its copies.
+
+    Examples
+    --------
+    >>> first_index(np.array([0, 1, 2, 1, 2]), 4).tolist()
+    [0, 1, 2, -1]
+    """
+    first = np.full(n_old, -1, np.int64)
+    first[source[::-1]] = np.arange(len(source) - 1, -1, -1)  # the last write, the lowest index, stays
+    return first
+
+
 @njit(cache=True, inline="always")
 def sort_few(keys, count):
     """Sort ``keys[:count]`` in place: an insertion sort, for the few rows of one column."""

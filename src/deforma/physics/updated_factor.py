@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from .model import sort_few
+from .model import first_index, sort_few
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -401,8 +401,7 @@ class UpdatedFactor:
         ref = np.ascontiguousarray(ref, dtype=np.int64)
         if ref.shape != (n,) or (n and (ref.min() < 0 or ref.max() >= n0)):
             raise ValueError("ref must map every row of the matrix to a row of the reference")
-        first = np.full(n0, -1, np.int64)
-        first[ref[::-1]] = np.arange(n - 1, -1, -1)  # the lowest current index of each reference vertex
+        first = first_index(ref, n0)  # the lowest current index of each reference vertex
         if (first < 0).any():
             raise ValueError("ref must reach every row of the reference")
         copies = np.flatnonzero(first[ref] != np.arange(n))
