@@ -301,6 +301,60 @@ def _sorted_elements(c, b, area, n):
     return tri, bs, ar, lumped, order
 
 
+@njit(cache=True)
+def _merged_elements(c, changed, old_order, old_b, old_area, old_b0, old_area0, v0, tri, bs, ar, b0, ar0, order,
+                     lumped):
+    """Model._torn_elements' pass: the elements of triangles ``c`` (M, 3) in the order of
+    their lowest vertex, from the old arrays (``old_order`` their rows, ``old_b``...) where
+    the triangles ``changed`` were renumbered; written into ``tri`` (plus ``v0``), ``bs``,
+    ``ar``, ``b0``, ``ar0``, ``order``, and each vertex's third of its triangles' rest areas
+    added to ``lumped`` (in that order, as :func:`_sorted_elements` sums them)."""
+    m = c.shape[0]
+    n = lumped.shape[0]
+    for f in range(m):
+        for k in range(3):
+            if c[f, k] < 0 or c[f, k] >= n:  # Numba does not check indices: refuse rather than write astray
+                raise ValueError("Model: a torn triangle's vertex outside [0, n)")
+    at = np.empty(m, np.int64)  # each triangle's row in the old arrays
+    for i in range(m):
+        at[old_order[i]] = i
+    moved = np.zeros(m, np.bool_)
+    nc = changed.shape[0]
+    key = np.empty(nc, np.int64)  # the renumbered ones by (new lowest vertex, row): the stable order
+    for j in range(nc):
+        f = changed[j]
+        moved[f] = True
+        key[j] = min(c[f, 0], c[f, 1], c[f, 2]) * np.int64(m) + f
+    key.sort()
+    i = 0
+    j = 0
+    for p in range(m):
+        while i < m and moved[old_order[i]]:
+            i += 1
+        take = j < nc
+        if take and i < m:
+            g = old_order[i]
+            take = key[j] < min(c[g, 0], c[g, 1], c[g, 2]) * np.int64(m) + g
+        if take:
+            f = key[j] % m
+            j += 1
+        else:
+            f = old_order[i]
+            i += 1
+        order[p] = f
+        q = at[f]
+        for k in range(3):
+            tri[p, k] = c[f, k] + v0
+        for k in range(4):
+            bs[p, k] = old_b[q, k]
+            b0[p, k] = old_b0[q, k]
+        ar[p] = old_area[q]
+        ar0[p] = old_area0[q]
+        third = old_area0[q] / 3.0
+        for k in range(3):
+            lumped[c[f, k]] += third
+
+
 def _outline(x: np.ndarray, edges: np.ndarray):
     """Boundary edges (B, 2) int32, boundary vertices and their rest clearances of one body."""
     verts = np.unique(edges).astype(np.int32)
@@ -439,6 +493,12 @@ class Model:
         triangles, per-vertex contact thickness, per-body flags, thickness and friction);
         see :mod:`deforma.physics.contacts`.
 
+    The constructor takes the bodies' topologies and parameters (lists, one entry per body);
+    ``torn``, a dict from a finite-element body to ``(Model before, its index there, rows of
+    the triangles a tear renumbered)``, builds that body's elements from the Model before
+    (the same arrays, with its rest shape where plasticity moved it) instead of from its
+    topology.
+
     Examples
     --------
     >>> t = BodyTopology.from_arrays([[0, 0], [1, 0], [0, 1]], [[0, 1], [1, 2], [0, 2]])
@@ -448,7 +508,7 @@ class Model:
     """
 
     def __init__(self, topologies, *, masses, stiffness, damping, materials=None, pinned=None, contact=None,
-                 pressure=None):
+                 pressure=None, torn=None):
         self.topologies = list(topologies)
         self.version = 0
         self.serial = uuid.uuid4().int  # unique across processes too (a pickled world's Models)
@@ -476,6 +536,9 @@ class Model:
         self.elem_area = np.empty(ntot, np.float64)
         self.elem_source = np.empty(ntot, np.int64)
         self.vertex_area = np.zeros(n, np.float64)
+        self.elem_b0 = np.empty((ntot, 4), np.float64)
+        self.elem_area0 = np.empty(ntot, np.float64)
+        torn = torn or {}
         for b, t in enumerate(self.topologies):
             s0, s1 = self.body_spring_offsets[b], self.body_spring_offsets[b + 1]
             v0 = self.body_vertex_offsets[b]
@@ -485,16 +548,20 @@ class Model:
                 self.spring_rest_length[s0:s1] = t.spring_rest_length
                 continue
             t0, t1 = self.body_elem_offsets[b], self.body_elem_offsets[b + 1]
+            if b in torn:
+                self._torn_elements(b, *torn[b])
+                continue
             tri, bmat, area, lumped, order = element_geometry(t)
             self.elem_source[t0:t1] = order
-            self.elem[t0:t1] = tri + v0
-            self.elem_b[t0:t1] = bmat
-            self.elem_area[t0:t1] = area
+            np.add(tri, v0, out=self.elem[t0:t1], casting="unsafe")
+            self.elem_b[t0:t1] = self.elem_b0[t0:t1] = bmat
+            self.elem_area[t0:t1] = self.elem_area0[t0:t1] = area
             self.vertex_area[v0:v0 + t.n_vertices] = lumped
-        self.elem_mu = np.zeros(ntot, np.float64)
-        self.elem_lambda = np.zeros(ntot, np.float64)
-        self.elem_damping = np.zeros(ntot, np.float64)
-        self.elem_kind = np.zeros(ntot, np.int32)
+        # every element is a finite-element body's: set_body_material below fills them all
+        self.elem_mu = np.empty(ntot, np.float64)
+        self.elem_lambda = np.empty(ntot, np.float64)
+        self.elem_damping = np.empty(ntot, np.float64)
+        self.elem_kind = np.empty(ntot, np.int32)
         self.vertex_mass = np.empty(n, np.float64)
         self.vertex_inv_mass = np.empty(n, np.float64)
         self.pinned = np.zeros(n, bool)
@@ -511,8 +578,6 @@ class Model:
                 self.set_body_parameters(b, mass=masses[b], stiffness=stiffness[b], damping=damping[b])
 
         self.spring_rest_length0 = self.spring_rest_length.copy()
-        self.elem_b0 = self.elem_b.copy()
-        self.elem_area0 = self.elem_area.copy()
         self._pressure(pressure if pressure is not None else [None] * nb)
 
         # The contact stage's view: the collision vertices are every body's outline vertices,
@@ -539,10 +604,11 @@ class Model:
             cv.append(inner[b] + self.body_vertex_offsets[b])
             cb.append(np.full(len(inner[b]), b))
         v = int(body_interior[-1])
-        tris = [t.triangles + self.body_vertex_offsets[b] for b, t in enumerate(self.topologies)]
         body_tri = np.zeros(nb + 1, np.int64)
-        np.cumsum([len(t) for t in tris], out=body_tri[1:])
-        tri = np.ascontiguousarray(np.concatenate([np.zeros((0, 3), np.int32)] + tris), dtype=np.int32)
+        np.cumsum([len(t.triangles) for t in self.topologies], out=body_tri[1:])
+        tri = np.empty((body_tri[-1], 3), np.int32)
+        for b, t in enumerate(self.topologies):
+            np.add(t.triangles, self.body_vertex_offsets[b], out=tri[body_tri[b]:body_tri[b + 1]], casting="unsafe")
 
         def i32(parts):
             return np.ascontiguousarray(np.concatenate(parts), dtype=np.int32)
@@ -555,6 +621,24 @@ class Model:
         for b in range(nb):
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
+
+    def _torn_elements(self, body: int, old: "Model", old_body: int, changed) -> None:
+        """Fill body ``body``'s elements from body ``old_body`` of Model ``old`` after a tear
+        renumbered the corners of its triangles ``changed`` (``Tear.changed``).
+
+        A tear neither moves nor reshapes a triangle, and a triangle it did not renumber keeps
+        its lowest vertex: the elements keep their order but for the renumbered ones, which
+        merge back in at their new lowest vertex. The arrays are those :func:`element_geometry`
+        makes of the torn topology (the same order, the same sums), made in one pass over
+        ``old``'s instead of a sort, with the rest shape plasticity moved carried along.
+        """
+        t0, t1 = self.body_elem_offsets[body], self.body_elem_offsets[body + 1]
+        o0, o1 = old.body_elem_offsets[old_body], old.body_elem_offsets[old_body + 1]
+        v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
+        _merged_elements(self.topologies[body].triangles, np.asarray(changed, np.int64), old.elem_source[o0:o1],
+                         old.elem_b[o0:o1], old.elem_area[o0:o1], old.elem_b0[o0:o1], old.elem_area0[o0:o1], v0,
+                         self.elem[t0:t1], self.elem_b[t0:t1], self.elem_area[t0:t1], self.elem_b0[t0:t1],
+                         self.elem_area0[t0:t1], self.elem_source[t0:t1], self.vertex_area[v0:v1])
 
     def rest_shape(self, body: int):
         """Body ``body``'s rest shape where plasticity moved it, in its topology's order:

@@ -488,11 +488,14 @@ class World:
         # the rest shapes plasticity moved live in the Model's arrays: take them over, body by
         # body (a torn body's vertices through the tear's source), so dents survive a rebuild
         old = getattr(self, "_model", None)
-        shapes = {}
+        shapes, torn = {}, {}
         if old is not None:
             for i, body in enumerate(getattr(self, "_model_bodies", ())):
                 was_fem = old.materials[i] is not None and old.materials[i].is_fem
                 if body._world is self and was_fem == body.is_fem:  # springs and elements do not convert
+                    if was_fem and body._tear_changed is not None:  # its elements, rest shape and all
+                        torn[body._index] = (old, i, body._tear_changed)
+                        continue
                     shape = old.rest_shape(i)
                     if any(part is not None for part in shape):
                         shapes[body] = shape
@@ -503,7 +506,7 @@ class World:
                             materials=[b.material for b in self._bodies],
                             pinned=[b._pinned for b in self._bodies],
                             contact=[self._contact_parameters(b) for b in self._bodies],
-                            pressure=[b._overrides["pressure"] for b in self._bodies])
+                            pressure=[b._overrides["pressure"] for b in self._bodies], torn=torn)
         for body, shape in shapes.items():
             src = body._tear_source
             self._model.take_rest_shape(body._index, shape, None if isinstance(src, slice) else src)
@@ -865,6 +868,7 @@ class World:
                 fresh[new_off[i] + body._tear_fresh] = True
                 body._tear_source = slice(None)
                 body._tear_fresh = np.zeros(0, np.int64)
+                body._tear_changed = None
             self._model.torn_from = (old.serial, source, fresh, self._model.version)
 
     def _check_shape(self) -> None:
