@@ -324,12 +324,12 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None):
     diag[held] += h * h * grab_pull[grab_slot[held], 0]
     if patch is None:
         fresh, source, first = np.ones(n, np.bool_), np.zeros(0, np.int64), np.zeros(0, np.int64)
-        old = (np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+        old = (np.zeros(1, np.int32), np.zeros(0, np.int32), np.zeros(0), np.zeros(0))
     else:
         a, old_diag, source, fresh = patch
         source = np.ascontiguousarray(source, dtype=np.int64)
         first = first_index(source, a.shape[0])
-        old = (a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, old_diag)
+        old = (a.indptr, a.indices, a.data, old_diag)  # SciPy's own arrays (int32 here): no copies
     ptr, ind, val = _assemble(diag, model.spring_i, model.spring_j,
                               h * h * model.spring_stiffness + h * model.spring_damping,
                               model.elem, model.elem_b, element_weights(model, h), model.pinned,
@@ -381,9 +381,12 @@ def _assemble(diag, si, sj, sw, tris, b, ew, pinned, fresh, source, first, optr,
     work = np.zeros(n)
     seen = np.zeros(n, np.bool_)
     rows = np.empty(n, np.int64)
-    ptr = np.zeros(n + 1, np.int64)
     size = n + 2 * ns + 6 * nt
-    ind = np.empty(size, np.int64)
+    if size >= 2 ** 31:
+        raise ValueError("_assemble: the matrix would have 2^31 entries or more")
+    # int32 indices, as SciPy keeps them (it would copy int64 ones down to int32)
+    ptr = np.zeros(n + 1, np.int32)
+    ind = np.empty(size, np.int32)
     val = np.empty(size)
     out = 0
     for j in range(n):
@@ -485,8 +488,10 @@ def _merge(ptr, ind, val, rows, cols, vals, pinned):
             er[fill[c]] = rows[k]
             ev[fill[c]] = vals[k]
             fill[c] += 1
-    out_ptr = np.zeros(n + 1, np.int64)
-    out_ind = np.empty(ind.shape[0] + er.shape[0], np.int64)
+    if ind.shape[0] + er.shape[0] >= 2 ** 31:
+        raise ValueError("_merge: the matrix would have 2^31 entries or more")
+    out_ptr = np.zeros(n + 1, np.int32)  # int32, as SciPy keeps them (it would copy int64 ones down)
+    out_ind = np.empty(ind.shape[0] + er.shape[0], np.int32)
     out_val = np.empty(ind.shape[0] + er.shape[0])
     out = 0
     for c in range(n):
@@ -530,7 +535,7 @@ def with_entries(a, rows, cols, vals, pinned) -> sp.csc_matrix:
     """
     import scipy.sparse as sp
 
-    ptr, ind, val = _merge(a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data,
+    ptr, ind, val = _merge(a.indptr, a.indices, a.data,
                            np.asarray(rows, dtype=np.int64), np.asarray(cols, dtype=np.int64),
                            np.asarray(vals, dtype=np.float64), np.asarray(pinned, dtype=np.bool_))
     out = sp.csc_matrix((val, ind, ptr), shape=a.shape)

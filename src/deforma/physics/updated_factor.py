@@ -371,8 +371,6 @@ class UpdatedFactor:
 
     def _reference(self, a):
         self._a = a
-        # its CSC arrays as the blocks pass reads them, made once rather than at every update
-        self._a64 = (a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data)
         self._lu = factor(a)
         self._n0 = a.shape[0]
         self._tol = ROUNDING * float(np.abs(a.diagonal()).max(initial=0.0))
@@ -414,8 +412,8 @@ class UpdatedFactor:
             if len(cols) and (cols[0] < 0 or cols[-1] >= n0):
                 raise ValueError("cols must be rows of the reference")
         dr, dc, dv, b_ptr, b_ind, b_val, c_ptr, c_ind, c_val, d = _blocks(
-            a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data, ref, copies, n0,
-            *self._a64, self._tol, most - nc,
+            a.indptr, a.indices, a.data, ref, copies, n0,  # SciPy's own arrays: no copies
+            self._a.indptr, self._a.indices, self._a.data, self._tol, most - nc,
             np.arange(n0) if cols is None else np.ascontiguousarray(cols, dtype=np.int64))
         r = np.union1d(dr, dc)
         ko = len(r)
