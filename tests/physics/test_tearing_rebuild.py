@@ -105,7 +105,7 @@ def reference_tear(topo, x, limit, tips):
             share.append(part)
             for f in members:
                 new_t[f][new_t[f] == v] = len(source) - 1
-    return new_t.astype(np.int32), np.array(source, np.int64), np.array(share)
+    return new_t, np.array(source, np.int64), np.array(share)
 
 
 def torn_sheet(model, integrator, steps, detail=12):

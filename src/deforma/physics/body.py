@@ -77,6 +77,7 @@ class Body:
         self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
         self._tear_fresh = np.zeros(0, np.int64)  # and the vertices whose springs, elements or mass it changed
+        self._tear_changed = None  # and the rows of the triangles it renumbered (None: no tear)
         self._cracks = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
 
     def _tear_view(self):
@@ -102,10 +103,12 @@ class Body:
         self._tear_topology = (self.topology, tt)  # the tear check's view of the torn mesh, kept
         uv = getattr(self.mesh, "uv", None)
         if uv is not None and len(uv) == t.n_vertices:
-            self.mesh = Mesh._trusted(t.rest_positions[src], cut.triangles, np.asarray(uv)[src],
+            torn = self.topology  # the mesh's own copies of its rest positions and triangles
+            self.mesh = Mesh._trusted(torn.rest_positions.copy(), torn.triangles.copy(), np.asarray(uv)[src],
                                       getattr(self.mesh, "texture", None))
         self._pinned = self._pinned[src]
         self._tear_source = src
+        self._tear_changed = cut.changed
         self._cracks = (self.topology, cut.tips)
         self._overrides["pressure"] = None  # the gas escapes through the tear
 

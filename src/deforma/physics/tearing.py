@@ -57,8 +57,9 @@ class Tear:
 
     Attributes
     ----------
-    triangles : (M, 3) int32
-        The same triangles, in the same order, with split corners renumbered.
+    triangles : (M, 3) int64
+        The same triangles, in the same order, with split corners renumbered (the dtype of
+        :attr:`TearTopology.triangles`, which the torn mesh's takes over).
     source : (N', ) int64
         For every vertex of the torn mesh, the vertex it is a copy of (``source[k] = k`` for
         the first ``N`` vertices): positions, velocities, texture coordinates and pins
@@ -173,55 +174,13 @@ def _torn(topo: TearTopology, rest, cut: "Tear"):
     split triangle: its numbers are new)."""
     rest = np.asarray(rest, dtype=np.float64)
     t = np.ascontiguousarray(cut.triangles, dtype=np.int64)
-    keys, pairs, tri_pair, two, tri_edge, origin, ptr, vtris = torn_edges(
+    keys, pairs, tri_pair, tri_edge, origin, ptr, vtris, boundary, inner, inner_tri, normal, fresh = torn_edges(
         topo.triangles, t, topo.pairs, topo.tri_pair, topo.tri_edge, len(rest), topo.vertex_ptr, topo.vertex_tris,
-        np.ascontiguousarray(cut.source, dtype=np.int64))
-    boundary, inner, inner_tri, normal, fresh = _torn_inner(two, pairs, tri_pair, origin, topo.tri_pair, topo.normal,
-                                                            len(rest))
+        np.ascontiguousarray(cut.source, dtype=np.int64), topo.normal)
     normal[fresh] = _rest_normals(rest, pairs[inner[fresh]])  # the rebuilt interior edges'
     tt = TearTopology(t, pairs, tri_pair, inner, boundary, topo.b, topo.area, normal, keys, ptr, vtris, tri_edge,
                       inner_tri)
     return tt, origin
-
-
-@njit(cache=True)
-def _torn_inner(two, pairs, tri_pair, origin, old_tri_pair, old_normal, n):
-    """The outline vertices, interior edges, their triangles and rest normals of a torn edge
-    table (:func:`torn_edges`): a kept interior edge's normal is its old one; the rows of
-    the others (returned as ``fresh``, indices into ``inner``) are left for the caller."""
-    boundary = np.zeros(n, np.bool_)
-    count = 0
-    for e in range(two.shape[0]):
-        if two[e]:
-            count += 1
-        else:
-            boundary[pairs[e, 0]] = True
-            boundary[pairs[e, 1]] = True
-    row = np.empty(old_tri_pair.shape[0], np.int64)  # an old interior edge's row in old_normal
-    r = 0
-    for e in range(old_tri_pair.shape[0]):
-        row[e] = r
-        if old_tri_pair[e, 1] >= 0:
-            r += 1
-    inner = np.empty(count, np.int64)
-    inner_tri = np.empty((count, 2), np.int64)
-    normal = np.empty((count, 2))
-    fresh = np.empty(count, np.int64)
-    nf = 0
-    i = 0
-    for e in range(two.shape[0]):
-        if not two[e]:
-            continue
-        inner[i] = e
-        inner_tri[i, 0], inner_tri[i, 1] = tri_pair[e, 0], tri_pair[e, 1]
-        o = origin[e]
-        if o >= 0:
-            normal[i, 0], normal[i, 1] = old_normal[row[o], 0], old_normal[row[o], 1]
-        else:
-            fresh[nf] = i
-            nf += 1
-        i += 1
-    return boundary, inner, inner_tri, normal, fresh[:nf]
 
 
 def edge_table(n: int, t):
@@ -307,19 +266,23 @@ def _edge_table(n, t):
 
 
 @njit(cache=True)
-def torn_edges(t_old, t, pairs, tri_pair, tri_edge, n, vertex_ptr, vertex_tris, source):
+def torn_edges(t_old, t, pairs, tri_pair, tri_edge, n, vertex_ptr, vertex_tris, source, normal):
     """:func:`edge_table` of triangles ``t`` (M, 3) over ``n`` vertices, patched from that of
     ``t_old`` (``pairs``, ``tri_pair``, ``tri_edge``; the triangles around each vertex
-    ``vertex_ptr``, ``vertex_tris``): the same triangles with some corners renumbered (a
-    tear), vertex ``i`` a copy of ``source[i]``. Only the edges of changed triangles are
-    sorted again; the others keep their pairs and triangles and move in one merge, and a
-    vertex no changed triangle touches keeps its list of triangles.
+    ``vertex_ptr``, ``vertex_tris``; the interior edges' rest normals ``normal``): the same
+    triangles with some corners renumbered (a tear), vertex ``i`` a copy of ``source[i]``.
+    Only the edges of changed triangles are sorted again; the others keep their pairs,
+    triangles and normals and move in one merge, and a vertex no changed triangle touches
+    keeps its list of triangles.
 
-    Returns ``(keys, pairs, tri_pair, two, tri_edge, origin, vertex_ptr, vertex_tris)``: those
-    of :func:`edge_table` (``tri_edge`` as (M, 3)), ``origin`` (E',) each edge's index in
-    ``pairs`` when it is an edge of ``t_old`` untouched by the change (else -1), and the
-    triangles around each vertex (CSR, in triangle order) as :meth:`TearTopology.of` lists
-    them. 0.3 ms for a tear of a 1e4-vertex sheet, against 1.5 ms to build them again.
+    Returns ``(keys, pairs, tri_pair, tri_edge, origin, vertex_ptr, vertex_tris, boundary,
+    inner, inner_tri, normal, fresh)``: those of :func:`edge_table` (``tri_edge`` as (M,
+    3)); ``origin`` (E',) each edge's index in ``pairs`` when it is an edge of ``t_old``
+    untouched by the change (else -1); the triangles around each vertex (CSR, in triangle
+    order) as :meth:`TearTopology.of` lists them; :class:`TearTopology`'s ``boundary``,
+    ``inner``, ``inner_tri`` and ``normal``, whose rows ``fresh`` (indices into ``inner``:
+    the rebuilt interior edges) are left for the caller to measure. 0.3 ms for a tear of a
+    1e4-vertex sheet, against 1.5 ms to build them again.
     """
     m = t.shape[0]
     ne = pairs.shape[0]
@@ -371,10 +334,19 @@ def torn_edges(t_old, t, pairs, tri_pair, tri_edge, n, vertex_ptr, vertex_tris, 
     origin = np.full(total, -1, np.int64)
     out_edge = np.empty((m, 3), np.int64)
     moved = np.empty(ne, np.int64)  # a kept edge's new index
+    boundary = np.zeros(n, np.bool_)
+    inner = np.empty(total, np.int64)
+    inner_tri = np.empty((total, 2), np.int64)
+    out_normal = np.empty((total, 2))
+    fresh = np.empty(total, np.int64)
+    n_inner, n_fresh = 0, 0
     # merge the kept edges (in their order) with the rebuilt ones (sorted), both by key
     e, i, out = 0, 0, 0
+    row = 0  # the interior edges of t_old before e: e's row in normal
     while out < total:
         while e < ne and hit[e]:
+            if tri_pair[e, 1] >= 0:
+                row += 1
             e += 1
         if e < ne and i < count and pairs[e, 0] * n + pairs[e, 1] == hkey[order[i]]:
             raise ValueError("torn_edges: t_old's edge table is not that of t_old")  # a kept edge is never rebuilt
@@ -386,6 +358,11 @@ def torn_edges(t_old, t, pairs, tri_pair, tri_edge, n, vertex_ptr, vertex_tris, 
             two[out] = tri_pair[e, 1] >= 0
             origin[out] = e
             moved[e] = out
+            if two[out]:
+                if row >= normal.shape[0]:  # Numba does not check indices
+                    raise ValueError("torn_edges: fewer normals than interior edges")
+                out_normal[n_inner, 0], out_normal[n_inner, 1] = normal[row, 0], normal[row, 1]
+                row += 1
             e += 1
         else:
             key = hkey[order[i]]
@@ -402,6 +379,16 @@ def torn_edges(t_old, t, pairs, tri_pair, tri_edge, n, vertex_ptr, vertex_tris, 
             two[out] = c == 2
             if c != 2:  # an edge of three or more triangles is no interior edge either
                 out_tri[out, 1] = -1
+            else:  # an interior edge, at n_inner below: its normal is new
+                fresh[n_fresh] = n_inner
+                n_fresh += 1
+        if two[out]:
+            inner[n_inner] = out
+            inner_tri[n_inner, 0], inner_tri[n_inner, 1] = out_tri[out, 0], out_tri[out, 1]
+            n_inner += 1
+        else:
+            boundary[out_pairs[out, 0]] = True
+            boundary[out_pairs[out, 1]] = True
         out += 1
     for f in range(m):
         if not changed[f]:
@@ -432,7 +419,8 @@ def torn_edges(t_old, t, pairs, tri_pair, tri_edge, n, vertex_ptr, vertex_tris, 
         ptr[v + 1] = out
     if out != 3 * m:
         raise ValueError("torn_edges: a corner of t is in no source's list of triangles")
-    return keys, out_pairs, out_tri, two, out_edge, origin, ptr, vtris
+    return (keys, out_pairs, out_tri, out_edge, origin, ptr, vtris, boundary, inner[:n_inner], inner_tri[:n_inner],
+            out_normal[:n_inner], fresh[:n_fresh])
 
 
 @njit(cache=True)
@@ -539,7 +527,7 @@ def tear_mesh(topo: TearTopology, x, tear_strain, strain=None, tips=()):
                                            topo.vertex_tris, topo.area, np.unique(topo.pairs[cut].ravel()), n)
     if len(source) == n:
         return None
-    return Tear(new_t.astype(np.int32), source, share, topo.pairs[cut].astype(np.int32), new_tips,
+    return Tear(new_t, source, share, topo.pairs[cut].astype(np.int32), new_tips,
                 np.flatnonzero(renumbered))
 
 
@@ -552,7 +540,6 @@ def _choose_cuts(candidates, pairs, boundary, is_tip, n, tri_pair, tri_edge):
     running = is_tip.any()
     used = np.zeros(n, np.bool_)
     out = np.empty(len(candidates), np.int64)
-    seen = np.full(tri_edge.shape[0], -1, np.int64)
     c = 0
     for e in candidates:
         a, b = pairs[e, 0], pairs[e, 1]
@@ -562,7 +549,7 @@ def _choose_cuts(candidates, pairs, boundary, is_tip, n, tri_pair, tri_edge):
             continue
         if not running and c == 1:
             break
-        if _chip(e, tri_pair, tri_edge, seen):  # last: the search for the only edges that could be cut
+        if _chip(e, tri_pair, tri_edge):  # last: the search for the only edges that could be cut
             continue
         used[a] = True
         used[b] = True
@@ -577,7 +564,7 @@ MIN_PIECE = 4
 
 
 @njit(cache=True)
-def _chip(e, tri_pair, tri_edge, seen):
+def _chip(e, tri_pair, tri_edge):
     """Whether cutting interior edge ``e`` would cut off a chip: fewer than ``MIN_PIECE``
     triangles joined to one side across uncut edges, and at least that many on the other.
 
@@ -585,29 +572,27 @@ def _chip(e, tri_pair, tri_edge, seen):
     time, which flew about as confetti (15 single triangles off the clamped 1e4-vertex sheet
     of ``benchmarks/bench_behaviours.py`` under symplectic Euler). Such a triangle now stays,
     a flap on its last edges, as a torn cloth's frayed edge does. Both sides are searched
-    no further than ``MIN_PIECE`` triangles; ``seen`` (M,) is scratch marks, -1 at first
-    and left with this call's own (``2 e`` and ``2 e + 1``: distinct for every edge).
+    no further than ``MIN_PIECE`` triangles, so the triangles found are kept in a list of
+    that many (a mark per triangle of the mesh cost more to clear than the search).
     """
     size = np.zeros(2, np.int64)
-    stack = np.empty(MIN_PIECE, np.int64)
+    found = np.empty(MIN_PIECE, np.int64)  # the side's triangles found, the first `count`
     for side in range(2):
-        stamp = 2 * e + side  # marks of other calls and of the other side read as unseen
-        f0 = tri_pair[e, side]
-        seen[f0] = stamp
-        stack[0] = f0
-        top, count = 1, 1
-        while top > 0 and count < MIN_PIECE:
-            top -= 1
-            f = stack[top]
+        found[0] = tri_pair[e, side]
+        done, count = 0, 1  # found[done:count] are still to visit
+        while done < count and count < MIN_PIECE:
+            f = found[done]
+            done += 1
             for k in range(3):
                 g = tri_edge[f, k]
-                if g == e or tri_pair[g, 1] < 0:
+                if g == e or tri_pair[g, 1] < 0 or count >= MIN_PIECE:
                     continue
                 h = tri_pair[g, 0] if tri_pair[g, 1] == f else tri_pair[g, 1]
-                if seen[h] != stamp and count < MIN_PIECE:
-                    seen[h] = stamp
-                    stack[top] = h
-                    top += 1
+                known = False
+                for q in range(count):
+                    known = known or found[q] == h
+                if not known:
+                    found[count] = h
                     count += 1
         size[side] = count
     small, large = min(size[0], size[1]), max(size[0], size[1])
@@ -708,7 +693,7 @@ def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
     share = share * cut.mass_share
     tt, origin = _torn(tear_topology, rest, cut)
     rest_length = None
-    if np.array_equal(topology.springs, tear_topology.pairs):  # its springs are its triangles' edges
+    if _same_pairs(topology.springs, tear_topology.pairs):  # its springs are its triangles' edges
         # a kept edge keeps its rest length; the new ones are measured as _trusted measures them
         rest_length = np.take(topology.spring_rest_length, np.maximum(origin, 0))
         new = np.flatnonzero(origin < 0)
@@ -719,22 +704,42 @@ def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
 
 
 @njit(cache=True)
+def _same_pairs(a, b):
+    """``np.array_equal(a, b)`` for (E, 2) integer arrays of any two dtypes, in one pass
+    without temporaries."""
+    if a.shape[0] != b.shape[0] or a.shape[1] != b.shape[1]:
+        return False
+    for i in range(a.shape[0]):
+        for k in range(a.shape[1]):
+            if a[i, k] != b[i, k]:
+                return False
+    return True
+
+
+@njit(cache=True)
 def _outline_edges(t, tri_edge, tri_pair):
     """The half-edges (B, 2) of triangles ``t`` that lie in one triangle, in half-edge order
-    (``k M + f``: corners 0-1 of every triangle, then 1-2, then 2-0)."""
+    (``k M + f``: corners 0-1 of every triangle, then 1-2, then 2-0). Found from the edges
+    (``tri_pair``'s second triangle -1; a mesh has no edge of three), whose few half-edges
+    are then sorted, rather than by reading the edge of every half-edge."""
     m = t.shape[0]
     count = 0
-    for f in range(m):
-        for k in range(3):
-            if tri_pair[tri_edge[f, k], 1] < 0:
-                count += 1
-    out = np.empty((count, 2), np.int64)
+    for e in range(tri_pair.shape[0]):
+        if tri_pair[e, 1] < 0:
+            count += 1
+    half = np.empty(count, np.int64)
     q = 0
-    for k in range(3):
-        for f in range(m):
-            if tri_pair[tri_edge[f, k], 1] < 0:
-                out[q, 0], out[q, 1] = t[f, k], t[f, (k + 1) % 3]
-                q += 1
+    for e in range(tri_pair.shape[0]):
+        if tri_pair[e, 1] < 0:
+            f = tri_pair[e, 0]
+            k = 0 if tri_edge[f, 0] == e else (1 if tri_edge[f, 1] == e else 2)
+            half[q] = k * m + f
+            q += 1
+    half.sort()
+    out = np.empty((count, 2), np.int64)
+    for q in range(count):
+        f, k = half[q] % m, half[q] // m
+        out[q, 0], out[q, 1] = t[f, k], t[f, (k + 1) % 3]
     return out
 
 
