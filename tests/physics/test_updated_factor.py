@@ -85,6 +85,41 @@ def test_a_split_alone_adds_only_the_copies_columns():
     assert f.rank == 1 and f.solves == 1
 
 
+class CountingFactor:
+    """A SuperLU factor that counts the calls into it."""
+
+    def __init__(self, lu):
+        self.lu, self.calls = lu, 0
+
+    def solve(self, b):
+        self.calls += 1
+        return self.lu.solve(b)
+
+
+def test_update_solves_the_callers_right_side_with_its_new_columns():
+    n, springs = grid(10)
+    w, mass = np.full(len(springs), 10.0), np.ones(n)
+    f = UpdatedFactor(spring_matrix(n, springs, w, mass))
+    f.max_share = 1.0
+    f._lu = counting = CountingFactor(f._lu)
+    springs, mass, ref = split(n, springs, 55)
+    a = spring_matrix(n + 1, springs, w, mass)
+    b = np.random.default_rng(1).normal(size=(n + 1, 2))
+    assert f.update(a, ref, rhs=b)
+    assert f.solves == 1 and counting.calls == 1  # the copy's column and b: one call
+    expected = spla.splu(a).solve(b)
+    assert np.abs(f.solution - expected).max() <= 1e-12 * np.abs(expected).max()
+    assert np.abs(f.solve(b) - f.solution).max() <= 1e-12 * np.abs(expected).max()  # as a solve after it
+    # no new column: b alone; nothing to correct: the reference factor's own solve
+    assert f.update(a, ref, rhs=b[:, 0]) and counting.calls == 3
+    assert np.abs(f.solution - expected[:, 0]).max() <= 1e-12 * np.abs(expected).max()
+    assert f.update(f._a, np.arange(n), rhs=b[:n]) and f.rank == 0
+    assert np.array_equal(f.solution, counting.lu.solve(b[:n]))
+    # declined (too many columns for max_rank): no solution, nothing solved
+    f.max_rank = 0
+    assert not f.update(a, ref, rhs=b) and f.solution is None
+
+
 def split(n, springs, v, moved_count=3):
     """``springs`` with vertex ``v``'s first ``moved_count`` springs moved to a copy ``n``,
     the masses (v keeps 0.6) and the map to the reference rows."""

@@ -653,14 +653,16 @@ class ImplicitEuler:
         source = torn[1]
         return np.array_equal(old[3][source], inputs.grab_slot) and np.array_equal(old[4], inputs.grab_pull[:, 0])
 
-    def _factor_if_needed(self, model, touching, triples, s):
+    def _matrix_if_changed(self, model, touching, triples, s):
+        """The matrix with this contact set, when it differs from the one the factor solves
+        with (``None``: the factor stands); :meth:`_take` gives it to the factor."""
         # The vertices in collider contact add their weight to the diagonal, the body
         # contacts their vertex-to-edge-point springs: a new set changes the matrix. A body
         # contact keeps the edge parameter s it had when the matrix was built (it is in the
         # matrix), so a resting heap, whose s only jitters, keeps its factor.
         if self._touching is not None and self._weight_used == self.contact_weight \
                 and np.array_equal(self._touching, touching) and np.array_equal(self._triples, triples):
-            return
+            return None
         s = s.copy()
         if self._touching is not None and len(triples) and len(self._triples):
             # a pair that stays keeps its s: only the pairs that come or go change the matrix,
@@ -682,18 +684,23 @@ class ImplicitEuler:
             vals = np.concatenate([self._contact_weight,
                                    (self._pair_weight[:, None, None] * co[:, :, None] * co[:, None, :]).ravel()])
             a = with_entries(a, rows, cols, vals, model.pinned)
+        return a
+
+    def _take(self, model, a, b) -> np.ndarray:
+        """Solve with matrix ``a`` (:meth:`_matrix_if_changed`) from now on; returns ``a^-1 b``."""
         # A small change (a tear, a new contact set, a grab) is taken into the factor by a
-        # low-rank correction; a large one, or one whose rows are unknown, factors again.
-        listed = np.concatenate([touching, triples.ravel()])
+        # low-rank correction, which solves b with its new columns (one call into the factor,
+        # not two); a large one, or one whose rows are unknown, factors again.
+        listed = np.concatenate([self._touching, self._triples.ravel()])
         if self._ref is not None:
             cols = None
             if self._dirty is not None:  # what may differ: changed columns, and those of either's contacts
                 mask = self._dirty.copy()
                 mask[listed] = True
                 cols = np.union1d(self._ref[mask], self._ref_contacts)
-            if self._factor.update(a, self._ref, cols):
+            if self._factor.update(a, self._ref, cols, rhs=b):
                 self.updates += 1
-                return
+                return self._factor.solution
         if self._factor is None:
             self._factor = UpdatedFactor(a)
         else:
@@ -702,6 +709,7 @@ class ImplicitEuler:
         self._dirty = np.zeros(model.n_vertices, bool)
         self._ref_contacts = np.unique(listed)
         self.factorizations += 1
+        return self._factor.solve(b)
 
     def advance(self, model, state, inputs, h, substeps):
         if isinstance(self.iterations, bool) or not isinstance(self.iterations, (int, np.integer)) \
@@ -751,7 +759,7 @@ class ImplicitEuler:
             cv = topo.cv_vertex
             edge = buf.edge[:n_body]
             triples = np.stack([cv[buf.vertex[:n_body]], cv[topo.ce_a[edge]], cv[topo.ce_b[edge]]], axis=1)
-            self._factor_if_needed(model, self._touch[:count], triples, buf.s[:n_body])
+            changed = self._matrix_if_changed(model, self._touch[:count], triples, buf.s[:n_body])
             self._listed = np.concatenate([self._touch[:count], triples.ravel()])  # the vertices the contacts read
             for it in range(self.iterations):
                 implicit_rhs(x, x_n, y, self._mass, model.spring_i, model.spring_j, model.spring_rest_length,
@@ -773,7 +781,11 @@ class ImplicitEuler:
                 body_contact_rhs(z, x_n, self._triples, self._s, self._pair_weight, buf.normal, buf.target, buf.mu,
                                  n_body, b)
                 b[self._pinned] = x_n[self._pinned]  # pinned: x_p = where it is
-                x[...] = self._factor.solve(b)
+                if changed is not None:  # the first solve with a new matrix
+                    x[...] = self._take(model, changed, b)
+                    changed = None
+                else:
+                    x[...] = self._factor.solve(b)
             bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
             if bad:
                 return bad

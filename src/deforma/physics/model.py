@@ -277,17 +277,15 @@ def _sorted_elements(c, b, area, n):
     areas (summed in that order), and the order: one compiled pass each, where NumPy's
     gathers and bincount took 0.7 ms for a 1e4-vertex sheet, at every tear."""
     m = c.shape[0]
+    lumped = np.zeros(n)
+    _lumped(c, area, lumped)  # checks the indices too
     low = np.empty(m, np.int64)
     for f in range(m):
-        for k in range(3):
-            if c[f, k] < 0 or c[f, k] >= n:  # Numba does not check indices: refuse rather than write astray
-                raise ValueError("element_geometry: a triangle's vertex outside [0, n)")
         low[f] = min(c[f, 0], c[f, 1], c[f, 2])
     order = counting_order(low, n)
     tri = np.empty((m, 3), c.dtype)
     bs = np.empty((m, 4))
     ar = np.empty(m)
-    lumped = np.zeros(n)
     for i in range(m):
         f = order[i]
         for k in range(3):
@@ -295,64 +293,21 @@ def _sorted_elements(c, b, area, n):
         for k in range(4):
             bs[i, k] = b[f, k]
         ar[i] = area[f]
-        third = area[f] / 3.0
-        for k in range(3):
-            lumped[c[f, k]] += third
     return tri, bs, ar, lumped, order
 
 
 @njit(cache=True)
-def _merged_elements(c, changed, old_order, old_b, old_area, old_b0, old_area0, v0, tri, bs, ar, b0, ar0, order,
-                     lumped):
-    """Model._torn_elements' pass: the elements of triangles ``c`` (M, 3) in the order of
-    their lowest vertex, from the old arrays (``old_order`` their rows, ``old_b``...) where
-    the triangles ``changed`` were renumbered; written into ``tri`` (plus ``v0``), ``bs``,
-    ``ar``, ``b0``, ``ar0``, ``order``, and each vertex's third of its triangles' rest areas
-    added to ``lumped`` (in that order, as :func:`_sorted_elements` sums them)."""
-    m = c.shape[0]
-    n = lumped.shape[0]
-    for f in range(m):
+def _lumped(c, area, out):
+    """Add a third of each triangle's ``area`` to each of its corners ``c`` (M, 3) in
+    ``out``, triangle by triangle in row order: the same sums however the elements are
+    ordered (a torn body keeps its order, a new one is sorted)."""
+    n = out.shape[0]
+    for f in range(c.shape[0]):
+        third = area[f] / 3.0
         for k in range(3):
             if c[f, k] < 0 or c[f, k] >= n:  # Numba does not check indices: refuse rather than write astray
-                raise ValueError("Model: a torn triangle's vertex outside [0, n)")
-    at = np.empty(m, np.int64)  # each triangle's row in the old arrays
-    for i in range(m):
-        at[old_order[i]] = i
-    moved = np.zeros(m, np.bool_)
-    nc = changed.shape[0]
-    key = np.empty(nc, np.int64)  # the renumbered ones by (new lowest vertex, row): the stable order
-    for j in range(nc):
-        f = changed[j]
-        moved[f] = True
-        key[j] = min(c[f, 0], c[f, 1], c[f, 2]) * np.int64(m) + f
-    key.sort()
-    i = 0
-    j = 0
-    for p in range(m):
-        while i < m and moved[old_order[i]]:
-            i += 1
-        take = j < nc
-        if take and i < m:
-            g = old_order[i]
-            take = key[j] < min(c[g, 0], c[g, 1], c[g, 2]) * np.int64(m) + g
-        if take:
-            f = key[j] % m
-            j += 1
-        else:
-            f = old_order[i]
-            i += 1
-        order[p] = f
-        q = at[f]
-        for k in range(3):
-            tri[p, k] = c[f, k] + v0
-        for k in range(4):
-            bs[p, k] = old_b[q, k]
-            b0[p, k] = old_b0[q, k]
-        ar[p] = old_area[q]
-        ar0[p] = old_area0[q]
-        third = old_area0[q] / 3.0
-        for k in range(3):
-            lumped[c[f, k]] += third
+                raise ValueError("lumped areas: a triangle's vertex outside [0, n)")
+            out[c[f, k]] += third
 
 
 def _outline(x: np.ndarray, edges: np.ndarray):
@@ -449,7 +404,9 @@ class Model:
     elem : (T, 3) int32
         Triangle elements (global vertex indices, counter-clockwise at rest), each body's
         sorted by their lowest vertex (so a run of elements touches a narrow band of
-        vertices).
+        vertices); a torn body's keep the order they had (a few renumbered corners aside,
+        the same band). ``elem_source`` (T,) int64: each element's row in its body's
+        ``topology.triangles``.
     elem_b : (T, 4) float64
         Rest-shape inverses ``B`` (row-major, 1/m); see :mod:`deforma.physics.elements`.
     elem_area : (T,) float64
@@ -494,10 +451,10 @@ class Model:
         see :mod:`deforma.physics.contacts`.
 
     The constructor takes the bodies' topologies and parameters (lists, one entry per body);
-    ``torn``, a dict from a finite-element body to ``(Model before, its index there, rows of
-    the triangles a tear renumbered)``, builds that body's elements from the Model before
-    (the same arrays, with its rest shape where plasticity moved it) instead of from its
-    topology.
+    ``torn``, a dict from a finite-element body to ``(Model before, its index there)`` when a
+    tear made the body's topology from that one's, builds that body's elements from the
+    Model before (the same elements in the same order, with the rest shape plasticity
+    moved) instead of from its topology.
 
     Examples
     --------
@@ -622,23 +579,25 @@ class Model:
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
 
-    def _torn_elements(self, body: int, old: "Model", old_body: int, changed) -> None:
-        """Fill body ``body``'s elements from body ``old_body`` of Model ``old`` after a tear
-        renumbered the corners of its triangles ``changed`` (``Tear.changed``).
-
-        A tear neither moves nor reshapes a triangle, and a triangle it did not renumber keeps
-        its lowest vertex: the elements keep their order but for the renumbered ones, which
-        merge back in at their new lowest vertex. The arrays are those :func:`element_geometry`
-        makes of the torn topology (the same order, the same sums), made in one pass over
-        ``old``'s instead of a sort, with the rest shape plasticity moved carried along.
-        """
+    def _torn_elements(self, body: int, old: "Model", old_body: int) -> None:
+        """Fill body ``body``'s elements from body ``old_body`` of Model ``old``, which a tear
+        turned into this one: it keeps the triangles, in order, with corners at the same rest
+        positions (some renumbered onto copies), so the elements keep their order, rest shape
+        (as built and where plasticity moved it) and parameters; only their corners are
+        read again. Copies, where building them sorted and gathered every row."""
         t0, t1 = self.body_elem_offsets[body], self.body_elem_offsets[body + 1]
         o0, o1 = old.body_elem_offsets[old_body], old.body_elem_offsets[old_body + 1]
         v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
-        _merged_elements(self.topologies[body].triangles, np.asarray(changed, np.int64), old.elem_source[o0:o1],
-                         old.elem_b[o0:o1], old.elem_area[o0:o1], old.elem_b0[o0:o1], old.elem_area0[o0:o1], v0,
-                         self.elem[t0:t1], self.elem_b[t0:t1], self.elem_area[t0:t1], self.elem_b0[t0:t1],
-                         self.elem_area0[t0:t1], self.elem_source[t0:t1], self.vertex_area[v0:v1])
+        t = self.topologies[body]
+        if t1 - t0 != o1 - o0:
+            raise ValueError("a torn body keeps its triangles: the Model before has another number of them")
+        order = old.elem_source[o0:o1]
+        self.elem_source[t0:t1] = order
+        np.add(t.triangles[order], v0, out=self.elem[t0:t1], casting="unsafe")
+        for name in ("elem_b", "elem_area", "elem_b0", "elem_area0"):
+            getattr(self, name)[t0:t1] = getattr(old, name)[o0:o1]
+        area = t.geometry[1] if t.geometry is not None else rest_geometry(t.rest_positions, t.triangles)[1]
+        _lumped(t.triangles, np.ascontiguousarray(area), self.vertex_area[v0:v1])  # as element_geometry sums them
 
     def rest_shape(self, body: int):
         """Body ``body``'s rest shape where plasticity moved it, in its topology's order:

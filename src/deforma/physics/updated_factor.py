@@ -349,6 +349,8 @@ class UpdatedFactor:
     solves : int
         Columns solved with the reference factor to build corrections (a measure of the
         updates' cost).
+    solution : ndarray or None
+        The solution of the right-hand side the last :meth:`update` was given.
 
     Examples
     --------
@@ -367,6 +369,7 @@ class UpdatedFactor:
         self.max_rank = MAX_RANK
         self.max_share = MAX_SHARE
         self.solves = 0
+        self.solution = None
         self._reference(a)
 
     def _reference(self, a):
@@ -384,7 +387,7 @@ class UpdatedFactor:
         self.rank = 0
         self._ref = None  # the current matrix is A_R itself
 
-    def update(self, a: "sp.csc_matrix", ref: np.ndarray, cols=None) -> bool:
+    def update(self, a: "sp.csc_matrix", ref: np.ndarray, cols=None, rhs=None) -> bool:
         """Solve with ``a`` from now on, where current vertex ``i`` comes from reference vertex
         ``ref[i]`` (every reference vertex at least once). Returns False, changing nothing,
         when the correction would be too large or ill-conditioned: factor ``a`` instead
@@ -392,7 +395,14 @@ class UpdatedFactor:
 
         ``cols``: when the caller knows them, the reference vertices whose columns may differ
         (those of every changed entry, copy or copy's neighbour); only they are compared.
+
+        ``rhs``: a right-hand side ((n,) or (n, k)) the caller will solve next: it is solved
+        with ``a`` in the same call into the factor as the correction's new columns (a call
+        costs about a right-hand side more than its columns: 0.5 ms for one on a 1e4-vertex
+        sheet, 0.25 ms for each one more), and left in :attr:`solution` (``None`` when
+        this returns False).
         """
+        self.solution = None
         import scipy.linalg as sla
 
         n, n0 = a.shape[0], self._n0
@@ -422,13 +432,16 @@ class UpdatedFactor:
             return False
         if k == 0:
             self._identity()
+            if rhs is not None:
+                self.solution = self._lu.solve(rhs)
             return True
         delta = np.zeros((ko, ko))
         np.add.at(delta, (np.searchsorted(r, dr), np.searchsorted(r, dc)), dv)
         b = (b_ptr, b_ind, b_val)
         keys = [("row", int(x)) for x in r] + [
             b_ind[b_ptr[j]:b_ptr[j + 1]].tobytes() + b_val[b_ptr[j]:b_ptr[j + 1]].tobytes() for j in range(nc)]
-        slots = self._columns(keys, b)
+        extra = None if rhs is None else _gather(rhs.reshape(n, -1), first, ref, copies)
+        slots, u = self._columns(keys, b, extra)
         m = _small_system(self._store, slots, r, delta, c_ptr, c_ind, c_val, d)
         if not np.all(np.isfinite(m)):
             return False
@@ -441,19 +454,29 @@ class UpdatedFactor:
         self._delta, self._r, self._c = delta, r, (c_ptr, c_ind, c_val)
         self._ref, self._copies, self._primary = ref, copies, first
         self.rank = k
+        if rhs is not None:
+            self.solution = self._corrected(u, rhs)
         return True
 
     def refactor(self, a: "sp.csc_matrix") -> None:
         """Factor ``a``, which becomes the reference."""
         self._reference(a)
 
-    def _columns(self, keys, b) -> np.ndarray:
+    def _columns(self, keys, b, extra=None):
         """Slots of the store holding the solved column of each key (``("row", r)``: the
         identity's column ``r``; bytes: copy ``j``'s column of ``B``, CSC arrays ``b``), solving the missing
-        ones in one batch; columns no key names may be dropped to make room."""
+        ones in one batch; columns no key names may be dropped to make room. ``extra``
+        (n0, w): more right-hand sides for the same batch; returns ``(slots, their
+        solutions)`` (``None`` without)."""
         missing = [t for t, key in enumerate(keys) if key not in self._slot]
+        w = 0 if extra is None else extra.shape[1]
+        solved_extra = None
+        if not missing and extra is not None:
+            solved_extra = self._lu.solve(extra)
         if missing:
-            rhs = np.zeros((self._n0, len(missing)), order="F")
+            rhs = np.zeros((self._n0, len(missing) + w), order="F")
+            if w:
+                rhs[:, len(missing):] = extra
             b_ptr, b_ind, b_val = b
             nr = sum(isinstance(key, tuple) for key in keys)
             for col, t in enumerate(missing):
@@ -465,6 +488,8 @@ class UpdatedFactor:
                     rhs[b_ind[lo:hi], col] = b_val[lo:hi]
             self.solves += len(missing)
             solved = self._lu.solve(rhs)
+            if w:
+                solved_extra = solved[:, len(missing):]
             used = set(self._slot[key] for key in keys if key in self._slot)
             if self._ref is not None:  # the correction in use keeps its columns until replaced
                 used.update(int(t) for t in self._slots)
@@ -482,14 +507,19 @@ class UpdatedFactor:
                     del self._slot[taken[slot]]
                 self._slot[keys[t]] = slot
                 self._store[:, slot] = solved[:, col]
-        return np.array([self._slot[key] for key in keys], np.int64)
+        return np.array([self._slot[key] for key in keys], np.int64), solved_extra
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """``A^-1 b`` for the current matrix ``A``; ``b`` is (n,) or (n, k)."""
         if self._ref is None:
             return self._lu.solve(b)
         b2 = b.reshape(len(b), -1)
-        u = self._lu.solve(_gather(b2, self._primary, self._ref, self._copies))
+        return self._corrected(self._lu.solve(_gather(b2, self._primary, self._ref, self._copies)), b)
+
+    def _corrected(self, u, b):
+        """``A^-1 b`` from ``u = A_R^-1 T^T b``'s first block (the correction in use)."""
+        b2 = b.reshape(len(b), -1)
+        u = u.reshape(len(u), -1)
         lu, piv = self._small
         s = _reduced(u, b2, self._r, self._delta, self._copies, *self._c, lu, piv)
         x = _finish(u, self._store, self._slots, s, self._ref, self._copies, len(self._r))
