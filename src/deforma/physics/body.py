@@ -104,7 +104,7 @@ class Body:
         uv = getattr(self.mesh, "uv", None)
         if uv is not None and len(uv) == t.n_vertices:
             torn = self.topology  # the mesh's own copies of its rest positions and triangles
-            self.mesh = Mesh._trusted(torn.rest_positions.copy(), torn.triangles.copy(), np.asarray(uv)[src],
+            self.mesh = Mesh._trusted(torn.rest_positions.copy(), torn.triangles.copy(), np.take(uv, src, axis=0),
                                       getattr(self.mesh, "texture", None))
         self._pinned = self._pinned[src]
         self._tear_source = src

@@ -565,7 +565,9 @@ class Model:
         np.cumsum([len(t.triangles) for t in self.topologies], out=body_tri[1:])
         tri = np.empty((body_tri[-1], 3), np.int32)
         for b, t in enumerate(self.topologies):
-            np.add(t.triangles, self.body_vertex_offsets[b], out=tri[body_tri[b]:body_tri[b + 1]], casting="unsafe")
+            tri[body_tri[b]:body_tri[b + 1]] = t.triangles
+            if self.body_vertex_offsets[b]:
+                tri[body_tri[b]:body_tri[b + 1]] += int(self.body_vertex_offsets[b])
 
         def i32(parts):
             return np.ascontiguousarray(np.concatenate(parts), dtype=np.int32)
@@ -593,7 +595,9 @@ class Model:
             raise ValueError("a torn body keeps its triangles: the Model before has another number of them")
         order = old.elem_source[o0:o1]
         self.elem_source[t0:t1] = order
-        np.add(t.triangles[order], v0, out=self.elem[t0:t1], casting="unsafe")
+        np.take(t.triangles, order, axis=0, out=self.elem[t0:t1])
+        if v0:
+            self.elem[t0:t1] += int(v0)
         for name in ("elem_b", "elem_area", "elem_b0", "elem_area0"):
             getattr(self, name)[t0:t1] = getattr(old, name)[o0:o1]
         area = t.geometry[1] if t.geometry is not None else rest_geometry(t.rest_positions, t.triangles)[1]
