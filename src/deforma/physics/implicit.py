@@ -289,7 +289,7 @@ def element_weights(model, h: float) -> np.ndarray:
     return model.elem_area * (h * h + h * model.elem_damping) * max_stiffness(model.elem_mu, model.elem_lambda)
 
 
-def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None):
+def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None, weights=None):
     """The constant global matrix ``M + L_w + K_w + h^2 S_grab`` (N x N, kg), canonical CSC,
     each pinned row the identity's, and its diagonal before the pinning (N,).
 
@@ -305,7 +305,8 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None):
     a copy of its vertex ``source[i]``, and only the ``fresh`` vertices (N,) bool have
     springs, elements or a mass the tear changed (:attr:`Model.torn_from`). Their columns
     are assembled; every other column is the old one, its rows renumbered: the same numbers,
-    as it sums the same terms in the same order.
+    as it sums the same terms in the same order. ``weights``: :func:`element_weights` of
+    ``model`` and ``h``, when the caller has them already.
 
     Examples
     --------
@@ -332,7 +333,8 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None):
         old = (a.indptr, a.indices, a.data, old_diag)  # SciPy's own arrays (int32 here): no copies
     ptr, ind, val = _assemble(diag, model.spring_i, model.spring_j,
                               h * h * model.spring_stiffness + h * model.spring_damping,
-                              model.elem, model.elem_b, element_weights(model, h), model.pinned,
+                              model.elem, model.elem_b, element_weights(model, h) if weights is None else weights,
+                              model.pinned,
                               np.ascontiguousarray(fresh, dtype=np.bool_), source, first, *old)
     a = sp.csc_matrix((val, ind, ptr), shape=(n, n))
     a.has_sorted_indices = True
@@ -632,12 +634,12 @@ class ImplicitEuler:
         # a patched column is the reference's where it was before; an assembled one may differ
         self._dirty = self._dirty[patch[2]] | patch[3] if patch is not None and self._dirty is not None else None
         self._mass = mass
-        self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, mass, patch)
+        self._we = element_weights(model, h)
+        self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, mass, patch, self._we)
         self._rows = None  # its rows, for free_estimate, made when a contact first needs them
         self._key = key
         self._wk = h * h * model.spring_stiffness
         self._wd = h * model.spring_damping
-        self._we = element_weights(model, h)
         self._pinned = np.flatnonzero(model.pinned)
         self._touching = None  # the contact terms must be added again
 

@@ -281,8 +281,8 @@ def torn_edges(t_old, t, pairs, tri_pair, tri_edge, n, vertex_ptr, vertex_tris, 
     untouched by the change (else -1); the triangles around each vertex (CSR, in triangle
     order) as :meth:`TearTopology.of` lists them; :class:`TearTopology`'s ``boundary``,
     ``inner``, ``inner_tri`` and ``normal``, whose rows ``fresh`` (indices into ``inner``:
-    the rebuilt interior edges) are left for the caller to measure. 0.3 ms for a tear of a
-    1e4-vertex sheet, against 1.5 ms to build them again.
+    the rebuilt interior edges) are left for the caller to measure. 0.57 ms (standalone) for
+    a tear of a 1e4-vertex sheet, where :func:`edge_table` alone takes 0.8 ms.
     """
     m = t.shape[0]
     ne = pairs.shape[0]
