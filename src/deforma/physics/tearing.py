@@ -699,7 +699,8 @@ def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
         new = np.flatnonzero(origin < 0)
         rest_length[new] = lengths(rest, tt.pairs[new, 0], tt.pairs[new, 1])
     body = BodyTopology._trusted(rest, tt.pairs, cut.triangles, _outline_edges(tt.triangles, tt.tri_edge, tt.tri_pair),
-                                 mass_share=share, geometry=(tt.b, tt.area), spring_rest_length=rest_length)
+                                 mass_share=share, geometry=(tt.b, tt.area), spring_rest_length=rest_length,
+                                 before=topology)
     return body, tt
 
 
