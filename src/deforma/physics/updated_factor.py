@@ -397,13 +397,14 @@ class UpdatedFactor:
         (those of every changed entry, copy or copy's neighbour); only they are compared.
 
         ``rhs``: a right-hand side ((n,) or (n, k)) the caller will solve next: it is solved
-        with ``a`` in the same call into the factor as the correction's new columns (a call
-        costs about a right-hand side more than its columns: 0.5 ms for one on a 1e4-vertex
-        sheet, 0.25 ms for each one more), and left in :attr:`solution` (``None`` when
-        this returns False).
+        with ``a`` in the same call into the factor as the correction's new columns, and
+        left in :attr:`solution` (``None`` when this returns False). On a 1e4-vertex sheet a
+        call costs 0.5 ms with one right-hand side and 0.25 ms for each one more, so a call
+        of its own cost the columns about a right-hand side's time more.
         """
-        self.solution = None
         import scipy.linalg as sla
+
+        self.solution = None
 
         n, n0 = a.shape[0], self._n0
         ref = np.ascontiguousarray(ref, dtype=np.int64)
