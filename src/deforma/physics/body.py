@@ -77,7 +77,6 @@ class Body:
         self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
         self._tear_fresh = np.zeros(0, np.int64)  # and the vertices whose springs, elements or mass it changed
-        self._torn = False  # whether the topology is a tear's of the Model's (not yet rebuilt)
         self._cracks = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
 
     def _tear_view(self):
@@ -108,7 +107,6 @@ class Body:
                                       getattr(self.mesh, "texture", None))
         self._pinned = self._pinned[src]
         self._tear_source = src
-        self._torn = True
         self._cracks = (self.topology, cut.tips)
         self._overrides["pressure"] = None  # the gas escapes through the tear
 

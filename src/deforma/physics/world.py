@@ -493,7 +493,7 @@ class World:
             for i, body in enumerate(getattr(self, "_model_bodies", ())):
                 was_fem = old.materials[i] is not None and old.materials[i].is_fem
                 if body._world is self and was_fem == body.is_fem:  # springs and elements do not convert
-                    if was_fem and body._torn:  # its elements, rest shape and all
+                    if was_fem and not isinstance(body._tear_source, slice):  # torn: its elements and all
                         torn[body._index] = (old, i)
                         continue
                     shape = old.rest_shape(i)
@@ -869,7 +869,6 @@ class World:
                 fresh[new_off[i] + body._tear_fresh] = True
                 body._tear_source = slice(None)
                 body._tear_fresh = np.zeros(0, np.int64)
-                body._torn = False
             self._model.torn_from = (old.serial, source, fresh, self._model.version)
 
     def _check_shape(self) -> None:
