@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import Row  # noqa: E402
 
 import deforma  # noqa: E402
-from deforma.physics.colliders import pack_colliders  # noqa: E402
+from deforma.physics.colliders.shapes import pack_colliders  # noqa: E402
 
 GRAVITY = (0.0, -9.81)
 

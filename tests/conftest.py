@@ -23,7 +23,7 @@ def patched_matrices(monkeypatch):
     """Check every matrix implicit Euler patches after a tear against the one assembled from
     scratch (the same arrays, bit for bit); returns the list of the checked patches' fresh
     vertex masks, which grows as the test runs."""
-    from deforma.physics import implicit
+    from deforma.physics.integrators.implicit import solver as implicit
 
     full = implicit.system_matrix
     checked = []

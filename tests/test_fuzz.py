@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 import deforma
-from deforma.physics.elements import signed_areas
+from deforma.physics.elements.triangles import signed_areas
 from deforma.scene.build import build
 from deforma.scene.schema import SceneError, parse_scene
 

@@ -1,6 +1,6 @@
 """Independent checks of the contact invariants: outline crossings and vertices inside other bodies.
 
-Written apart from deforma.physics.contacts on purpose: a sort-and-sweep over segment boxes
+Written apart from deforma.physics.contact on purpose: a sort-and-sweep over segment boxes
 and exact orientation signs (deforma.mesh.predicates, Shewchuk's expansions) decide whether
 two outline segments cross, and an even-odd ray test decides whether a vertex lies inside
 another body.

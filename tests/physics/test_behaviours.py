@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import deforma
-from deforma.physics.elements import signed_areas
-from deforma.physics.strain import spring_strains, stretch_field
+from deforma.physics.elements.triangles import signed_areas
+from deforma.physics.behaviours.strain import spring_strains, stretch_field
 
 STABLE = ("symplectic-euler", "implicit-euler", "xpbd")
 
@@ -65,9 +65,10 @@ def test_stretch_limit_holds_under_a_hundred_times_the_pull(integrator, model):
 def test_stretch_projection_lowers_the_energy(model):
     # random overshoots of a body that started the step within its limit: after the
     # projection, kinetic + elastic energy is never higher
-    from deforma.physics.model import BodyTopology, Model
-    from deforma.physics.strain_limit import project_stretch
-    from deforma.physics.elements import element_energy
+    from deforma.physics.topology import BodyTopology
+    from deforma.physics.model import Model
+    from deforma.physics.behaviours.strain_limit import project_stretch
+    from deforma.physics.elements.triangles import element_energy
 
     rng = np.random.default_rng(3)
     mesh = strip(1.0, 0.2, (6, 2))
@@ -397,7 +398,7 @@ def test_a_crack_along_a_clamp_cuts_off_no_loose_chips():
     # The same sheet, smaller, under symplectic Euler, which rings after the first cut: the
     # crack running along a clamp cut single triangles loose (two here, 15 at 1e4 vertices),
     # which flew off. A cut that would leave fewer than MIN_PIECE triangles on one side holds.
-    from deforma.physics.tearing import MIN_PIECE
+    from deforma.physics.behaviours.tearing import MIN_PIECE
 
     w, body, _, _ = clamped_sheet("symplectic-euler", 30, 400)
     pieces = body.pieces

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import deforma
-from deforma.physics.elements import signed_areas
-from deforma.physics import contacts
+from deforma.physics.elements.triangles import signed_areas
+from deforma.physics.contact import contacts
 from contact_checks import crossings, vertices_inside_other_bodies
 from physics_meshes import grid_mesh, head_on, slide_acceleration
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import deforma
-from deforma.physics.elements import signed_areas
+from deforma.physics.elements.triangles import signed_areas
 
 MODELS = ["corotated", "neo-hookean"]
 INTEGRATORS = ["symplectic-euler", "implicit-euler", "xpbd"]

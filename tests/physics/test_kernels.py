@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 import deforma
-from deforma.physics import symplectic
-from deforma.physics.colliders import Rect, collide_point, pack_colliders
-from deforma.physics.forces import spring_force
+from deforma.physics.integrators import symplectic
+from deforma.physics.colliders.shapes import Rect, pack_colliders
+from deforma.physics.colliders.response import collide_point
+from deforma.physics.elements.springs import spring_force
 from physics_meshes import grid_mesh
 
 
@@ -135,7 +136,7 @@ def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_los
 
 
 def test_the_implicit_matrix_assembly_matches_a_dense_sum():
-    from deforma.physics.implicit import element_weights, system_matrix, with_entries
+    from deforma.physics.integrators.implicit.assembly import element_weights, system_matrix, with_entries
 
     w = deforma.World(stiffness=300.0, damping=0.7)
     w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.5), (0, 0.5)), detail=3), position=(0, 1))  # springs

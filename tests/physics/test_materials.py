@@ -7,7 +7,8 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import deforma
-from deforma.physics import corotated, elements, neo_hookean
+from deforma.physics.elements import corotated, neo_hookean
+from deforma.physics.elements import triangles as elements
 from deforma.physics.material import KIND_COROTATED, KIND_NEO_HOOKEAN
 from physics_meshes import grid_mesh
 

@@ -1,7 +1,7 @@
 """A torn body's incremental rebuild gives exactly what a rebuild from scratch gives.
 
 A tear updates the body's topology and its tear check's edge table from the ones before the
-tear (:func:`deforma.physics.tearing.torn_topologies`) and reuses the triangles' rest
+tear (:func:`deforma.physics.behaviours.tearing.torn_topologies`) and reuses the triangles' rest
 geometry; these tests tear sheets and compare every array, bit for bit, with
 ``BodyTopology.from_arrays`` / ``TearTopology.of`` of the torn mesh and with the Model those
 make, and the split itself with the straightforward fan search it replaced.
@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import deforma
-from deforma.physics import tearing
-from deforma.physics.model import BodyTopology, Model, element_geometry, lengths, stable_order
+from deforma.physics.behaviours import tearing
+from deforma.physics.topology import BodyTopology, element_geometry, lengths, stable_order
+from deforma.physics.model import Model
 
 BODY_FIELDS = ("rest_positions", "springs", "spring_rest_length", "triangles", "boundary_edges",
                "boundary_vertices", "boundary_clearance", "mass_share")
@@ -171,7 +172,7 @@ def torn_sheet(model, integrator, steps, detail=12):
 @pytest.mark.parametrize("model, integrator", [("corotated", "implicit-euler"), ("springs", "implicit-euler"),
                                                ("corotated", "xpbd")])
 def test_incremental_rebuild_equals_rebuild_from_scratch(model, integrator, patched_matrices, monkeypatch):
-    from deforma.physics import model as model_module
+    from deforma.physics import topology as model_module
 
     patched = []  # the torn outline's clearances, patched (compared at every tear with from_arrays')
     torn_clearance = model_module._torn_clearance
@@ -255,8 +256,8 @@ def test_lengths_are_numpys_norm():
 
 
 def test_clearance_through_a_grid_equals_rest_clearance():
-    from deforma.physics.contacts import rest_clearance
-    from deforma.physics.model import _clearance
+    from deforma.physics.contact.clearance import rest_clearance
+    from deforma.physics.topology import _clearance
 
     # a wiggly ring, flattened: many vertices close to edges across from them
     rng = np.random.default_rng(5)

@@ -1,5 +1,5 @@
 """Implicit Euler's factor kept across tears, contact sets and grabs by a low-rank correction
-(:mod:`deforma.physics.updated_factor`) solves what a fresh factorisation solves."""
+(:mod:`deforma.physics.integrators.implicit.updated_factor`) solves what a fresh factorisation solves."""
 
 import copy
 
@@ -10,7 +10,7 @@ import scipy.sparse.linalg as spla
 from hypothesis import given, settings, strategies as st
 
 import deforma
-from deforma.physics.updated_factor import UpdatedFactor
+from deforma.physics.integrators.implicit.updated_factor import UpdatedFactor
 
 
 def spring_matrix(n, springs, w, mass, pinned=()):
@@ -132,7 +132,7 @@ def split(n, springs, v, moved_count=3):
 
 
 def test_a_declined_update_leaves_the_correction_in_use_as_it_was(monkeypatch):
-    import deforma.physics.updated_factor as updated
+    import deforma.physics.integrators.implicit.updated_factor as updated
 
     n, springs = grid(10)
     w = np.full(len(springs), 10.0)
@@ -266,7 +266,7 @@ def test_the_columns_implicit_euler_names_hold_every_change(monkeypatch):
     # compares only those: on a tearing sheet whose pieces touch, and on the pile, every
     # update finds exactly what a comparison of every column finds
     from deforma import scene as scenes
-    from deforma.physics import updated_factor
+    from deforma.physics.integrators.implicit import updated_factor
 
     full = updated_factor._blocks
     named = [0]

@@ -92,7 +92,7 @@ def test_a_wide_grab_moves_its_patch_without_squeezing_it(integrator):
     assert np.ptp(b.positions[g.vertices], axis=0) == pytest.approx(spread, rel=0.1)
     moved = (b.positions[g.vertices] - g.offsets).mean(axis=0) - (1.0, 0.5)
     assert moved == pytest.approx((0.5, 0.0), abs=0.1)  # the patch went where it was dragged
-    assert deforma.physics.elements.signed_areas(b.positions, b.triangles).min() > 0
+    assert deforma.physics.elements.triangles.signed_areas(b.positions, b.triangles).min() > 0
 
 
 def test_absurd_dt_raises_and_keeps_the_state_before_the_failing_step():

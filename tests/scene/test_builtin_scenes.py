@@ -96,7 +96,7 @@ def test_builtin_scene_frame_shows_each_body_where_it_is(gl_ctx, name):
 # plastic: its rest shape follows); test_dent_keeps_its_dent checks the rest of the block.
 @pytest.mark.parametrize("name", RESTING)
 def test_builtin_scene_comes_to_rest_with_no_triangle_inside_out(name):
-    from deforma.physics.elements import signed_areas
+    from deforma.physics.elements.triangles import signed_areas
 
     seconds = max(6.0, scenes.load(name).run.seconds)
     world, done = _AFTER_THE_FIRST_SECOND.pop(name, (None, 0))  # see above
@@ -149,7 +149,7 @@ def test_explode_scene_box_lands_flat_and_bounces_straight():
 
 def test_tear_scene_tears_in_two_under_its_scripted_pull():
     # deforma run plays the [[pull]]; the plain steps above only let the sheet hang
-    from deforma.physics.elements import signed_areas
+    from deforma.physics.elements.triangles import signed_areas
 
     s = scenes.load("tear")
     w = s.build()
@@ -214,7 +214,7 @@ def test_torn_sheet_is_drawn_with_its_texture_on_every_piece(gl_ctx, tmp_path):
 
 
 def test_dent_keeps_its_dent():
-    from deforma.physics.elements import signed_areas
+    from deforma.physics.elements.triangles import signed_areas
 
     w = scenes.load_scene("dent")
     (b,) = w.bodies
@@ -235,7 +235,7 @@ def test_dent_keeps_its_dent():
 
 
 def test_balloon_keeps_its_area_while_it_bounces():
-    from deforma.physics.elements import signed_areas
+    from deforma.physics.elements.triangles import signed_areas
 
     w = scenes.load_scene("balloon")
     (b,) = w.bodies

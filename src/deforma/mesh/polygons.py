@@ -1,6 +1,6 @@
 """Plain polygon geometry over NumPy arrays: shoelace areas, segment intersection, even-odd inside.
 
-Shared by the collider shapes (:mod:`deforma.physics.shapes`, which validate and test
+Shared by the collider shapes (:mod:`deforma.physics.colliders.shapes`, which validate and test
 polygons) and the renderer's fill (:mod:`deforma.render.fill`), so that both agree on what
 crosses and what is inside. Floating-point signs: exact predicates live in
 :mod:`deforma.mesh.predicates`, for the triangulation, where a wrong sign breaks the mesh.

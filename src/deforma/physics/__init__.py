@@ -5,8 +5,14 @@
 collider leaf. See ``docs/physics.md`` for the model and the friction scheme.
 """
 
-from . import symplectic, implicit, xpbd  # noqa: F401, I001  (each registers its integrator; the default first)
-from .shapes import Circle, Collider, Polygon, Rect, Segment, colliders_from_image
+from .colliders.shapes import (
+           Circle,
+           Collider,
+           Polygon,
+           Rect,
+           Segment,
+           colliders_from_image,
+)
 from .integrators import available_integrators, register_integrator
 from .material import Material
 from .world import Body, Energy, Grab, SimulationUnstable, World

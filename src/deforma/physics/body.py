@@ -16,10 +16,10 @@ import numpy as np
 from ..checks import non_negative as _non_negative
 from ..checks import positive as _positive
 from ..checks import switch as _switch
-from . import tearing as _tearing
+from .behaviours import tearing as _tearing
+from .behaviours.pressure import outline_loops
 from .material import Material
-from .model import BodyTopology, element_geometry
-from .pressure import outline_loops
+from .topology import BodyTopology, element_geometry
 
 if TYPE_CHECKING:  # the World imports this module
     from .world import World
@@ -80,7 +80,7 @@ class Body:
         self._cracks = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
 
     def _tear_view(self):
-        """The tear check's view (:class:`~deforma.physics.tearing.TearTopology`) of the current
+        """The tear check's view (:class:`~deforma.physics.behaviours.tearing.TearTopology`) of the current
         topology: kept from the last tear, or built once for a topology it has not seen."""
         t = self.topology
         if self._tear_topology is None or self._tear_topology[0] is not t:
@@ -94,7 +94,7 @@ class Body:
         return c[1] if c is not None and c[0] is self.topology else ()
 
     def _apply_tear(self, cut) -> None:
-        """Take the torn mesh ``cut`` (a :class:`~deforma.physics.tearing.Tear`) as the body's."""
+        """Take the torn mesh ``cut`` (a :class:`~deforma.physics.behaviours.tearing.Tear`) as the body's."""
         from ..mesh import Mesh
 
         t, src = self.topology, cut.source
@@ -354,7 +354,7 @@ class Body:
     @property
     def pressure(self) -> float | None:
         """Gas pressure at the rest area, N/m (``None``: no gas); settable. See
-        :mod:`deforma.physics.pressure`. A body that tears lets its gas out (``None``)."""
+        :mod:`deforma.physics.behaviours.pressure`. A body that tears lets its gas out (``None``)."""
         self._check()
         return self._overrides["pressure"]
 

@@ -77,11 +77,11 @@ class Material:
     tear_strain : float, optional
         Tearing (any model; the body needs triangles): where the material is stretched by
         more than this strain (0.5 = 50% longer) across a mesh edge, the mesh splits along
-        that edge (:mod:`deforma.physics.tearing`). A springs body without triangles snaps
+        that edge (:mod:`deforma.physics.behaviours.tearing`). A springs body without triangles snaps
         the spring instead. ``None`` (default): never tears. In (0, 100].
     yield_strain : float, optional
         Plasticity: strain beyond this in any direction moves the rest shape, so dents stay
-        (:mod:`deforma.physics.plasticity`). ``None`` (default): elastic. In (0, 100].
+        (:mod:`deforma.physics.behaviours.plasticity`). ``None`` (default): elastic. In (0, 100].
     plastic_rate : float, optional
         Share of the strain beyond ``yield_strain`` that becomes permanent at each step, in
         (0, 1]; 1 (default) is perfectly plastic (independent of the step), smaller values
@@ -89,7 +89,7 @@ class Material:
     max_stretch : float, optional
         Strain limit: no spring or element ends a step stretched beyond this ratio of its
         rest length in any direction (1.05 = at most 5% longer), however hard it is pulled
-        (:mod:`deforma.physics.strain_limit`). ``None`` (default): no limit. In (1, 100].
+        (:mod:`deforma.physics.behaviours.strain_limit`). ``None`` (default): no limit. In (1, 100].
 
     Raises
     ------

@@ -23,17 +23,24 @@ from ..checks import pair as _pair
 from ..checks import positive as _positive
 from ..checks import switch as _switch
 from . import behaviours as _behaviours
-from . import contacts as _contacts
-from . import tearing as _tearing
-from .colliders import make_hits
-from .shapes import SHAPES, Collider, pack_colliders
-from .elements import element_energy, gradient_row_sums, max_stiffness, signed_areas
-from .integrators import make_integrator
+from .behaviours import tearing as _tearing
+from .behaviours.strain import spring_strains
 from .body import Body, Grab, _fem_mesh_check, _material, _pressure
+from .colliders.response import make_hits
+from .colliders.shapes import SHAPES, Collider, pack_colliders
+from .contact import contacts as _contacts
+from .contact.clearance import outlines_overlap
+from .elements.triangles import (
+    element_energy,
+    gradient_row_sums,
+    max_stiffness,
+    signed_areas,
+)
+from .integrators import make_integrator
 from .material import Material
-from .model import BodyTopology, Model
+from .model import Model
 from .state import State
-from .strain import spring_strains
+from .topology import BodyTopology
 
 # Automatic contact thickness: this fraction of a body's median boundary edge (see World).
 AUTO_THICKNESS = 0.05
@@ -393,7 +400,7 @@ class World:
             world's. Two bodies use ``sqrt(a * b)`` of theirs; colliders use their own.
         pressure : float, optional
             A gas inside the body's outer outline, N/m at the rest area (>= 0), pushing
-            with ``pressure * A0 / A`` (:mod:`deforma.physics.pressure`); the body needs a
+            with ``pressure * A0 / A`` (:mod:`deforma.physics.behaviours.pressure`); the body needs a
             closed outline (triangles, or springs forming closed loops). ``None`` (default):
             no gas.
 
@@ -547,7 +554,7 @@ class World:
         for other in self._bodies:
             if other is body or not other._overrides["collide"] or not len(other.topology.boundary_edges):
                 continue
-            if _contacts.outlines_overlap(x, topo.boundary_edges, other.positions, other.topology.boundary_edges):
+            if outlines_overlap(x, topo.boundary_edges, other.positions, other.topology.boundary_edges):
                 which = f"body {body._index}" if body in self._bodies else f"the new body ({len(self._bodies)})"
                 raise ValueError(
                     f"{which} would overlap body {other._index} (their outlines cross or one lies inside the "
@@ -557,7 +564,7 @@ class World:
     def contacts(self) -> "_contacts.Contacts":
         """The contacts of the last substep: with colliders, other bodies and itself.
 
-        A struct of arrays (see :class:`~deforma.physics.contacts.Contacts`); collider
+        A struct of arrays (see :class:`~deforma.physics.contact.contacts.Contacts`); collider
         contacts have ``collider >= 0``, body contacts ``collider == -1`` and an ``edge``.
 
         Examples
@@ -834,7 +841,7 @@ class World:
 
     def _tear(self) -> None:
         """Split the meshes of bodies stretched beyond their ``tear_strain`` (see
-        :mod:`deforma.physics.tearing`); rebuilds the Model when any tore."""
+        :mod:`deforma.physics.behaviours.tearing`); rebuilds the Model when any tore."""
         torn = False
         for body in self._bodies:
             limit = body.material.tear_strain
@@ -991,7 +998,7 @@ class World:
         2 sum(ks)_i / m_i`` and ``gamma <= max_i 2 sum(kd)_i / m_i`` over the springs (and
         grabs) at each vertex; a finite element adds its stiffness matrix's row sum,
         ``A k sum_w |D_i . D_w|`` with ``k = 2 (mu + max(lambda, 0))`` its stiffness at rest
-        (:func:`~deforma.physics.elements.max_stiffness`), and ``damping`` times that to
+        (:func:`~deforma.physics.elements.triangles.max_stiffness`), and ``damping`` times that to
         ``gamma``. Then it returns the step at which semi-implicit Euler on
         ``x'' = -omega^2 x - gamma x'`` turns unstable, ``(sqrt(gamma^2 + 4 omega^2) - gamma)
         / omega^2`` (``2 / omega`` without damping). Compare it with ``dt / substeps``.

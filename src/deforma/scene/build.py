@@ -457,7 +457,7 @@ def _loop(points) -> tuple:
 
 def collider_spec(collider, spec=None, pose=None):
     """The ``[[collider]]`` spec of ``collider``: its motion and friction now, at its
-    :attr:`~deforma.physics.shapes.Collider.origin` (where it was put, before its own motion
+    :attr:`~deforma.physics.colliders.shapes.Collider.origin` (where it was put, before its own motion
     moved it: a saved moving collider starts where it started, as bodies do).
 
     One spec per collider: the pieces of an image collider are written as polygons (with the

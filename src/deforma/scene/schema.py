@@ -855,7 +855,7 @@ def _check_pull(pull: Pull, path: str) -> None:
 
 def _check_integrator(name: str, path: str) -> None:
     # the registry, not a fixed list: an integrator registered by the user is allowed too
-    from ..physics.integrators import available_integrators
+    from ..physics import available_integrators
 
     names = available_integrators()
     if name not in names:

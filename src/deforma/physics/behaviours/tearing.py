@@ -4,7 +4,7 @@ A material with ``tear_strain = t`` (``deforma.Material(..., tear_strain=0.3)``)
 after every step. For each interior edge of the mesh (one shared by two triangles), the
 *opening stretch* is how much the material on either side is stretched across the edge:
 ``|F n|`` with ``n`` the edge's unit normal in the rest shape and ``F`` each neighbouring
-triangle's deformation gradient (:mod:`deforma.physics.elements`), averaged over the two.
+triangle's deformation gradient (:mod:`deforma.physics.elements.triangles`), averaged over the two.
 An edge whose opening strain ``|F n| - 1`` exceeds ``t`` is cut.
 
 A cut opens only where the mesh can open: a vertex splits when the triangles around it fall
@@ -45,9 +45,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .contacts import find_root
-from .elements import _gradient, rest_geometry
-from .model import counting_order, lengths, stable_order
+from ..elements.triangles import deformation_gradient, rest_geometry
+from ..topology import counting_order, lengths, stable_order
+from ..union_find import find_root
 from .strain import spring_strains
 
 
@@ -437,7 +437,7 @@ def opening_strain(x, tris, b, pairs_inner_tri, normal, out):
         for side in range(2):
             t = pairs_inner_tri[e, side]
             i, j, k = tris[t, 0], tris[t, 1], tris[t, 2]
-            f00, f01, f10, f11 = _gradient(x, i, j, k, b[t, 0], b[t, 1], b[t, 2], b[t, 3])
+            f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b[t, 0], b[t, 1], b[t, 2], b[t, 3])
             ax = f00 * nx + f01 * ny
             ay = f10 * nx + f11 * ny
             s += (ax * ax + ay * ay) ** 0.5
@@ -684,7 +684,7 @@ def torn_topologies(topology, tear_topology: TearTopology, cut: Tear):
     triangles in order, with corners at the same rest positions, so none of them turns or
     changes shape): no validation, no second sort.
     """
-    from .model import BodyTopology
+    from ..topology import BodyTopology
 
     src = cut.source
     rest = np.take(topology.rest_positions, src, axis=0)  # rows: 15x faster than rest_positions[src]

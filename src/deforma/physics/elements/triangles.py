@@ -8,7 +8,7 @@ the constant deformation gradient
 so ``F[r, :] = sum_v x_v[r] D_v`` with shape-function gradients ``D_j = B[0, :]``, ``D_k =
 B[1, :]``, ``D_i = -D_j - D_k``. An element of rest area ``A`` and energy density ``psi(F)``
 puts the force ``f_v = -A P D_v`` on its vertices (``P = dpsi/dF``, from the element kind's
-module: :mod:`~deforma.physics.corotated`, :mod:`~deforma.physics.neo_hookean`); the three
+module: :mod:`~deforma.physics.elements.corotated`, :mod:`~deforma.physics.elements.neo_hookean`); the three
 forces sum to zero, so elements keep momentum.
 
 Damping (``beta`` seconds, per element) is a viscous stress ``beta R (2 mu E' + lambda tr(E')
@@ -28,8 +28,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..material import KIND_COROTATED
 from . import corotated, neo_hookean
-from .material import KIND_COROTATED
 
 
 def rest_geometry(x, tris):
@@ -130,7 +130,7 @@ def gradient_row_sums(tris, b, area, weight, n):
 
 
 @njit(cache=True, inline="always")
-def _gradient(x, i, j, k, b0, b1, b2, b3):
+def deformation_gradient(x, i, j, k, b0, b1, b2, b3):
     """``F`` (4 entries) of one triangle."""
     e1x = x[j, 0] - x[i, 0]
     e1y = x[j, 1] - x[i, 1]
@@ -166,7 +166,7 @@ def rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu, lam):
 
 
 @njit(cache=True, inline="always")
-def _corners(elem, b, e):
+def corners(elem, b, e):
     """Vertex indices (unsigned: no negative-index test) and rest-shape inverse of element ``e``."""
     return (np.uint64(elem[e, 0]), np.uint64(elem[e, 1]), np.uint64(elem[e, 2]),
             b[e, 0], b[e, 1], b[e, 2], b[e, 3])
@@ -228,17 +228,17 @@ def element_forces(x, v, elem, b, area, mu, lam, beta, kind, damped, f):
     """
     if not damped:
         for e in range(elem.shape[0]):
-            i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
-            f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+            i, j, k, b0, b1, b2, b3 = corners(elem, b, e)
+            f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
             p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
             fjx, fjy, fkx, fky = _columns(p00, p01, p10, p11, b0, b1, b2, b3, -area[e])
             _scatter(f, i, j, k, fjx, fjy, fkx, fky)
         return
     for e in range(elem.shape[0]):
-        i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
-        f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+        i, j, k, b0, b1, b2, b3 = corners(elem, b, e)
+        f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
         p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
-        r00, r01, r10, r11 = _gradient(v, i, j, k, b0, b1, b2, b3)
+        r00, r01, r10, r11 = deformation_gradient(v, i, j, k, b0, b1, b2, b3)
         d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, r00, r01, r10, r11, mu[e], lam[e])
         be = beta[e]
         fjx, fjy, fkx, fky = _columns(p00 + be * d00, p01 + be * d01, p10 + be * d10, p11 + be * d11, b0, b1, b2,
@@ -264,8 +264,8 @@ def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, 
     """
     h2 = h * h
     for e in range(elem.shape[0]):
-        i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
-        f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+        i, j, k, b0, b1, b2, b3 = corners(elem, b, e)
+        f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
         p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
         if kind[e] != KIND_COROTATED:
             # Neo-Hookean stiffens beyond the matrix's 2 (mu + lambda) when stretched or
@@ -289,7 +289,7 @@ def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, 
         p10 *= h2
         p11 *= h2
         if beta[e] > 0.0:
-            n00, n01, n10, n11 = _gradient(x_n, i, j, k, b0, b1, b2, b3)
+            n00, n01, n10, n11 = deformation_gradient(x_n, i, j, k, b0, b1, b2, b3)
             d00, d01, d10, d11 = rate_stress(f00, f01, f10, f11, f00 - n00, f01 - n01, f10 - n10, f11 - n11,
                                              mu[e], lam[e])
             hb = h * beta[e]
@@ -309,7 +309,7 @@ def implicit_element_rhs(x, x_n, elem, b, area, mu, lam, beta, kind, weight, h, 
 
 
 @njit(cache=True, inline="always")
-def _vertex_gradients(g00, g01, g10, g11, b0, b1, b2, b3):
+def vertex_gradients(g00, g01, g10, g11, b0, b1, b2, b3):
     """Gradients at vertices ``i, j, k`` (6) of a constraint whose gradient in ``F`` is ``g``:
     ``g D_v`` with ``D_j = (b0, b1)``, ``D_k = (b2, b3)``, ``D_i = -D_j - D_k``."""
     jx, jy, kx, ky = _columns(g00, g01, g10, g11, b0, b1, b2, b3, 1.0)
@@ -317,7 +317,7 @@ def _vertex_gradients(g00, g01, g10, g11, b0, b1, b2, b3):
 
 
 @njit(cache=True, inline="always")
-def _dot(wi, wj, wk, a, b):
+def weighted_dot(wi, wj, wk, a, b):
     """Inverse-mass weighted dot product of two vertex gradients (6 entries each)."""
     return wi * (a[0] * b[0] + a[1] * b[1]) + wj * (a[2] * b[2] + a[3] * b[3]) + wk * (a[4] * b[4] + a[5] * b[5])
 
@@ -339,10 +339,10 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, or
     rotation; corotated ``mu C_dev^2`` and Neo-Hookean ``mu / 2 C_S^2`` are both this), so
     each has the two shear constraints ``C_a``, ``C_b`` (stiffness ``mu A``) and a size
     constraint (``(mu + lambda) A``): corotated ``tr S - 2``
-    (:func:`~deforma.physics.corotated.size_constraint`), Neo-Hookean ``J - 1`` (after
-    Macklin and Mueller 2021; :func:`~deforma.physics.neo_hookean.size_constraint`).
+    (:func:`~deforma.physics.elements.neo_hookean.size_constraint`), Neo-Hookean ``J - 1`` (after
+    Macklin and Mueller 2021; :func:`~deforma.physics.elements.neo_hookean.size_constraint`).
     Damping ``beta`` gives each constraint ``kd = beta * stiffness``. ``order`` (T,) is the
-    order of the sweep (:func:`deforma.physics.xpbd.sweep_order`); ``lam_acc`` (T, 3) holds
+    order of the sweep (:func:`deforma.physics.integrators.xpbd.sweep_order`); ``lam_acc`` (T, 3) holds
     the multipliers of the substep.
 
     The shear constraints are linear in the positions (their gradients are constant), which
@@ -362,9 +362,9 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, or
         colour = sequence[c]
         for q in range(starts[colour], starts[colour + 1]):
             e = order[q]
-            i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
+            i, j, k, b0, b1, b2, b3 = corners(elem, b, e)
             a, m, lm, be = area[e], mu[e], lam[e], beta[e]
-            f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+            f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
             if kind[e] == KIND_COROTATED:
                 c3, v00, v01, v10, v11 = corotated.size_constraint(f00, f01, f10, f11)
             else:
@@ -372,9 +372,9 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, or
             k1 = m * a
             k3 = (m + lm) * a
             wi, wj, wk = inv_mass[i], inv_mass[j], inv_mass[k]
-            g1 = _vertex_gradients(1.0, 0.0, 0.0, -1.0, b0, b1, b2, b3)  # C_a = F00 - F11
-            g2 = _vertex_gradients(0.0, 1.0, 1.0, 0.0, b0, b1, b2, b3)  # C_b = F01 + F10
-            g3 = _vertex_gradients(v00, v01, v10, v11, b0, b1, b2, b3)
+            g1 = vertex_gradients(1.0, 0.0, 0.0, -1.0, b0, b1, b2, b3)  # C_a = F00 - F11
+            g2 = vertex_gradients(0.0, 1.0, 1.0, 0.0, b0, b1, b2, b3)  # C_b = F01 + F10
+            g3 = vertex_gradients(v00, v01, v10, v11, b0, b1, b2, b3)
             # Row n of XPBD's system, divided by s_n = (1 + beta / h) k_n h^2 (kt + dt, dt = beta
             # k h) so that the matrix is symmetric: (G + diag(1 / s)) dlam = -(kt C + lam + dt
             # rate) / s, G the inverse-mass Gram matrix of the gradients (positive definite with
@@ -384,12 +384,12 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, or
             r1 = -(k1 * h2 * (f00 - f11) + lam_acc[e, 0] + be * k1 * h * _rate(x, x_prev, i, j, k, g1)) / s1
             r2 = -(k1 * h2 * (f01 + f10) + lam_acc[e, 1] + be * k1 * h * _rate(x, x_prev, i, j, k, g2)) / s1
             r3 = -(k3 * h2 * c3 + lam_acc[e, 2] + be * k3 * h * _rate(x, x_prev, i, j, k, g3)) / s3
-            p = _dot(wi, wj, wk, g1, g1) + 1.0 / s1
-            u = _dot(wi, wj, wk, g2, g2) + 1.0 / s1
-            z = _dot(wi, wj, wk, g3, g3) + 1.0 / s3
-            q12 = _dot(wi, wj, wk, g1, g2)
-            q13 = _dot(wi, wj, wk, g1, g3)
-            q23 = _dot(wi, wj, wk, g2, g3)
+            p = weighted_dot(wi, wj, wk, g1, g1) + 1.0 / s1
+            u = weighted_dot(wi, wj, wk, g2, g2) + 1.0 / s1
+            z = weighted_dot(wi, wj, wk, g3, g3) + 1.0 / s3
+            q12 = weighted_dot(wi, wj, wk, g1, g2)
+            q13 = weighted_dot(wi, wj, wk, g1, g3)
+            q23 = weighted_dot(wi, wj, wk, g2, g3)
             c00 = u * z - q23 * q23  # cofactors of the symmetric matrix
             c01 = q13 * q23 - q12 * z
             c02 = q12 * q23 - u * q13

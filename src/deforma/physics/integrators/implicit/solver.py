@@ -30,7 +30,7 @@ changes the factor; moving a held grab changes only the right-hand side). Gravit
 
 Contacts are inside the solve (the projective-dynamics way). The vertices whose
 prediction ``y`` lies inside a collider are listed with the plane of the face they would
-leave by (:func:`~deforma.physics.colliders.contact_planes`); each gets the term
+leave by (:func:`~deforma.physics.colliders.response.contact_planes`); each gets the term
 ``k_c/2 |x - P(x)|^2``, ``k_c = contact_weight * A_ii``, whose local step
 (:func:`contact_rhs`) projects onto the outside of the plane with Coulomb friction at
 position level (the prediction in the first iteration, then where a Jacobi step of the
@@ -39,24 +39,24 @@ contact-free system would move the iterate: :func:`free_estimate`), and whose we
 exerts no force at convergence. A new
 contact set changes the factor; a resting or sliding body keeps its set, and its factor, for
 many steps (docs/integrators.md says why this and not an iterative solve). After the solve the
-shared collider response (:func:`~deforma.physics.colliders.finish_position_step`) and the
+shared collider response (:func:`~deforma.physics.integrators.base.finish_position_step`) and the
 body contact stage run as in the symplectic path, so nothing ends inside a collider or
 across an outline; the stage's impulses change velocities only, not positions
-(:func:`~deforma.physics.contacts.contact_stage` says why).
+(:func:`~deforma.physics.contact.stage.contact_stage` says why).
 
 Body contacts are in the solve too: the contacts of the predicted motion
-(:func:`~deforma.physics.contacts.detect_contacts`) each add a spring between the vertex and
+(:func:`~deforma.physics.contact.narrow_phase.detect_contacts`) each add a spring between the vertex and
 the edge point, ``k_c/2 |D x - q|^2`` with ``D x = x_p - (1 - s) x_a - s x_b``, whose
 coefficients sum to zero (linear momentum kept exactly); :func:`body_contact_rhs` is its
 local step. A pair closer than its target at the start of the substep is held there rather
-than pushed apart (:func:`~deforma.physics.contacts.hold_start_distance`). Its entries join
+than pushed apart (:func:`~deforma.physics.contact.response.hold_start_distance`). Its entries join
 the matrix, so a new set of pairs changes the factor; a pair keeps the ``s`` it had when the matrix
 was built, also when other pairs come or go. The contact-free matrix is assembled once per Model
 (:func:`system_matrix`) and a new contact set merges the contacts' entries into it
 (:func:`with_entries`), each in one compiled pass: with SciPy's sparse sums this took 1.5
 ms per refactor of the ``pile`` (2458 vertices), now 0.56 ms. A new contact set, a grab or
 a tear is then taken into the factor by a low-rank correction while it is small
-(:mod:`~deforma.physics.updated_factor`), and the matrix is factored again once the
+(:mod:`~deforma.physics.integrators.implicit.updated_factor`), and the matrix is factored again once the
 changes add up.
 
 With a fixed number of iterations per substep (``iterations``, default 3) the solution is
@@ -75,15 +75,20 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
-from .contacts import ST_STAMP, contact_stage, detect_contacts, gather_start, hold_start_distance
-from .elements import implicit_element_rhs, max_stiffness
-from .integrators import register_integrator
-from .model import first_index, sort_few
+from ...colliders.geometry import advance_colliders
+from ...colliders.response import contact_planes, push_edges_off_corners
+from ...contact.broad_phase import gather_start
+from ...contact.contacts import ST_STAMP
+from ...contact.narrow_phase import detect_contacts
+from ...contact.response import hold_start_distance
+from ...contact.stage import contact_stage
+from ...elements.triangles import implicit_element_rhs
+from ..base import finish_position_step, register_integrator
+from .assembly import element_weights, system_matrix, with_entries
 from .updated_factor import UpdatedFactor
 
 if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
-    import scipy.sparse as sp
+    pass
 
 
 @njit(cache=True)
@@ -284,267 +289,6 @@ def body_contact_rhs(x, x_n, triple, s, weight, normal, target, mu, count, b):
         b[e, 1] -= w * t * qy
 
 
-def element_weights(model, h: float) -> np.ndarray:
-    """Weight (kg) of each element in the solve: ``A (h^2 + h beta) k``, ``k`` its stiffness bound."""
-    return model.elem_area * (h * h + h * model.elem_damping) * max_stiffness(model.elem_mu, model.elem_lambda)
-
-
-def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None, weights=None):
-    """The constant global matrix ``M + L_w + K_w + h^2 S_grab`` (N x N, kg), canonical CSC,
-    each pinned row the identity's, and its diagonal before the pinning (N,).
-
-    ``L_w`` is the graph Laplacian of the springs weighted by ``h^2 ks + h kd``, ``K_w`` the
-    elements' ``sum_e w_e D D^T`` (:func:`element_weights`); the x and y coordinates share
-    it, so one N x N factor serves both. ``mass`` replaces ``M``'s diagonal (the solve uses
-    ``M (1 + h air_drag)``). A pinned row's equation is ``x_p = b_p`` (the caller puts the
-    pinned position in ``b_p``), while the free rows keep their coupling to it, so that it
-    acts on them as a known position.
-
-    ``patch = (a, diag, source, fresh)``: ``model`` is a torn copy of the Model whose matrix
-    and diagonal are ``a`` and ``diag`` (same ``h``, mass factor and grabs), vertex ``i``
-    a copy of its vertex ``source[i]``, and only the ``fresh`` vertices (N,) bool have
-    springs, elements or a mass the tear changed (:attr:`Model.torn_from`). Their columns
-    are assembled; every other column is the old one, its rows renumbered: the same numbers,
-    as it sums the same terms in the same order. ``weights``: :func:`element_weights` of
-    ``model`` and ``h``, when the caller has them already.
-
-    Examples
-    --------
-    >>> from deforma.physics.model import BodyTopology, Model
-    >>> t = BodyTopology.from_arrays([[0, 0], [1, 0]], [[0, 1]])
-    >>> m = Model([t], masses=[2.0], stiffness=[100.0], damping=[0.0])
-    >>> a, diag = system_matrix(m, np.full(2, -1, np.int32), np.zeros((0, 3)), 0.1)
-    >>> a.toarray().round(9).tolist(), diag.round(9).tolist()
-    ([[2.0, -1.0], [-1.0, 2.0]], [2.0, 2.0])
-    """
-    import scipy.sparse as sp
-
-    n = model.n_vertices
-    diag = (model.vertex_mass if mass is None else mass).copy()
-    held = np.flatnonzero(grab_slot >= 0)
-    diag[held] += h * h * grab_pull[grab_slot[held], 0]
-    if patch is None:
-        fresh, source, first = np.ones(n, np.bool_), np.zeros(0, np.int64), np.zeros(0, np.int64)
-        old = (np.zeros(1, np.int32), np.zeros(0, np.int32), np.zeros(0), np.zeros(0))
-    else:
-        a, old_diag, source, fresh = patch
-        source = np.ascontiguousarray(source, dtype=np.int64)
-        first = first_index(source, a.shape[0])
-        old = (a.indptr, a.indices, a.data, old_diag)  # SciPy's own arrays (int32 here): no copies
-    ptr, ind, val = _assemble(diag, model.spring_i, model.spring_j,
-                              h * h * model.spring_stiffness + h * model.spring_damping,
-                              model.elem, model.elem_b, element_weights(model, h) if weights is None else weights,
-                              model.pinned,
-                              np.ascontiguousarray(fresh, dtype=np.bool_), source, first, *old)
-    a = sp.csc_matrix((val, ind, ptr), shape=(n, n))
-    a.has_sorted_indices = True
-    return a, diag
-
-
-@njit(cache=True)
-def _assemble(diag, si, sj, sw, tris, b, ew, pinned, fresh, source, first, optr, oind, oval, odiag):
-    """CSC arrays of :func:`system_matrix` (``diag`` comes in as the masses and grabs and
-    leaves as the whole diagonal before pinning), column by column: each ``fresh`` vertex's
-    springs and elements are summed into a dense work column, whose touched rows are then
-    sorted; any other column is copied from the old matrix ``(optr, oind, oval)`` (diagonal
-    ``odiag``), column ``source[j]``, rows renumbered by ``first``. One pass over the
-    incidences; the coordinate-format build it replaced sorted 1.9e5 entries (4-5 ms on a
-    1e4-vertex sheet, at every tear). Entries that sum to exactly zero off the diagonal are
-    dropped (a right triangle's two legs do not couple: a stored zero would cost the factor
-    fill)."""
-    n = diag.shape[0]
-    ns, nt = si.shape[0], tris.shape[0]
-    start = np.zeros(n + 1, np.int64)  # per fresh vertex: its springs (s) and element corners (-1 - 3 e - c)
-    for k in range(ns):
-        if fresh[si[k]]:
-            start[si[k] + 1] += 1
-        if fresh[sj[k]]:
-            start[sj[k] + 1] += 1
-    for e in range(nt):
-        for c in range(3):
-            if fresh[tris[e, c]]:
-                start[tris[e, c] + 1] += 1
-    for v in range(n):
-        start[v + 1] += start[v]
-    fill = start[:-1].copy()
-    inc = np.empty(start[n], np.int64)
-    for k in range(ns):
-        if fresh[si[k]]:
-            inc[fill[si[k]]] = k
-            fill[si[k]] += 1
-        if fresh[sj[k]]:
-            inc[fill[sj[k]]] = k
-            fill[sj[k]] += 1
-    for e in range(nt):
-        for c in range(3):
-            if fresh[tris[e, c]]:
-                inc[fill[tris[e, c]]] = -1 - 3 * e - c
-                fill[tris[e, c]] += 1
-    work = np.zeros(n)
-    seen = np.zeros(n, np.bool_)
-    rows = np.empty(n, np.int64)
-    size = n + 2 * ns + 6 * nt
-    if size >= 2 ** 31:
-        raise ValueError("_assemble: the matrix would have 2^31 entries or more")
-    # int32 indices, as SciPy keeps them (it would copy int64 ones down to int32)
-    ptr = np.zeros(n + 1, np.int32)
-    ind = np.empty(size, np.int32)
-    val = np.empty(size)
-    out = 0
-    for j in range(n):
-        if not fresh[j]:
-            o = source[j]
-            if out + optr[o + 1] - optr[o] > size:  # Numba does not check indices: refuse rather than write astray
-                raise ValueError("_assemble: a kept column has more entries than its vertex's incidences allow")
-            for p in range(optr[o], optr[o + 1]):
-                ind[out] = first[oind[p]]
-                val[out] = oval[p]
-                out += 1
-            diag[j] = odiag[o]
-            ptr[j + 1] = out
-            continue
-        # the work column, written out here rather than through a helper: a compiled helper
-        # that writes arrays costs reference counting at every call (2.5 against 0.27 ms
-        # for the 1.8e5 entries of a 1e4-vertex sheet)
-        rows[0] = j
-        seen[j] = True
-        work[j] = diag[j]
-        m = 1
-        for p in range(start[j], start[j + 1]):
-            k = inc[p]
-            if k >= 0:
-                o = sj[k] if si[k] == j else si[k]
-                work[j] += sw[k]
-                if not seen[o]:
-                    seen[o] = True
-                    rows[m] = o
-                    m += 1
-                work[o] -= sw[k]
-            else:
-                e, c = (-1 - k) // 3, (-1 - k) % 3
-                d1x, d1y, d2x, d2y = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
-                dxc = -d1x - d2x if c == 0 else (d1x if c == 1 else d2x)
-                dyc = -d1y - d2y if c == 0 else (d1y if c == 1 else d2y)
-                for v in range(3):
-                    r = tris[e, v]
-                    if not seen[r]:
-                        seen[r] = True
-                        rows[m] = r
-                        m += 1
-                    dxv = -d1x - d2x if v == 0 else (d1x if v == 1 else d2x)
-                    dyv = -d1y - d2y if v == 0 else (d1y if v == 1 else d2y)
-                    work[r] += ew[e] * (dxv * dxc + dyv * dyc)  # w_e D_v . D_c
-        diag[j] = work[j]
-        sort_few(rows, m)  # a column holds a vertex's few neighbours
-        for a in range(m):
-            r = rows[a]
-            v = work[r]
-            work[r] = 0.0
-            seen[r] = False
-            if r == j:
-                ind[out] = r
-                val[out] = 1.0 if pinned[j] else v
-                out += 1
-            elif v != 0.0 and not pinned[r]:
-                ind[out] = r
-                val[out] = v
-                out += 1
-        ptr[j + 1] = out
-    return ptr, ind[:out], val[:out]
-
-
-@njit(cache=True, inline="always")
-def _sort_rows(ind, val, lo, hi):
-    """Sort ``ind[lo:hi]`` (row indices of one column) and ``val`` with it, in place: an
-    insertion sort, as a column holds a vertex's few neighbours."""
-    for a in range(lo + 1, hi):
-        r, v = ind[a], val[a]
-        b = a - 1
-        while b >= lo and ind[b] > r:
-            ind[b + 1] = ind[b]
-            val[b + 1] = val[b]
-            b -= 1
-        ind[b + 1] = r
-        val[b + 1] = v
-
-
-@njit(cache=True)
-def _merge(ptr, ind, val, rows, cols, vals, pinned):
-    """CSC arrays of the canonical CSC matrix ``(ptr, ind, val)`` plus the entries ``(rows,
-    cols, vals)`` (those in ``pinned`` rows left out), summed where they meet; entries that
-    sum to exactly zero off the diagonal dropped (a right triangle's two legs do not couple:
-    a stored zero would cost the factor fill)."""
-    n = ptr.shape[0] - 1
-    extra = np.zeros(n + 1, np.int64)
-    for k in range(rows.shape[0]):
-        if not pinned[rows[k]]:
-            extra[cols[k] + 1] += 1
-    for c in range(n):
-        extra[c + 1] += extra[c]
-    er = np.empty(extra[n], np.int64)
-    ev = np.empty(extra[n])
-    fill = extra[:-1].copy()
-    for k in range(rows.shape[0]):
-        if not pinned[rows[k]]:
-            c = cols[k]
-            er[fill[c]] = rows[k]
-            ev[fill[c]] = vals[k]
-            fill[c] += 1
-    if ind.shape[0] + er.shape[0] >= 2 ** 31:
-        raise ValueError("_merge: the matrix would have 2^31 entries or more")
-    out_ptr = np.zeros(n + 1, np.int32)  # int32, as SciPy keeps them (it would copy int64 ones down)
-    out_ind = np.empty(ind.shape[0] + er.shape[0], np.int32)
-    out_val = np.empty(ind.shape[0] + er.shape[0])
-    out = 0
-    for c in range(n):
-        lo, hi = extra[c], extra[c + 1]
-        _sort_rows(er, ev, lo, hi)  # the column's few extra entries in row order
-        first = out
-        p, q = ptr[c], lo
-        while p < ptr[c + 1] or q < hi:
-            if q >= hi or (p < ptr[c + 1] and ind[p] <= er[q]):
-                r, v = ind[p], val[p]
-                p += 1
-            else:
-                r, v = er[q], ev[q]
-                q += 1
-            if out > first and out_ind[out - 1] == r:
-                out_val[out - 1] += v
-            else:
-                if out > first and out_val[out - 1] == 0.0 and out_ind[out - 1] != c:
-                    out -= 1
-                out_ind[out] = r
-                out_val[out] = v
-                out += 1
-        if out > first and out_val[out - 1] == 0.0 and out_ind[out - 1] != c:
-            out -= 1
-        out_ptr[c + 1] = out
-    return out_ptr, out_ind[:out], out_val[:out]
-
-
-def with_entries(a, rows, cols, vals, pinned) -> sp.csc_matrix:
-    """The canonical CSC matrix ``a`` (from :func:`system_matrix`, pinned rows already the
-    identity's) plus the entries ``(rows, cols, vals)``, none added to a ``pinned`` row: the
-    contacts' terms on the contact-free matrix, merged column by column.
-
-    Examples
-    --------
-    >>> import scipy.sparse as sp
-    >>> a = sp.csc_matrix(np.diag([2.0, 3.0]))
-    >>> b = with_entries(a, np.array([0, 1]), np.array([1, 0]), np.array([-1.0, -1.0]), np.zeros(2, bool))
-    >>> b.toarray().tolist()
-    [[2.0, -1.0], [-1.0, 3.0]]
-    """
-    import scipy.sparse as sp
-
-    ptr, ind, val = _merge(a.indptr, a.indices, a.data,
-                           np.asarray(rows, dtype=np.int64), np.asarray(cols, dtype=np.int64),
-                           np.asarray(vals, dtype=np.float64), np.asarray(pinned, dtype=np.bool_))
-    out = sp.csc_matrix((val, ind, ptr), shape=a.shape)
-    out.has_sorted_indices = True
-    return out
-
-
 def _row_items(t) -> np.ndarray:
     """The rows of an integer array (M, 3) as single comparable items (for set operations)."""
     t = np.ascontiguousarray(t, dtype=np.int64)
@@ -572,7 +316,7 @@ class ImplicitEuler:
     factorizations : int
         How many times the matrix was factored: at the start, and after changes of the
         parameters, ``h`` or ``contact_weight``, and after small changes (tears, contact
-        sets, grabs) have added up (:mod:`~deforma.physics.updated_factor`).
+        sets, grabs) have added up (:mod:`~deforma.physics.integrators.implicit.updated_factor`).
     updates : int
         How many times a small change of the matrix was taken into the factor by a low-rank
         correction instead of factoring again.

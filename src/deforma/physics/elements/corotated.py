@@ -87,7 +87,7 @@ def energy_density(f, mu, lam):
 def size_constraint(f00, f01, f10, f11):
     """XPBD's size constraint of ``F``: ``(C_vol, gradient (4))`` with ``C_vol = tr S - 2``
     and gradient ``R`` (stiffness ``mu + lambda`` per unit area; the shear constraints are
-    :func:`~deforma.physics.elements.project_elements`'s).
+    :func:`~deforma.physics.elements.triangles.project_elements`'s).
 
     Examples
     --------

@@ -1,6 +1,6 @@
 """The material behaviours that run around a step: gas pressure before it, the stretch limit
 and plasticity after it (tearing, which changes a body's mesh, is the World's:
-:mod:`deforma.physics.tearing`).
+:mod:`deforma.physics.behaviours.tearing`).
 
 Each reads the bodies' materials from the :class:`~deforma.physics.model.Model` and works on
 the body's own slice of the arrays, so a world whose materials have none of them pays one

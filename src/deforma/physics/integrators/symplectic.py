@@ -10,7 +10,7 @@ Semi-implicit (symplectic) Euler, per substep::
 
 Every integrator ends its substeps with the same two responses: the collider response per
 vertex (fused into its last pass over the vertices) and then the body contact stage of
-:mod:`~deforma.physics.contacts` (collide, solve, verify), which needs the boundary's
+:mod:`~deforma.physics.contact` (collide, solve, verify), which needs the boundary's
 positions at the start of the substep (``contacts.gather_start``).
 
 It is fused into two passes over memory per substep: springs, each thread scattering a
@@ -25,18 +25,20 @@ from __future__ import annotations
 import math
 import time
 
-
 import numba
 import numpy as np
 from numba import njit, prange
 
-from .colliders import (RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN, advance_colliders, collide_point, is_bad,
-                        jump_reach, n_colliders, push_edges_off_corners, record_hit)
-from .contacts import ST_STAMP, contact_stage, gather_start
-from .elements import element_forces
-from .forces import spring_force
-from .integrators import register_integrator
-from .jit import serial_and_parallel
+from ..colliders.geometry import advance_colliders, jump_reach, n_colliders
+from ..colliders.response import collide_point, push_edges_off_corners, record_hit
+from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
+from ..contact.broad_phase import gather_start
+from ..contact.contacts import ST_STAMP
+from ..contact.stage import contact_stage
+from ..elements.springs import scatter_spring_forces
+from ..elements.triangles import element_forces
+from ..jit import serial_and_parallel
+from .base import is_bad, register_integrator
 
 # Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
 PARALLEL_MIN_VERTICES = 512
@@ -48,33 +50,6 @@ def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, keep, h):
     vx = (vx + h * (fx * inv_mass + gx)) * keep
     vy = (vy + h * (fy * inv_mass + gy)) * keep
     return x0 + h * vx, y0 + h * vy, vx, vy
-
-
-@njit(cache=True)
-def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
-    """Add the force (N) of every spring to both of its ends in ``f`` (N, 2).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> f = np.zeros((2, 2))
-    >>> scatter_spring_forces(np.array([[0., 0.], [2., 0.]]), np.zeros((2, 2)), np.array([0], np.int32),
-    ...                       np.array([1], np.int32), np.ones(1), np.full(1, 10.0), np.zeros(1), f)
-    >>> f.tolist()
-    [[10.0, 0.0], [-10.0, 0.0]]
-    """
-    # Indices that Numba knows are >= 0 skip its negative-index wraparound test: the loop
-    # runs over range(len) (not range(lo, hi)) and vertex ids are read as unsigned; together
-    # this made the kernel 25-35% faster.
-    for e in range(spring_i.shape[0]):
-        a = np.uint64(spring_i[e])
-        b = np.uint64(spring_j[e])
-        fx, fy = spring_force(x[a, 0], x[a, 1], x[b, 0], x[b, 1], v[a, 0], v[a, 1], v[b, 0], v[b, 1],
-                              rest[e], ks[e], kd[e])
-        f[a, 0] += fx
-        f[a, 1] += fy
-        f[b, 0] -= fx
-        f[b, 1] -= fy
 
 
 # Both drivers below run the same two passes per substep:
@@ -95,7 +70,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
 
     ``fbuf`` (T, N, 2) are zeroed force buffers, one per chunk ``t`` of springs
     (``chunk_ptr[t]:chunk_ptr[t + 1]``) and of triangle elements (``elem_ptr[t]:elem_ptr[t +
-    1]``; see :mod:`deforma.physics.elements` for ``elem*``), and are left zeroed; chunk
+    1]``; see :mod:`deforma.physics.elements.triangles` for ``elem*``), and are left zeroed; chunk
     ``t`` touches only the vertices ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see
     :func:`spring_chunks`). A vertex with ``inv_mass`` 0 is pinned: it stays where it is. Saves the start state into ``x_start`` /
     ``v_start``; stops early and returns the number of vertices that ended non-finite or

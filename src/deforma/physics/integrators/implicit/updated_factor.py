@@ -1,6 +1,6 @@
 """A sparse factorisation kept across small changes of its matrix: tears, contacts, grabs.
 
-Implicit Euler (:mod:`deforma.physics.implicit`) solves with a factored matrix ``A`` that
+Implicit Euler (:mod:`deforma.physics.integrators.implicit`) solves with a factored matrix ``A`` that
 changes now and then: a tear splits vertices (the matrix gains rows and its entries move to
 the copies), a new contact set adds a few weights, a mouse grab one more. Factoring again
 took 15-18 ms on a 1e4-vertex sheet (and grows faster than the mesh); one solve with the
@@ -44,12 +44,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from .model import first_index, sort_few
+from .assembly import first_index, sort_few
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
-
-__all__ = ["UpdatedFactor", "factor"]
 
 #: Columns of ``[Z V]`` past which :meth:`UpdatedFactor.update` declines. On a 1e4-vertex
 #: sheet (2 cores) the product with 64 columns costs about 0.3 ms per solve, a solved column

@@ -29,7 +29,7 @@ the shear stiffness then acts only through the constraint's curvature, one subst
 shear and ``C_H = J - 1`` are both zero at rest, so the rest shape carries no multiplier
 and shear is resisted directly; the shear enters as its two linear parts ``C_a = F00 - F11``
 and ``C_b = F01 + F10`` (``C_S^2 = C_a^2 + C_b^2``), whose projection is exact, and the three
-are solved together (see :func:`~deforma.physics.elements.project_elements`): a body rests
+are solved together (see :func:`~deforma.physics.elements.triangles.project_elements`): a body rests
 at any step.
 """
 
@@ -114,7 +114,7 @@ def size_constraint(f00, f01, f10, f11):
     """XPBD's size constraint of ``F``: ``(C_H, gradient (4))`` with ``C_H = J - 1`` and
     gradient ``cof F`` (stiffness ``lambda'`` per unit area; the shear constraints ``C_a``,
     ``C_b``, whose squares sum to ``C_S^2``, are
-    :func:`~deforma.physics.elements.project_elements`'s).
+    :func:`~deforma.physics.elements.triangles.project_elements`'s).
 
     Examples
     --------

@@ -23,10 +23,10 @@ import math
 
 import numpy as np
 
-from ..checks import coefficient as _coefficient
-from ..checks import number as _number
-from ..checks import pair as _pair
-from ..mesh.polygons import inside_loops, segments_meet, signed_area
+from ...checks import coefficient as _coefficient
+from ...checks import number as _number
+from ...checks import pair as _pair
+from ...mesh.polygons import inside_loops, segments_meet, signed_area
 
 # Columns of the packed array. Collider rows:
 RECT_CX, RECT_CY, RECT_UX, RECT_UY = 0, 1, 2, 3   # centre; unit x axis of the shape's frame
@@ -681,7 +681,7 @@ def colliders_from_image(source, *, scale=0.01, position=(0.0, 0.0), tolerance=1
     >>> len(level), len(level[0].points)  # one piece: an upside-down T, 8 corners
     (1, 8)
     """
-    from ..mesh.outline import outline
+    from ...mesh.outline import outline
 
     x, y = _pair(position, "position")
     pieces = outline(source, scale=scale, tolerance=tolerance, background=background, threshold=threshold,

@@ -2,7 +2,7 @@
 
 A material with ``max_stretch = s`` (``deforma.Material(..., max_stretch=1.05)``) is
 projected after every step (any integrator): each spring longer than ``s`` times its rest
-length, and each triangle with a principal stretch (:mod:`deforma.physics.strain`) above
+length, and each triangle with a principal stretch (:mod:`deforma.physics.behaviours.strain`) above
 ``s``, is shortened to exactly ``s`` by moving its vertices along the constraint's gradient
 weighted by their inverse masses (Provot 1995 for springs; the stretch of an element is
 limited in its principal directions, as in Thomaszewski et al. 2009). Sweeps repeat, in
@@ -22,7 +22,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .elements import _corners, _gradient, _vertex_gradients, _dot
+from ..elements.triangles import (
+    corners,
+    deformation_gradient,
+    vertex_gradients,
+    weighted_dot,
+)
 from .strain import principal_stretches
 
 #: A constraint within this (strain) of its limit is active: the velocity that stretches it
@@ -106,19 +111,19 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
     (``move``) and remove the velocity that stretches one at its limit further (``stop``).
 
     ``C = s_i - max_stretch`` for each principal stretch above the limit, gradient ``R v_i
-    v_i^T`` in ``F`` (:mod:`deforma.physics.strain`). Returns the sweeps run, the largest
+    v_i^T`` in ``F`` (:mod:`deforma.physics.behaviours.strain`). Returns the sweeps run, the largest
     excess stretch left (0 when none) and how many constraints the first sweep found active.
 
     Examples
     --------
     >>> import numpy as np
-    >>> from deforma.physics.elements import rest_geometry
+    >>> from deforma.physics.elements.triangles import rest_geometry
     >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     >>> bb, _ = rest_geometry(x, [[0, 1, 2]])
     >>> x[1, 0] = 2.0  # twice as long along x
     >>> limit_elements(x, np.zeros((3, 2)), np.ones(3), np.array([[0, 1, 2]], np.int32), bb, 1.2, 1e-4, 50)[1]
     0.0
-    >>> from deforma.physics.strain import stretch_field
+    >>> from deforma.physics.behaviours.strain import stretch_field
     >>> bool(stretch_field(x, [[0, 1, 2]], bb)[0].max() <= 1.2 + 1e-4)
     True
     """
@@ -132,10 +137,10 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
             # sweeps alternate direction: a correction then travels the length of the body in
             # one sweep either way (a chain pulled at one end converged ~10x faster)
             e = n if sweeps % 2 == 1 else m - 1 - n
-            i, j, k, b0, b1, b2, b3 = _corners(elem, b, e)
+            i, j, k, b0, b1, b2, b3 = corners(elem, b, e)
             wi, wj, wk = inv_mass[i], inv_mass[j], inv_mass[k]
             for which in range(2):
-                f00, f01, f10, f11 = _gradient(x, i, j, k, b0, b1, b2, b3)
+                f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
                 s1, s2, v1x, v1y, c, s = principal_stretches(f00, f01, f10, f11)
                 if which == 0:
                     cons = s1 - max_stretch
@@ -147,8 +152,8 @@ def limit_elements(x, v, inv_mass, elem, b, max_stretch, tolerance, max_sweeps, 
                     continue
                 ux = c * vx - s * vy  # u = R v, gradient u v^T
                 uy = s * vx + c * vy
-                g = _vertex_gradients(ux * vx, ux * vy, uy * vx, uy * vy, b0, b1, b2, b3)
-                norm = _dot(wi, wj, wk, g, g)
+                g = vertex_gradients(ux * vx, ux * vy, uy * vx, uy * vy, b0, b1, b2, b3)
+                norm = weighted_dot(wi, wj, wk, g, g)
                 if norm == 0.0:
                     continue
                 if sweeps == 1:

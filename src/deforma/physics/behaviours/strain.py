@@ -1,8 +1,8 @@
 """Principal stretches: how much a triangle is stretched, and in which direction.
 
-The deformation gradient of a triangle (:mod:`deforma.physics.elements`) factors as ``F = R
+The deformation gradient of a triangle (:mod:`deforma.physics.elements.triangles`) factors as ``F = R
 S`` (``R`` a rotation, ``S`` symmetric, the 2D polar decomposition of
-:func:`~deforma.physics.corotated.polar_rotation`). The eigenvalues ``s1 >= s2`` of ``S``
+:func:`~deforma.physics.elements.corotated.polar_rotation`). The eigenvalues ``s1 >= s2`` of ``S``
 are the principal stretches (1 at rest; 1.1 means 10% longer along that direction; a
 negative ``s2`` means the triangle is inverted) and its unit eigenvectors ``v1``, ``v2 =
 perp(v1)`` the directions, in the rest shape, along which they act; ``R v1`` is the same
@@ -10,7 +10,7 @@ direction in the world. Tearing, plasticity and the stretch limit all read these
 
 The derivative of a principal stretch is simple: ``d s_i / dF = R v_i v_i^T`` (the singular
 value's derivative ``u_i v_i^T`` with ``u_i = R v_i``), so a constraint on a stretch has the
-gradient :func:`~deforma.physics.elements._vertex_gradients` turns into vertex gradients.
+gradient :func:`~deforma.physics.elements.triangles.vertex_gradients` turns into vertex gradients.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .corotated import polar_rotation
-from .elements import deformation_gradients
+from ..elements.corotated import polar_rotation
+from ..elements.triangles import deformation_gradients
 
 
 @njit(cache=True, inline="always")
@@ -51,7 +51,7 @@ def stretch_field(x, tris, b):
     Examples
     --------
     >>> import numpy as np
-    >>> from deforma.physics.elements import rest_geometry
+    >>> from deforma.physics.elements.triangles import rest_geometry
     >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     >>> bb, _ = rest_geometry(x, [[0, 1, 2]])
     >>> s, d = stretch_field(x * [2.0, 1.0], [[0, 1, 2]], bb)

@@ -33,14 +33,14 @@ through the body within it. A collider contact sticks or slides as decided once 
 from its predicted push (the collider rule's impulse): stuck, its tangential motion since the
 substep began is undone in every sweep; sliding, each sweep holds it back by ``friction``
 times that sweep's push. Body contacts are found for the predicted motion by the contact
-stage's own broad and narrow phase (:func:`~deforma.physics.contacts.detect_contacts`) and
+stage's own broad and narrow phase (:func:`~deforma.physics.contact.narrow_phase.detect_contacts`) and
 projected as the stage projects them, with the same position-level friction as colliders
-(stick or slide decided by the first sweep; :func:`~deforma.physics.contacts.project_contacts`).
+(stick or slide decided by the first sweep; :func:`~deforma.physics.contact.response.project_contacts`).
 That friction matters where the sweep itself separates a pair (a thick contact, a fast hit):
 the contact stage after the sweep then sees no approach and gives no friction impulse.
 Resting pairs are held by the stage's speculative contacts, which carry friction. A pair
 that starts the substep closer than its target is held there, not pushed apart (velocities
-come from positions: :func:`~deforma.physics.contacts.hold_start_distance`). The full
+come from positions: :func:`~deforma.physics.contact.response.hold_start_distance`). The full
 collider response and contact stage still run after the sweep.
 
 One Gauss-Seidel sweep per substep (``iterations = 1``, the "small steps" choice) carries
@@ -59,12 +59,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .colliders import advance_colliders, contact_planes, finish_position_step, push_edges_off_corners
-from .contacts import (ST_NEEDED, ST_PAIRS_NEEDED, ST_STAMP, contact_stage, detect_contacts, gather_start,
-                       hold_start_distance, project_contacts)
-from .elements import project_elements
-from .integrators import register_integrator
-
+from ..colliders.geometry import advance_colliders
+from ..colliders.response import contact_planes, push_edges_off_corners
+from ..contact.broad_phase import gather_start
+from ..contact.contacts import ST_NEEDED, ST_PAIRS_NEEDED, ST_STAMP
+from ..contact.narrow_phase import detect_contacts
+from ..contact.response import hold_start_distance, project_contacts
+from ..contact.stage import contact_stage
+from ..elements.triangles import project_elements
+from .base import finish_position_step, register_integrator
 
 COLOURS = 64  # colours of the sweep order's greedy colouring (one bit each in a uint64 per vertex)
 
@@ -156,7 +159,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         Scratch: accumulated multipliers (N s^2).
     planes, touch : (N, 8) float64, (N,) int32
         Scratch: the collider contacts of the substep
-        (:func:`~deforma.physics.colliders.contact_planes`; column 7: 1 stuck, 0 sliding).
+        (:func:`~deforma.physics.colliders.response.contact_planes`; column 7: 1 stuck, 0 sliding).
     inv_mass : (N,) float64
         1/kg.
     spring_i, spring_j : (E,) int32
@@ -166,7 +169,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     spring_order : (E,) int64
         The springs by colour (:func:`sweep_order`), the order of every sweep.
     elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind : arrays
-        Triangle elements (see :mod:`deforma.physics.elements`).
+        Triangle elements (see :mod:`deforma.physics.elements.triangles`).
     elem_order, elem_starts : (T,) int64, (COLOURS + 1,) int64
         The elements by colour and where each colour starts.
     seed : int
@@ -187,7 +190,7 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     hits : ColliderHits
         Collider contacts, per vertex.
     ctopo, cscr, cbuf : namedtuples
-        The contact stage's topology, scratch and buffer (:mod:`deforma.physics.contacts`).
+        The contact stage's topology, scratch and buffer (:mod:`deforma.physics.contact`).
     h : float
         Substep (s).
     substeps, iterations : int
@@ -204,8 +207,8 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     Examples
     --------
     >>> import numpy as np
-    >>> from deforma.physics.contacts import empty_topology, make_buffer, make_scratch
-    >>> from deforma.physics.colliders import make_hits
+    >>> from deforma.physics.contact.contacts import empty_topology, make_buffer, make_scratch
+    >>> from deforma.physics.colliders.response import make_hits
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
     >>> elem = np.zeros((0, 3), np.int32)
     >>> no_elements = (elem, np.zeros((0, 4)), *[np.zeros(0)] * 4, np.zeros(0, np.int32), *sweep_order(elem, 2))

@@ -7,7 +7,7 @@ rest shape. After each step, whatever lies beyond becomes permanent (at the shar
 
 * a spring of length ``L`` outside ``[(1 - y) r, (1 + y) r]`` gets the rest length ``r``
   that puts it on the nearer bound;
-* a triangle's principal stretches ``s_i`` (:mod:`deforma.physics.strain`) outside the
+* a triangle's principal stretches ``s_i`` (:mod:`deforma.physics.behaviours.strain`) outside the
   bounds are split ``F = F_e F_p`` into an elastic part on the bound and a plastic part
   ``F_p = V diag(p) V^T`` (``p_i = s_i / clamp(s_i)``, ``V`` the principal directions in the
   rest shape); the rest shape becomes ``F_p`` applied to the old one: ``B <- B F_p^-1``,
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from .elements import _corners, _gradient
+from ..elements.triangles import corners, deformation_gradient
 from .strain import principal_stretches
 
 REST_LIMIT = 4.0
@@ -76,7 +76,7 @@ def yield_elements(x, elem, b, area, b0, area0, yield_strain, rate):
     Examples
     --------
     >>> import numpy as np
-    >>> from deforma.physics.elements import rest_geometry
+    >>> from deforma.physics.elements.triangles import rest_geometry
     >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     >>> bb, a = rest_geometry(x, [[0, 1, 2]])
     >>> x[1, 0] = 1.5  # 50% longer along x; yield at 10%
@@ -89,8 +89,8 @@ def yield_elements(x, elem, b, area, b0, area0, yield_strain, rate):
     hi = 1.0 + yield_strain
     changed = 0
     for e in range(elem.shape[0]):
-        i, j, k, b00, b01, b10, b11 = _corners(elem, b, e)
-        f00, f01, f10, f11 = _gradient(x, i, j, k, b00, b01, b10, b11)
+        i, j, k, b00, b01, b10, b11 = corners(elem, b, e)
+        f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b00, b01, b10, b11)
         s1, s2, vx, vy, _, _ = principal_stretches(f00, f01, f10, f11)
         if s2 <= 0.0 or (lo <= s2 and s1 <= hi):
             continue  # inverted (no flow) or elastic

@@ -1,0 +1,219 @@
+"""The contact stage's data: the bodies as it reads them (:class:`ContactTopology`), its
+scratch (:class:`ContactScratch`) and the contacts it finds (:class:`ContactBuffer`), the
+status slots, and :class:`Contacts`, what ``world.contacts`` shows a user.
+
+The three are namedtuples of arrays that :class:`~deforma.physics.model.Model`, the world
+and the integrators own; the kernels of :mod:`~deforma.physics.contact` read and write them.
+Units: m, m/s, kg.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..colliders.shapes import RECT_FRICTION, RECT_STATIC_FRICTION
+
+# Bits of ContactTopology.body_flags.
+COLLIDE = 1          # touches other bodies
+SELF_COLLIDE = 2     # touches itself
+
+CONTACT_ITERATIONS = 2   # position sweeps over the contacts per substep
+SPECULATIVE = 2.0        # proximity contacts reach this many thicknesses (see solve_contacts)
+VERIFY_ROUNDS = 3        # crossing checks (and re-solves) before the fail-safe
+SIDE_MARGIN = 1e-3       # a crossing is put back at least this fraction of the thickness off the line
+
+# Contact kinds in ContactBuffer.kind.
+PROXIMITY = 1
+CROSSING = 2
+
+# Slots of ContactScratch.status.
+ST_CONTACTS = 0      # contacts found by the first narrow phase of the last substep
+ST_NEEDED = 1        # > 0: the buffer's contact arrays were too small, this many are needed
+ST_PAIRS_NEEDED = 2  # > 0: ... its candidate pair arrays
+ST_FAILSAFE = 3      # substeps that needed the impact-zone fail-safe (cumulative)
+ST_STAMP = 4         # substeps run through the stage (cumulative)
+ST_PAIRS = 5         # candidate pairs of the last substep
+ST_ACTIVE = 6        # collision vertices tested in the last substep
+ST_DIRTY = 7         # length of ContactScratch.dirty
+ST_GEN = 8           # generations of checks (cumulative)
+ST_TOUCHED = 9       # length of ContactScratch.touched
+
+ContactTopology = namedtuple("ContactTopology", [
+    "cv_vertex",        # (V,) int32: global vertex index of each collision vertex: the outline
+                        #   vertices of every body, then every body's other vertices
+    "cv_body",          # (V,) int32: its body
+    "vertex_cv",        # (N,) int32: the collision vertex of each world vertex (-1: none)
+    "body_outline",     # (B + 1,) int64: body b's outline vertices are cv[body_outline[b]:...[b + 1]]
+    "body_interior",    # (B + 1,) int64: ... its other vertices cv[body_interior[b]:...[b + 1]]
+    "tri",              # (T, 3) int32: every body's triangles, global vertex indices
+    "body_tri",         # (B + 1,) int64: body b's triangles are tri[body_tri[b]:body_tri[b + 1]]
+    "ce_a", "ce_b",     # (Ec,) int32: outline edge ends, as collision-vertex indices
+    "ce_body",          # (Ec,) int32: the edge's body
+    "thick_other",      # (V,) float64: contact thickness against other bodies (m); a pair of two
+                        #   outlines uses the larger of its two bodies' (body_thickness)
+    "thick_self",       # (V,) float64: ... against its own body (m)
+    "body_flags",       # (B,) int32: COLLIDE | SELF_COLLIDE
+    "body_thickness",   # (B,) float64: each body's contact thickness (m)
+    "body_friction",    # (B, 2) float64: dynamic, static coefficient for body contacts
+    "margin",           # (1,) float64: growth of the edge boxes (m): SPECULATIVE times the largest thickness
+])
+
+ContactScratch = namedtuple("ContactScratch", [
+    "xp",               # (V, 2): collision vertices at the start of the substep
+    "active",           # (V,) int32: the collision vertices tested this substep (status[ST_ACTIVE] of them)
+    "body_box",         # (B, 4) float64: each body's swept box xmin, ymin, xmax, ymax
+    "xq",               # (V, 2): ... when the grid was built
+    "dirty",            # (V,) int32: vertices the response moved since the last check (status[ST_DIRTY])
+    "dirty_mark",       # (V,) int64: the check generation (status[ST_GEN]) a vertex was listed in dirty
+    "touched",          # (V,) int32: every vertex the stage moved this substep (status[ST_TOUCHED])
+    "touched_mark",     # (V,) int64: the substep (status[ST_STAMP]) a vertex was listed in touched
+    "pair_ptr",         # (V + 1,) int64: CSR, the candidate pairs each vertex is part of (out.pair_index)
+    "pair_fill",        # (V,) int64: fill cursors for it
+    "zone_list",        # (V,) int32: the vertices in impact zones
+    "zone_mark",        # (V,) int64: the fail-safe call (status[ST_GEN]) a vertex joined a zone in
+    "ebox",             # (Ec, 4) float64: edge boxes xmin, ymin, xmax, ymax as in the grid
+    "ecell",            # (Ec, 4) int64: the cells they cover, ix0, iy0, ix1, iy1
+    "cell_start",       # (T + 1,) int64: bucket starts (T a power of two)
+    "cell_fill",        # (T,) int64: fill cursors
+    "cell_items",       # (I,) int32: edge indices by bucket
+    "grid",             # (3,) float64: origin x, origin y, 1 / cell size
+    "parent",           # (V,) int32: impact zones (union-find)
+    "zone",             # (V, 5) float64: zone sums m vx, m vy, m, members, still
+    "status",           # (10,) int64: see ST_*
+])
+
+ContactBuffer = namedtuple("ContactBuffer", [
+    "vertex", "edge",   # (C,) int32: collision vertex, outline edge
+    "s",                # (C,): position along the edge, 0 at ce_a, 1 at ce_b
+    "normal",           # (C, 2): unit normal toward the side the vertex must stay on
+    "depth",            # (C,): how far (m) the vertex was from its target at detection
+    "target",           # (C,): distance (m) from the edge's line that the response restores
+    "mu",               # (C, 2): dynamic, static friction
+    "kind",             # (C,) int8: PROXIMITY or CROSSING
+    "pair_vertex",      # (P,) int32: candidate pairs of the first narrow phase
+    "pair_edge",        # (P,) int32
+    "pair_index",       # (3P,) int32: the pairs by vertex (ContactScratch.pair_ptr)
+    "pair_mark",        # (P,) int64: the check generation a pair was last selected in
+    "pair_sel",         # (P,) int32: the pairs one check tests
+])
+
+
+def empty_topology(n_bodies: int = 0) -> ContactTopology:
+    """A topology without collision vertices (no body collides)."""
+    i32, f64, offsets = np.zeros(0, np.int32), np.zeros(0), np.zeros(n_bodies + 1, np.int64)
+    return ContactTopology(i32, i32, i32, offsets, offsets, np.zeros((0, 3), np.int32), offsets, i32, i32, i32, f64,
+                           f64, np.zeros(n_bodies, np.int32),
+                           np.zeros(n_bodies), np.zeros((n_bodies, 2)), np.zeros(1))
+
+
+def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScratch:
+    """Scratch arrays for ``n_vertices`` collision vertices, ``n_edges`` outline edges, ``n_bodies`` bodies."""
+    t = 16
+    while t < 2 * n_edges:
+        t *= 2
+    v = n_vertices
+    never = np.full(v, -1, np.int64)
+    return ContactScratch(np.zeros((v, 2)), np.zeros(v, np.int32), np.zeros((n_bodies, 4)),
+                          np.zeros((v, 2)), np.zeros(v, np.int32), never.copy(), np.zeros(v, np.int32), never.copy(),
+                          np.zeros(v + 1, np.int64), np.zeros(v, np.int64), np.zeros(v, np.int32), never.copy(),
+                          np.zeros((n_edges, 4)), np.zeros((n_edges, 4), np.int64), np.zeros(t + 1, np.int64),
+                          np.zeros(t, np.int64), np.zeros(16 * n_edges + 64, np.int32), np.zeros(3),
+                          np.zeros(v, np.int32), np.zeros((v, 5)), np.zeros(10, np.int64))
+
+
+def make_buffer(contacts: int, pairs: int) -> ContactBuffer:
+    """Room for ``contacts`` contacts and ``pairs`` candidate pairs."""
+    c = max(int(contacts), 16)
+    p = max(int(pairs), 16)
+    return ContactBuffer(np.zeros(c, np.int32), np.zeros(c, np.int32), np.zeros(c), np.zeros((c, 2)), np.zeros(c),
+                         np.zeros(c), np.zeros((c, 2)), np.zeros(c, np.int8), np.zeros(p, np.int32),
+                         np.zeros(p, np.int32), np.zeros(3 * p, np.int32), np.full(p, -1, np.int64),
+                         np.zeros(p, np.int32))
+
+
+@njit(cache=True, inline="always")
+def note_moved(k, dirty, dirty_mark, gen, touched, touched_mark, stamp, status):
+    # list vertex k as moved: for the next check (dirty) and for the collider pass (touched)
+    if dirty_mark[k] != gen:
+        dirty_mark[k] = gen
+        dirty[status[ST_DIRTY]] = k
+        status[ST_DIRTY] += 1
+    if touched_mark[k] != stamp:
+        touched_mark[k] = stamp
+        touched[status[ST_TOUCHED]] = k
+        status[ST_TOUCHED] += 1
+
+
+@dataclass(frozen=True)
+class Contacts:
+    """The contacts of the last substep, as arrays (struct of arrays, one row per contact).
+
+    Collider contacts come first: the vertices the collider response put back outside a
+    collider. Then body contacts: what the contact stage found before its response (a
+    vertex against another body's outline edge, or against its own).
+
+    Attributes
+    ----------
+    vertex : (C,) int64
+        World vertex index (rows of the world's state arrays).
+    collider : (C,) int64
+        Index into ``world.colliders``, or -1 for a body contact.
+    edge : (C, 2) int64
+        World vertex indices of the boundary edge's ends, or -1 for a collider contact.
+    weight : (C,) float64
+        Where the vertex's foot lies on the edge: 0 at ``edge[:, 0]``, 1 at ``edge[:, 1]``.
+    normal : (C, 2) float64
+        Unit normal pointing from the other side toward the vertex.
+    depth : (C,) float64
+        Metres the vertex had to move at detection: to its target distance from the edge
+        (the contact thickness, see ``docs/physics.md``) for body contacts, out of the
+        collider for collider contacts.
+    friction, static_friction : (C,) float64
+        The coefficients the contact used.
+    """
+
+    vertex: np.ndarray
+    collider: np.ndarray
+    edge: np.ndarray
+    weight: np.ndarray
+    normal: np.ndarray
+    depth: np.ndarray
+    friction: np.ndarray
+    static_friction: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.vertex)
+
+    @property
+    def body_contacts(self) -> np.ndarray:
+        """(C,) bool: rows that are body (edge) contacts."""
+        return self.collider < 0
+
+
+def snapshot(topo: ContactTopology, scr: ContactScratch, buf: ContactBuffer, hits, rects) -> Contacts:
+    """The contacts of the last substep as a :class:`Contacts`, in world vertex indices.
+
+    ``hits`` is the world's ``ColliderHits`` record and ``rects`` the packed colliders (for
+    the coefficients each collider contact used).
+    """
+    n = int(scr.status[ST_CONTACTS])
+    k = buf.vertex[:n]
+    j = buf.edge[:n]
+    cv = topo.cv_vertex.astype(np.int64)
+    edge = np.stack([cv[topo.ce_a[j]], cv[topo.ce_b[j]]], axis=1) if n else np.zeros((0, 2), np.int64)
+    touched = np.flatnonzero(hits.stamp == scr.status[ST_STAMP]) if scr.status[ST_STAMP] > 0 else np.zeros(0, int)
+    col = hits.collider[touched].astype(np.int64)
+    m = len(touched)
+    return Contacts(
+        vertex=np.concatenate([touched.astype(np.int64), cv[k]]),
+        collider=np.concatenate([col, np.full(n, -1, np.int64)]),
+        edge=np.concatenate([np.full((m, 2), -1, np.int64), edge]),
+        weight=np.concatenate([np.zeros(m), buf.s[:n]]),
+        normal=np.concatenate([hits.normal[touched], buf.normal[:n]]),
+        depth=np.concatenate([hits.depth[touched], buf.depth[:n]]),
+        friction=np.concatenate([rects[col, RECT_FRICTION], buf.mu[:n, 0]]),
+        static_friction=np.concatenate([rects[col, RECT_STATIC_FRICTION], buf.mu[:n, 1]]))
