@@ -12,6 +12,10 @@ Usage::
     ... change the code ...
     python tools/same_states.py compare /tmp/before.npz
 
+Besides each integrator at the scene's own ``substeps``, ``symplectic-euler@stable`` runs
+symplectic Euler with as many substeps as its stable step needs (at most 64), since most
+scenes are set up for a stable integrator and stop at once under it otherwise.
+
 Run both sides with the same NUMBA_NUM_THREADS (the symplectic step chunks its springs by
 thread count): the default here pins one thread, so the serial driver runs in both.
 A scene that stops with ``SimulationUnstable`` under an integrator is recorded up to
@@ -21,6 +25,7 @@ where it stopped, with its message; the comparison checks that it stops at the s
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import time
@@ -35,7 +40,9 @@ def run(scene_name: str, integrator: str, steps: int, every: int) -> tuple[list[
 
     scene = scenes.load(scene_name)
     world = scene.build()
-    world.integrator = integrator
+    world.integrator = integrator.split("@")[0]
+    if integrator.endswith("@stable"):  # as many substeps as the explicit step needs (at most 64)
+        world.substeps = max(1, min(64, math.ceil(world.dt / world.stable_dt() - 1e-9)))
     script = scenes.Script(scene, world)
     frames, failure = [], ""
     for k in range(steps):
@@ -67,7 +74,7 @@ def main(argv=None) -> int:
     from deforma.scene import builtin_scenes
 
     names = a.scenes.split(",") if a.scenes else sorted(builtin_scenes())
-    integrators = a.integrators.split(",") if a.integrators else available_integrators()
+    integrators = a.integrators.split(",") if a.integrators else [*available_integrators(), "symplectic-euler@stable"]
     saved = dict(np.load(a.path, allow_pickle=False)) if a.action == "compare" else {}
     out, worst = {}, 0.0
     for name in names:
