@@ -266,7 +266,7 @@ def run(quick: bool) -> list[Row]:
         worlds = {}
         for mode in ("auto", "serial", "parallel"):
             w, body = make_world(n)
-            w._integrator.mode = mode
+            w.integrator_options = {"mode": mode}
             for _ in range(200):  # touch down (the contact path runs) and let auto mode settle
                 w.step()
             worlds[mode] = w

@@ -42,6 +42,8 @@ LIMITS = {
 #: Largest coordinate or size of anything placed in a world (m), and of gravity (m/s^2).
 MAX_COORDINATE = 1e9
 MAX_GRAVITY = 1e7
+#: Largest component of a force (N) or impulse (N s) applied to a body (body.apply_force).
+MAX_LOAD = 1e12
 #: Largest number of substeps in one step: a step must stay short enough to interrupt.
 MAX_SUBSTEPS = 1000
 #: Smallest substep (s): dt / substeps below this is refused.

@@ -367,7 +367,7 @@ def _run_scene(a, watch, shown: dict) -> int:
         _check_states_path(a.states)
     world = scene.build()
     n_frames = max(1, int(round(seconds * fps)))
-    from .physics.world import xpbd_advice
+    from .physics.diagnostics import xpbd_advice
 
     advice = xpbd_advice(world)
     if advice:

@@ -258,11 +258,11 @@ def test_a_contact_buffer_too_small_grows_and_the_step_runs_again_from_its_start
             w.add_body(grid_mesh(0.6, 0.3, 9, 5), position=(0.05 * k, 0.16 + 0.32 * k))
         return w
     roomy, tight = world(), world()
-    tight._inputs.contacts = contacts.make_buffer(16, 16)  # far fewer than these stacked bodies need
+    tight._contacts.buffer = contacts.make_buffer(16, 16)  # far fewer than these stacked bodies need
     for _ in range(100):
         roomy.step()
         tight.step()
-    assert len(tight._inputs.contacts.pair_vertex) > 16 and len(tight._inputs.contacts.vertex) > 16
+    assert len(tight._contacts.buffer.pair_vertex) > 16 and len(tight._contacts.buffer.vertex) > 16
     assert np.array_equal(tight._state.x, roomy._state.x)  # the same steps, bit for bit
 
 

@@ -76,15 +76,15 @@ def test_parallel_and_serial_steps_agree_exactly(material):
         h = min(1e-3, 0.5 * w.stable_dt())  # within the elements' stable step
         w._pack_colliders()
         w._rebuild_grabs()
-        m, s, inp = w._model, w._state, w._inputs
+        m, s, control, contacts = w._model, w._state, w._control, w._contacts
         fbuf = np.zeros((3, m.n_vertices, 2))  # the same 3 chunks of springs and elements for both
         chunks, elem_chunks, verts = symplectic.merged_chunks(m.spring_i, m.spring_j, m.elem, 3)
         for _ in range(50):
-            kernel(s.x, s.v, s.x_start, s.v_start, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
+            kernel(s.x, s.v, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
                    m.spring_stiffness, m.spring_damping, elem_chunks, m.elem, m.elem_b, m.elem_area, m.elem_mu,
                    m.elem_lambda, m.elem_damping, m.elem_kind, bool(m.elem_damping.any()), m.vertex_inv_mass, 0.0, -9.81, 1.0,
-                   inp.grab_slot, inp.grab_pull, inp.rects, inp.hits, m.contact, inp.contact_scratch, inp.contacts,
-                   h, 2, 1e6)
+                   control.force, control.has_force, control.grab_slot, control.grab_pull, control.colliders,
+                   contacts.hits, m.contact, contacts.scratch, contacts.buffer, h, 2, 1e6)
         assert not fbuf.any()  # scratch left zeroed
         assert np.isfinite(s.x).all()
         runs.append((s.x.copy(), s.v.copy()))
@@ -111,7 +111,7 @@ def test_world_results_do_not_depend_on_the_threading_mode():
     for mode in ("serial", "parallel", "auto"):
         w, b = perturbed_world(40)  # 800 vertices: above PARALLEL_MIN_VERTICES
         w.add_collider(Rect((0, -0.4), (3, 0.2), 10.0))  # clear of the body at the start, hit soon
-        w._integrator.mode = mode
+        w.integrator_options = {"mode": mode}
         w.substeps = 4
         for _ in range(150):
             w.step()

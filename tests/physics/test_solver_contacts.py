@@ -40,7 +40,7 @@ def stiff_drop(name, *, substeps=1, iterations=None):
     dropped 1 m onto a 10 degree floor; returns the world and the largest strain seen."""
     w = deforma.World(dt=H, substeps=substeps, integrator=name, stiffness=1000.0, damping=0.5)
     if iterations is not None:
-        w._integrator.iterations = iterations
+        w.integrator_options = {"iterations": iterations}
     w.add_collider(deforma.Rect((0, -0.5), (20, 1.0), 10.0))
     box = deforma.mesh.box([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]], detail=8, edges=True)
     w.add_body(box, position=(0, 1.5))
@@ -85,7 +85,7 @@ def test_a_large_stiff_body_stands_on_the_floor_at_a_display_step_under_implicit
     for _ in range(120):
         w.step()
         assert np.ptp(body.positions[:, 1]) > 0.99
-    assert w._integrator.factorizations == 1  # the contact set stayed, so did the factor
+    assert w.integrator_stats["factorizations"] == 1  # the contact set stayed, so did the factor
 
 
 @pytest.mark.parametrize("name, iterations", [("implicit-euler", None), ("xpbd", 30)])
@@ -94,7 +94,8 @@ def test_a_block_on_a_slope_slides_or_sticks_at_a_display_step(name, iterations,
     a = math.radians(angle)
     n, t = np.array([-math.sin(a), math.cos(a)]), np.array([math.cos(a), math.sin(a)])
     w = deforma.World(dt=H, stiffness=2e4, damping=2.0, integrator=name)
-    w._integrator.iterations = iterations or w._integrator.iterations
+    if iterations:
+        w.integrator_options = {"iterations": iterations}
     w.add_collider(deforma.Rect(tuple(-0.5 * n), (40, 1.0), angle, friction=mu_d, static_friction=mu_s))
     b = w.add_body(grid_mesh(0.4, 0.2, 9, 5, angle=angle, center=tuple(0.1001 * n)))
     accel, along = slide_acceleration(w, b, t, steps=90, after=0.5)
@@ -204,7 +205,7 @@ def test_the_jelly_stack_keeps_apart_and_its_shape_at_a_display_step_under_xpbd(
 
     w = deforma.load_scene("jelly")
     w.integrator = "xpbd"
-    w._integrator.iterations = 100
+    w.integrator_options = {"iterations": 100}
     w.dt, w.substeps = H, 2
     for k in range(360):
         w.step()
@@ -247,11 +248,11 @@ def test_body_contacts_in_the_implicit_solve_keep_momentum_at_a_display_step():
     m = w._model.vertex_mass[:, None]
     p0 = (m * w._state.v).sum(axis=0)
     scale = (m * np.abs(w._state.v)).sum()
-    factored = w._integrator.factorizations + w._integrator.updates
+    factored = w.integrator_stats["factorizations"] + w.integrator_stats["updates"]
     for _ in range(40):
         w.step()
         assert np.abs((m * w._state.v).sum(axis=0) - p0).max() < 1e-9 * scale
-    assert w._integrator.factorizations + w._integrator.updates > factored + 1  # they met: contacts went into the matrix
+    assert w.integrator_stats["factorizations"] + w.integrator_stats["updates"] > factored + 1  # they met: contacts went into the matrix
     assert a.center_of_mass[0] < b.center_of_mass[0]
 
 
@@ -283,10 +284,13 @@ def test_a_stable_integrator_refuses_bad_settings_and_leaves_the_state(name, att
     w = deforma.World(dt=H, integrator=name)
     b = w.add_body(grid_mesh(0.4, 0.2, 5, 3))
     before = b.positions.copy()
-    setattr(w._integrator, attribute, value)
+    options = w.integrator_options
     with pytest.raises(ValueError, match=f"{attribute} must be"):
-        w.step()
+        w.integrator_options = {attribute: value}
     assert np.array_equal(b.positions, before) and w.step_count == 0
+    assert w.integrator_options == options  # nothing changed
+    with pytest.raises(ValueError, match=f"{attribute} must be"):
+        deforma.World(dt=H, integrator=name, integrator_options={attribute: value})
 
 
 @pytest.mark.parametrize("name", ["symplectic-euler", "implicit-euler", "xpbd"])
@@ -311,12 +315,12 @@ def test_a_new_contact_weight_is_taken_at_the_next_step():
     w.add_body(grid_mesh(0.4, 0.2, 9, 5, center=(0.0, 0.1001)))
     for _ in range(30):
         w.step()
-    resting = w._integrator.factorizations
+    resting = w.integrator_stats["factorizations"]
     w.step()
-    assert w._integrator.factorizations == resting  # same contacts, same factor
-    w._integrator.contact_weight = 50.0
+    assert w.integrator_stats["factorizations"] == resting  # same contacts, same factor
+    w.integrator_options = {"contact_weight": 50.0}
     w.step()
-    assert w._integrator.factorizations == resting + 1
+    assert w.integrator_stats["factorizations"] == resting + 1
 
 
 def test_a_body_contact_that_stays_keeps_its_edge_parameter_when_others_come_or_go():

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..checks import MAX_LOAD
 from ..checks import non_negative as _non_negative
 from ..checks import positive as _positive
 from ..checks import switch as _switch
@@ -109,6 +110,15 @@ class Body:
         self._tear_source = src
         self._cracks = (self.topology, cut.tips)
         self._overrides["pressure"] = None  # the gas escapes through the tear
+
+    def _tear_state(self) -> tuple:
+        """Everything a tear changes on this handle (what a failed step puts back)."""
+        return (self.topology, self._tear_topology, self.mesh, self._pinned, self._tear_source, self._tear_fresh,
+                self._cracks, self._overrides["pressure"])
+
+    def _set_tear_state(self, state: tuple) -> None:
+        (self.topology, self._tear_topology, self.mesh, self._pinned, self._tear_source, self._tear_fresh,
+         self._cracks, self._overrides["pressure"]) = state
 
     def _check(self) -> "World":
         if self._world is None:
@@ -278,6 +288,77 @@ class Body:
             raise ValueError(f"{name}: vertex index {bad} is out of range; body {self._index} has vertices "
                              f"0..{self.n_vertices - 1}")
         return a.astype(np.int64)
+
+    def _loads(self, value, indices, name: str, unit: str):
+        """``(vertices, per-vertex values)`` of a force or impulse: a (2,) total spread over the
+        listed vertices by their mass, or one (2,) row per listed vertex."""
+        world = self._check()
+        idx = np.arange(self.n_vertices) if indices is None else self._indices(indices, f"{name} indices")
+        try:
+            a = np.array(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be numbers in {unit}, got {value!r}") from None
+        if not (a.shape == (2,) or a.shape == (len(idx), 2)):
+            raise ValueError(f"{name} must be a total (2,) or one row per vertex ({len(idx)}, 2), in {unit}; "
+                             f"got shape {a.shape}")
+        if not np.isfinite(a).all() or np.abs(a).max(initial=0.0) > MAX_LOAD:
+            raise ValueError(f"{name} must be finite and within +-{MAX_LOAD:g} {unit}, got {value!r}")
+        if a.shape == (2,):
+            m = world._model.vertex_mass[self.vertex_slice][idx]
+            a = a[None, :] * (m / m.sum())[:, None] if len(idx) else np.zeros((0, 2))
+        return idx, a
+
+    def apply_force(self, force, indices=None) -> None:
+        """Push the body with ``force`` (N) during the next step (every substep of it).
+
+        Parameters
+        ----------
+        force : (2,) or (K, 2) array_like of float
+            A total force, spread over the vertices by their mass (so it accelerates them
+            alike: ``force / mass``), or one force per vertex listed in ``indices``.
+        indices : array_like of int or bool mask, optional
+            Body-local vertices (default: all). A pinned vertex takes its share and stays.
+
+        Calls before a step add up; the step uses them and forgets them.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(gravity=(0, 0), dt=0.01, mass=2.0)
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
+        >>> b.apply_force((4.0, 0.0))  # 4 N on 2 kg for 0.01 s
+        >>> w.step()
+        >>> b.velocities[:, 0].round(12).tolist()
+        [0.02, 0.02, 0.02]
+        """
+        idx, f = self._loads(force, indices, "force", "N")
+        self._check()._forces.append((self, idx, f))
+
+    def apply_impulse(self, impulse, indices=None) -> None:
+        """Change the body's velocities now by ``impulse`` (N s): ``impulse / mass`` per vertex.
+
+        Parameters
+        ----------
+        impulse : (2,) or (K, 2) array_like of float
+            A total impulse, spread over the vertices by their mass (each then changes its
+            velocity by ``impulse / mass``), or one impulse per vertex listed in ``indices``.
+        indices : array_like of int or bool mask, optional
+            Body-local vertices (default: all). A pinned vertex takes its share and stays.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(mass=3.0)
+        >>> b = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
+        >>> b.apply_impulse((0.0, 6.0))  # 6 N s on 3 kg
+        >>> b.velocities[:, 1].tolist()
+        [2.0, 2.0, 2.0]
+        """
+        idx, j = self._loads(impulse, indices, "impulse", "N*s")
+        world = self._check()
+        rows = self.vertex_slice.start + idx
+        free = ~self._pinned[idx]
+        np.add.at(world._state.v, rows[free], j[free] * world._model.vertex_inv_mass[rows[free], None])
 
     def pin(self, indices) -> None:
         """Hold vertices ``indices`` (body-local, or a bool mask) where they are: infinite mass,

@@ -8,13 +8,7 @@ import uuid
 
 import numpy as np
 
-from .contact.contacts import (
-    COLLIDE,
-    SELF_COLLIDE,
-    SIDE_MARGIN,
-    SPECULATIVE,
-    ContactTopology,
-)
+from .contact.contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology
 from .elements.triangles import rest_geometry
 from .topology import element_geometry, lumped_areas, off_outline
 
@@ -81,6 +75,9 @@ class Model:
     body_pressure, body_pressure_area : (B,) float64
         Each body's gas pressure at rest (N/m; 0 without gas) and the enclosed area at rest
         (m^2).
+    gravity : (float, float)
+        Acceleration of gravity (m/s^2), and ``air_drag`` (1/s): the World's, which it sets
+        in place when they change (the Model is not rebuilt for them).
     contact : ContactTopology
         Every body as the contact stage reads it (outline and other vertices, outline edges,
         triangles, per-vertex contact thickness, per-body flags, thickness and friction);
@@ -102,8 +99,10 @@ class Model:
     """
 
     def __init__(self, topologies, *, masses, stiffness, damping, materials=None, pinned=None, contact=None,
-                 pressure=None, torn=None):
+                 pressure=None, torn=None, gravity=(0.0, 0.0), air_drag=0.0):
         self.topologies = list(topologies)
+        self.gravity = gravity
+        self.air_drag = air_drag
         self.version = 0
         self.serial = uuid.uuid4().int  # unique across processes too (a pickled world's Models)
         self.torn_from = None

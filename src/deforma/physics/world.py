@@ -1,8 +1,12 @@
 """The World: soft bodies, colliders, gravity and friction, stepped in time.
 
-A world owns one :class:`~deforma.physics.model.Model` (constant arrays of all bodies) and
-one :class:`~deforma.physics.state.State` (positions and velocities of all bodies), hands
-both to its integrator every step and checks the result. Bodies and grabs are thin handles
+A world keeps the handles (bodies, grabs, colliders) and the parameters, and the data a step
+passes along: one :class:`~deforma.physics.model.Model` (constant arrays of all bodies), the
+:class:`~deforma.physics.state.State` (positions and velocities of all bodies) and the one
+the step started from, a :class:`~deforma.physics.control.Control` (grabs, applied forces,
+packed colliders) and the :class:`~deforma.physics.contact.contacts.Contacts`. The step
+itself is :mod:`deforma.physics.stepper`; the stable step, energies, checks and hints are
+:mod:`deforma.physics.diagnostics`. Bodies and grabs are thin handles
 (:mod:`deforma.physics.body`) whose ``positions`` / ``velocities`` are views into the
 world's arrays.
 
@@ -12,7 +16,6 @@ Units are SI (m, kg, s, N); y points up; angles are degrees.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -22,78 +25,23 @@ from ..checks import number as _finite
 from ..checks import pair as _pair
 from ..checks import positive as _positive
 from ..checks import switch as _switch
-from . import behaviours as _behaviours
-from .behaviours import tearing as _tearing
-from .behaviours.strain import spring_strains
+from . import diagnostics, stepper
 from .body import Body, Grab, _fem_mesh_check, _material, _pressure
-from .colliders.response import make_hits
 from .colliders.shapes import SHAPES, Collider, pack_colliders
-from .contact import contacts as _contacts
 from .contact.clearance import outlines_overlap
-from .elements.triangles import (
-    element_energy,
-    gradient_row_sums,
-    max_stiffness,
-    signed_areas,
-)
+from .contact.contacts import ContactPoints, Contacts
+from .control import Control
+from .diagnostics import Energy, SimulationUnstable
 from .integrators import make_integrator
 from .material import Material
 from .model import Model
 from .state import State
 from .topology import BodyTopology
 
+__all__ = ["Body", "Energy", "Grab", "SimulationUnstable", "World"]
+
 # Automatic contact thickness: this fraction of a body's median boundary edge (see World).
 AUTO_THICKNESS = 0.05
-# A body has lost its shape when a spring is this many times its rest length, or its area
-# falls below this share of its rest area; checked every SHAPE_CHECK_EVERY steps.
-LOST_STRETCH = 10.0
-LOST_AREA = 0.1
-REPACK_EVERY = 64  # steps: moving colliders are packed again from their objects this often
-SHAPE_CHECK_EVERY = 16
-
-
-class SimulationUnstable(RuntimeError):
-    """A step produced a non-finite or runaway state; the world was put back as before it.
-
-    Attributes
-    ----------
-    body : Body
-        The first body with a bad vertex.
-    step : int
-        Index of the failed step (``world.step_count`` when it started).
-    hint : str
-        What to change, e.g. "dt/substeps 0.01 s exceeds the stable estimate 0.002 s: ...".
-    """
-
-    def __init__(self, message: str, *, body, step: int, hint: str):
-        super().__init__(message)
-        self.body = body
-        self.step = step
-        self.hint = hint
-
-
-@dataclass(frozen=True)
-class Energy:
-    """Energies in joules: kinetic ``sum m v^2 / 2``, spring ``sum ks (L - l)^2 / 2``,
-    gravitational ``-sum m g . x`` (zero at the origin) and the elastic energy of the
-    finite elements ``sum A psi(F)``."""
-
-    kinetic: float
-    spring: float
-    gravitational: float
-    elastic: float = 0.0
-
-    @property
-    def total(self) -> float:
-        """Sum of the four, in joules."""
-        return self.kinetic + self.spring + self.gravitational + self.elastic
-
-
-class _StepInputs:
-    """What the integrator reads besides the model and the state (see integrators.StepInputs)."""
-
-    __slots__ = ("gravity", "air_drag", "rects", "hits", "grab_slot", "grab_pull", "max_speed", "contact_scratch",
-                 "contacts")
 
 
 class World:
@@ -128,6 +76,9 @@ class World:
         check only for NaN/inf).
     integrator : str, optional
         Time integrator by name; see ``deforma.physics.available_integrators()``.
+    integrator_options : dict, optional
+        The integrator's settings by name (see ``docs/integrators.md``; e.g.
+        ``{"iterations": 5}`` for ``"implicit-euler"``); the others keep their defaults.
     contact_thickness : float or None, optional
         How far apart touching bodies stay, metres (> 0, below every colliding body's
         shortest boundary edge). ``None`` (default): each body uses 5% of its median
@@ -157,19 +108,24 @@ class World:
 
     def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps=1, mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
-                 integrator="symplectic-euler", contact_thickness=None, air_drag=0.0, material=None):
-        self._inputs = _StepInputs()
+                 integrator="symplectic-euler", contact_thickness=None, air_drag=0.0, material=None,
+                 integrator_options=None):
         self._bodies: list[Body] = []
         self._colliders: list[Collider] = []
         self._packed_colliders: tuple | None = None  # what was packed: (id, version) per collider
         self._grabs: list[Grab] = []
         self._grabs_dirty = True
         self._lost_shape = {}  # id(body) -> checks in a row at which it had lost its shape
+        self._forces = []  # (body, body-local vertices, forces): applied during the next step
+        self._gravity, self._air_drag = (0.0, -9.81), 0.0
         self._model = Model([], masses=[], stiffness=[], damping=[])
+        self._model_bodies = []
         self._state = State.empty()
+        self._start = State.empty()  # the state the step started from: what a failed step keeps
+        self._control = Control(0)
+        self._contacts = Contacts.for_topology(self._model.contact, n_vertices=0)
         self._contact_thickness = None
         self._material = None
-        self._make_contact_scratch()
         self.time = 0.0
         self.step_count = 0
         self.gravity = gravity
@@ -183,6 +139,8 @@ class World:
         self.grab_strength = grab_strength
         self.max_speed = max_speed
         self.integrator = integrator
+        if integrator_options is not None:
+            self.integrator_options = integrator_options
         self.contact_thickness = contact_thickness
         self.air_drag = air_drag
         self.material = material
@@ -208,11 +166,11 @@ class World:
     @property
     def gravity(self) -> tuple[float, float]:
         """Acceleration of gravity (m/s^2) as (x, y)."""
-        return self._inputs.gravity
+        return self._gravity
 
     @gravity.setter
     def gravity(self, value):
-        self._inputs.gravity = _pair(value, "gravity", limit=MAX_GRAVITY)
+        self._gravity = self._model.gravity = _pair(value, "gravity", limit=MAX_GRAVITY)
 
     @property
     def dt(self) -> float:
@@ -275,7 +233,7 @@ class World:
     @property
     def max_speed(self) -> float:
         """Speed (m/s) above which a vertex counts as runaway."""
-        return self._inputs.max_speed
+        return self._max_speed
 
     @max_speed.setter
     def max_speed(self, value):
@@ -285,16 +243,16 @@ class World:
             raise ValueError(f"max_speed must be a number of m/s, got {value!r}") from None
         if v != math.inf:  # inf: no speed check; else a number whose square is finite
             v = _positive(value, "max_speed", "m/s (or inf)")
-        self._inputs.max_speed = v
+        self._max_speed = v
 
     @property
     def air_drag(self) -> float:
         """Air drag in 1/s: every velocity decays as ``dv/dt = -air_drag v``."""
-        return self._inputs.air_drag
+        return self._air_drag
 
     @air_drag.setter
     def air_drag(self, value):
-        self._inputs.air_drag = _non_negative(value, "air_drag", "1/s")
+        self._air_drag = self._model.air_drag = _non_negative(value, "air_drag", "1/s")
 
     @property
     def contact_thickness(self) -> float | None:
@@ -355,12 +313,42 @@ class World:
 
     @property
     def integrator(self) -> str:
-        """Name of the time integrator."""
+        """Name of the time integrator; setting one gives it its default options."""
         return self._integrator.name
 
     @integrator.setter
     def integrator(self, name):
         self._integrator = make_integrator(name)
+
+    @property
+    def integrator_options(self) -> dict:
+        """The integrator's settings by name (a new dict; ``docs/integrators.md`` lists them).
+
+        Setting a dict sets the options it names and puts the others back to their defaults;
+        a name the integrator does not take, or a value out of its range, raises
+        ``ValueError`` and changes nothing.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(integrator="implicit-euler", integrator_options={"iterations": 5})
+        >>> w.integrator_options
+        {'iterations': 5, 'contact_weight': 10.0}
+        >>> w.integrator_options = {"contact_weight": 20.0}
+        >>> w.integrator_options
+        {'iterations': 3, 'contact_weight': 20.0}
+        """
+        return self._integrator.options
+
+    @integrator_options.setter
+    def integrator_options(self, options):
+        self._integrator.configure(options)
+
+    @property
+    def integrator_stats(self) -> dict:
+        """Counters of the integrator's work so far, by name (a new dict; implicit Euler counts
+        ``factorizations`` and ``updates`` of its matrix, the others nothing)."""
+        return self._integrator.stats()
 
     # -- bodies -----------------------------------------------------------------------------
     @property
@@ -480,6 +468,7 @@ class World:
             if g.body is body:
                 g.active = False
         self._grabs = [g for g in self._grabs if g.active]
+        self._forces = [f for f in self._forces if f[0] is not body]  # its loads go with it
         del self._bodies[b]
         body._world = None
         for k, other in enumerate(self._bodies):
@@ -494,10 +483,10 @@ class World:
     def _rebuild(self, x, v):
         # the rest shapes plasticity moved live in the Model's arrays: take them over, body by
         # body (a torn body's vertices through the tear's source), so dents survive a rebuild
-        old = getattr(self, "_model", None)
+        old = self._model
         shapes, torn = {}, {}
         if old is not None:
-            for i, body in enumerate(getattr(self, "_model_bodies", ())):
+            for i, body in enumerate(self._model_bodies):
                 was_fem = old.materials[i] is not None and old.materials[i].is_fem
                 if body._world is self and was_fem == body.is_fem:  # springs and elements do not convert
                     if was_fem and not isinstance(body._tear_source, slice):  # torn: its elements and all
@@ -513,26 +502,21 @@ class World:
                             materials=[b.material for b in self._bodies],
                             pinned=[b._pinned for b in self._bodies],
                             contact=[self._contact_parameters(b) for b in self._bodies],
-                            pressure=[b._overrides["pressure"] for b in self._bodies], torn=torn)
+                            pressure=[b._overrides["pressure"] for b in self._bodies], torn=torn,
+                            gravity=self._gravity, air_drag=self._air_drag)
         for body, shape in shapes.items():
             src = body._tear_source
             self._model.take_rest_shape(body._index, shape, None if isinstance(src, slice) else src)
         self._model_bodies = list(self._bodies)
-        self._state = State(x, v, self._model.body_vertex_offsets)
+        self._state = State(x, v)
+        packed = self._control.colliders
+        self._control = Control(self._model.n_vertices)
+        self._control.colliders = packed  # where the colliders are: a tear rebuilds mid-step
         self._grabs_dirty = True
-        self._make_contact_scratch()
-
-    def _make_contact_scratch(self):
-        c = self._model.contact
-        self._inputs.contact_scratch = _contacts.make_scratch(len(c.cv_vertex), len(c.ce_a), len(self._bodies))
-        n_outline = int(c.body_interior[0])
         # keep what an earlier step grew the buffer to (a torn body rebuilds the Model while
         # its contacts go on; a small buffer would make the next step run twice)
-        old = getattr(self._inputs, "contacts", None)
-        grown = (len(old.vertex), len(old.pair_vertex)) if old is not None else (0, 0)
-        self._inputs.contacts = _contacts.make_buffer(max(n_outline + 64, grown[0]),
-                                                      max(4 * n_outline + 64, grown[1]))
-        self._inputs.hits = make_hits(self._model.n_vertices)
+        self._contacts = Contacts.for_topology(self._model.contact, n_vertices=self._model.n_vertices,
+                                               keep=self._contacts)
 
     def _contact_parameters(self, body) -> dict:
         o = body._overrides
@@ -561,10 +545,10 @@ class World:
                     f"other): colliding bodies must start apart; move it, or give it collide=False")
 
     @property
-    def contacts(self) -> "_contacts.Contacts":
+    def contacts(self) -> ContactPoints:
         """The contacts of the last substep: with colliders, other bodies and itself.
 
-        A struct of arrays (see :class:`~deforma.physics.contact.contacts.Contacts`); collider
+        A struct of arrays (see :class:`~deforma.physics.contact.contacts.ContactPoints`); collider
         contacts have ``collider >= 0``, body contacts ``collider == -1`` and an ``edge``.
 
         Examples
@@ -583,8 +567,7 @@ class World:
         """
         if self._colliders_changed():
             self._pack_colliders()
-        return _contacts.snapshot(self._model.contact, self._inputs.contact_scratch, self._inputs.contacts,
-                                  self._inputs.hits, self._inputs.rects)
+        return self._contacts.points(self._model.contact, self._control.colliders)
 
     # -- colliders --------------------------------------------------------------------------
     @property
@@ -629,13 +612,16 @@ class World:
                 return
         raise ValueError("that collider is not in this world (see world.colliders)")
 
+    def _collider_key(self) -> tuple:
+        return tuple((id(c), c._version) for c in self._colliders)
+
     def _colliders_changed(self) -> bool:
-        return self._packed_colliders != tuple((id(c), c._version) for c in self._colliders)
+        return self._packed_colliders != self._collider_key()
 
     def _pack_colliders(self):
-        self._inputs.rects = pack_colliders(self._colliders, friction=self.friction,
-                                            static_friction=self.static_friction)
-        self._packed_colliders = tuple((id(c), c._version) for c in self._colliders)
+        self._control.colliders = pack_colliders(self._colliders, friction=self.friction,
+                                                 static_friction=self.static_friction)
+        self._packed_colliders = self._collider_key()
 
     # -- interaction ------------------------------------------------------------------------
     def explode(self, strength: float, *, center=None) -> None:
@@ -751,240 +737,23 @@ class World:
             self._grabs_dirty = True
 
     def _rebuild_grabs(self):
-        n = self._model.n_vertices
-        slot = np.full(n, -1, np.int32)
-        rows = [(b.vertex_slice.start + g.vertices, g.strength, np.asarray(g.target) + g.offsets)
-                for g in self._grabs if len(g.vertices) for b in [g.body]]
-        if rows:
-            idx = np.concatenate([r[0] for r in rows])
-            st = np.concatenate([np.full(len(r[0]), r[1]) for r in rows])
-            tg = np.concatenate([r[2] for r in rows])  # each held vertex's own target
-            uniq, inv = np.unique(idx, return_inverse=True)
-            pull = np.zeros((len(uniq), 3))
-            np.add.at(pull[:, 0], inv, st)
-            np.add.at(pull[:, 1], inv, st * tg[:, 0])
-            np.add.at(pull[:, 2], inv, st * tg[:, 1])
-            slot[uniq] = np.arange(len(uniq), dtype=np.int32)
-        else:
-            pull = np.zeros((0, 3))
-        self._inputs.grab_slot = slot
-        self._inputs.grab_pull = pull
+        self._control.hold([(g.body.vertex_slice.start + g.vertices, g.strength, np.asarray(g.target) + g.offsets)
+                            for g in self._grabs if len(g.vertices)])
         self._grabs_dirty = False
 
     # -- stepping ---------------------------------------------------------------------------
     def step(self) -> None:
-        """Advance the world by ``dt`` seconds (``substeps`` substeps).
+        """Advance the world by ``dt`` seconds (``substeps`` substeps; the stages are
+        :mod:`deforma.physics.stepper`'s).
 
         Raises
         ------
         SimulationUnstable
-            If a vertex ends non-finite or faster than ``max_speed``; the state is then put
-            back to what it was before this step.
+            If a vertex ends non-finite or faster than ``max_speed``, is trapped between
+            colliders, or a body lost its shape; the world is then put back exactly as it was
+            before this step (positions, velocities, rest shapes, torn meshes, collider poses).
         """
-        moving = any(c.moving for c in self._colliders)
-        moved = self._colliders_changed()
-        if moved:
-            self._pack_colliders()
-        if moving:
-            # the kernels move the packed copies: until the objects follow (at the end of a
-            # step that succeeds), the packed array is not theirs
-            self._packed_colliders = None
-        if self._grabs_dirty:
-            self._rebuild_grabs()
-        if self._model.n_vertices:
-            status = self._inputs.contact_scratch.status
-            kicked = None
-            if self._model.body_pressure.any():
-                kicked = self._state.v.copy()  # what a failed step puts back
-                _behaviours.apply_pressure(self._model, self._state, self._dt)
-            while True:
-                status[_contacts.ST_NEEDED] = status[_contacts.ST_PAIRS_NEEDED] = 0
-                bad = self._integrator.advance(self._model, self._state, self._inputs,
-                                               self._dt / self._substeps, self._substeps)
-                need_c, need_p = int(status[_contacts.ST_NEEDED]), int(status[_contacts.ST_PAIRS_NEEDED])
-                if not (need_c or need_p):
-                    break
-                # the contact buffer was too small: grow it and run the step again from its start
-                self._state.restore()
-                if moving:  # the kernels moved the packed colliders: back to the start
-                    self._pack_colliders()
-                buf = self._inputs.contacts
-                self._inputs.contacts = _contacts.make_buffer(max(2 * need_c, len(buf.vertex)),
-                                                              max(2 * need_p, len(buf.pair_vertex)))
-            if bad:
-                if kicked is not None:
-                    self._state.v_start[...] = kicked
-                self._fail()
-            poses = [(c, c.center, c.angle) for c in self._colliders if c.moving]
-            for c, _, _ in poses:  # the kernels moved the packed copies; now the objects
-                c.advance(self._dt)
-            if moved or poses:
-                try:
-                    self._check_not_trapped()
-                except SimulationUnstable:
-                    for c, center, angle in poses:  # the step is undone: so is their motion
-                        c._set_pose(center, angle)
-                    raise
-            if poses and self.step_count % REPACK_EVERY:
-                # the packed copies are where the objects now are (up to rounding, which a
-                # repack every REPACK_EVERY steps clears): no repack next step
-                self._packed_colliders = tuple((id(c), c._version) for c in self._colliders)
-            _behaviours.limit_and_yield(self._model, self._state, self._dt)
-            self._tear()
-            if self.step_count % SHAPE_CHECK_EVERY == 0:
-                self._check_shape()
-        else:  # no body: moving colliders still move
-            for c in self._colliders:
-                c.advance(self._dt)
-        self.time += self._dt
-        self.step_count += 1
-
-    def _tear(self) -> None:
-        """Split the meshes of bodies stretched beyond their ``tear_strain`` (see
-        :mod:`deforma.physics.behaviours.tearing`); rebuilds the Model when any tore."""
-        torn = False
-        for body in self._bodies:
-            limit = body.material.tear_strain
-            if limit is None:
-                continue
-            topo = body.topology
-            x = self._state.x[body.vertex_slice]
-            if not len(topo.triangles):
-                keep = _tearing.snap_springs(x, topo.springs, topo.spring_rest_length, limit)
-                if not keep.all():
-                    body.topology = BodyTopology.from_arrays(topo.rest_positions, topo.springs[keep],
-                                                             mass_share=topo.mass_share)
-                    body._tear_fresh = np.unique(topo.springs[~keep])
-                    torn = True
-                continue
-            cut = _tearing.tear_mesh(body._tear_view(), x, limit, tips=body._crack_tips())
-            if cut is None:
-                body._cracks = None  # every crack stopped: a new one may start
-                continue
-            body._tear_fresh = np.union1d(cut.triangles[cut.changed], topo.triangles[cut.changed])  # old, new corners
-            body._apply_tear(cut)
-            torn = True
-        if torn:
-            old = self._model
-            off = old.body_vertex_offsets
-            source = np.concatenate([np.arange(off[i], off[i + 1])[b._tear_source] for i, b in enumerate(self._bodies)])
-            # np.take: NumPy's fancy indexing gathers (N, 2) rows 15x slower (0.23 against 0.016 ms at 1e4)
-            self._rebuild(np.take(self._state.x, source, axis=0), np.take(self._state.v, source, axis=0))
-            new_off = self._model.body_vertex_offsets
-            fresh = np.zeros(self._model.n_vertices, bool)
-            for i, body in enumerate(self._bodies):
-                fresh[new_off[i] + body._tear_fresh] = True
-                body._tear_source = slice(None)
-                body._tear_fresh = np.zeros(0, np.int64)
-            self._model.torn_from = (old.serial, source, fresh, self._model.version)
-
-    def _check_shape(self) -> None:
-        """Refuse a state in which a body has lost its shape: a spring stretched
-        ``LOST_STRETCH`` times its rest length, or a finite-element body's triangles turned inside
-        out over most of it (its area below ``LOST_AREA`` of its rest area), at two checks in a row (an
-        impact may crush a body for a moment). No stable step keeps either; a run that did is
-        garbage however finite its numbers (a step too long for the stiffness, a body started
-        inside a collider)."""
-        m, x = self._model, self._state.x
-        for b, body in enumerate(self._bodies):
-            tear = body.material.tear_strain
-            limit = LOST_STRETCH if tear is None else max(LOST_STRETCH, 2.0 * (1.0 + tear))
-            s0, s1 = m.body_spring_offsets[b], m.body_spring_offsets[b + 1]
-            what = None
-            if s1 > s0:
-                ratio = 1.0 + float(np.max(spring_strains(x, m.spring_i[s0:s1], m.spring_j[s0:s1],
-                                                          m.spring_rest_length[s0:s1])))
-                if ratio > limit:
-                    what = f"a spring is {ratio:.3g} times its rest length"
-            t0, t1 = m.body_elem_offsets[b], m.body_elem_offsets[b + 1]
-            # only finite elements are held to their area: a springs body (no elements in the
-            # Model) folded flat keeps every spring's length, a state of that model
-            if what is None and t1 > t0:
-                area = signed_areas(x, m.elem[t0:t1])
-                rest = m.elem_area[t0:t1]
-                if area.sum() < LOST_AREA * rest.sum():
-                    what = (f"its area fell to {area.sum() / rest.sum():.0%} of its rest area "
-                            f"({np.mean(area < 0):.0%} of its triangles inside out)")
-            # a hard impact may crush a body for a moment (a springs body has no area to keep):
-            # only a shape still lost at the next check is garbage
-            seen = self._lost_shape.get(id(body), 0) + 1 if what is not None else 0
-            self._lost_shape[id(body)] = seen
-            if seen < 2:
-                continue
-            self._state.restore()
-            hint = ("shorten dt or raise substeps (or use implicit-euler), and start bodies outside colliders; "
-                    "a stiffer or denser body keeps its shape better")
-            advice = xpbd_advice(self)
-            if advice:
-                hint = f"{advice}, and start bodies outside colliders"
-            raise SimulationUnstable(f"body {b} lost its shape at step {self.step_count}: {what}; {hint}",
-                                     body=body, step=self.step_count, hint=hint)
-
-    def _check_not_trapped(self) -> None:
-        """After colliders changed: refuse a step that left a vertex inside one.
-
-        The response pushes a vertex out of a collider that moved onto it; only one with no
-        room left, squeezed between colliders closer than the body can fit, stays inside.
-        """
-        x = self._state.x
-        for c, collider in enumerate(self._colliders):
-            x0, y0, x1, y1 = collider.bounds()
-            near = np.flatnonzero((x[:, 0] > x0) & (x[:, 0] < x1) & (x[:, 1] > y0) & (x[:, 1] < y1))
-            inside = near[collider.contains(x[near])] if len(near) else near
-            if len(inside):
-                b = int(np.searchsorted(self._model.body_vertex_offsets, inside[0], side="right") - 1)
-                self._state.restore()
-                hint = ("move the colliders apart (or the body out from between them): the gap left "
-                        "is narrower than the body can be squeezed")
-                raise SimulationUnstable(
-                    f"body {b} is trapped inside collider {c} at step {self.step_count} "
-                    f"({len(inside)} vertices, squeezed between colliders); {hint}",
-                    body=self._bodies[b], step=self.step_count, hint=hint)
-
-    def _fail(self):
-        x, v = self._state.x, self._state.v
-        speed = np.hypot(v[:, 0], v[:, 1])
-        bad = ~(np.isfinite(x).all(axis=1) & (speed <= self.max_speed))
-        first = int(np.argmax(bad))
-        b = int(np.searchsorted(self._model.body_vertex_offsets, first, side="right") - 1)
-        body = self._bodies[b]
-        finite = bool(np.isfinite(speed[first]) and np.isfinite(x[first]).all())
-        what = f"a vertex faster than max_speed {self.max_speed:g} m/s" if finite \
-            else "non-finite positions or velocities"
-        self._state.restore()
-        h = self._dt / self._substeps
-        stable = self.stable_dt()
-        given = float(np.max(np.hypot(self._state.v[:, 0], self._state.v[:, 1]), initial=0.0))
-        if given > self.max_speed:
-            hint = (f"a velocity given before the step is already {given:.3g} m/s, beyond max_speed "
-                    f"{self.max_speed:g} m/s (explode strength, body.velocities): give less, or raise max_speed")
-        elif math.isinf(stable) and getattr(self._integrator, "unconditionally_stable", False):
-            hint = (f"the {self.integrator} integrator has no step limit, so a large force ran away "
-                    f"(grab strength, explosion): lower it, or raise max_speed if such speeds are intended")
-        elif h > stable and self._dt / stable <= MAX_SUBSTEPS:
-            need = math.ceil(self._dt / stable)
-            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s{self._damping_note(stable)}: "
-                    f"lower dt or raise substeps to at least {need}")
-        elif h > stable:
-            hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s{self._damping_note(stable)} "
-                    f"by more than {MAX_SUBSTEPS} substeps can make up: lower the stiffness or damping, raise the "
-                    f"mass, or use an unconditionally stable integrator (implicit-euler, xpbd)")
-        else:
-            hint = (f"dt/substeps {h:.3g} s is within the stable estimate {stable:.3g} s, so a large "
-                    f"force ran away (grab strength, explosion, stiffness): lower it, raise damping "
-                    f"or substeps, or raise max_speed if such speeds are intended")
-        raise SimulationUnstable(f"body {b} became unstable at step {self.step_count} ({what}); {hint}",
-                                 body=body, step=self.step_count, hint=hint)
-
-    def _damping_note(self, stable: float) -> str:
-        """`` (set by damping: ...)`` when damping, not stiffness, makes the explicit step
-        ``stable`` (s) more than 10x shorter: a material's damping (stiffness-proportional,
-        ``material_damping``) easily does, and the hint should name it."""
-        w2, _ = self._explicit_rates()
-        undamped = math.inf if w2 == 0 else 2.0 / math.sqrt(w2)
-        if not stable < 0.1 * undamped:
-            return ""
-        return f" (set by the damping: {undamped:.3g} s without it; lower material_damping or damping)"
+        stepper.step(self)
 
     # -- diagnostics ------------------------------------------------------------------------
     def stable_dt(self, *, explicit: bool = False) -> float:
@@ -1011,34 +780,11 @@ class World:
         >>> round(w.stable_dt(), 4)  # 2 / sqrt(2 * 200 / (2 / 3))
         0.0816
         """
-        m = self._model
-        if m.n_vertices == 0 or (not explicit and getattr(self._integrator, "unconditionally_stable", False)):
+        if not explicit and self._integrator.unconditionally_stable:
             return math.inf
-        w2, gamma = self._explicit_rates()
-        if w2 == 0:
-            return math.inf if gamma == 0 else 2 / gamma
-        # (sqrt(gamma^2 + 4 w2) - gamma) / w2, written without the difference of two close
-        # numbers (heavy damping made it 0, and a hint then divided by it)
-        return 4.0 / (math.hypot(gamma, 2.0 * math.sqrt(w2)) + gamma)
-
-    def _explicit_rates(self) -> tuple[float, float]:
-        """``(omega^2, gamma)`` of :meth:`stable_dt`: the largest stiffness and damping rates
-        over the vertices (1/s^2, 1/s)."""
-        m = self._model
-        # (float: bincount of no springs gives integers)
-        ks = np.bincount(m.spring_i, m.spring_stiffness, m.n_vertices) + \
-            np.bincount(m.spring_j, m.spring_stiffness, m.n_vertices).astype(np.float64)
-        kd = np.bincount(m.spring_i, m.spring_damping, m.n_vertices) + \
-            np.bincount(m.spring_j, m.spring_damping, m.n_vertices).astype(np.float64)
         if self._grabs_dirty:
             self._rebuild_grabs()
-        held = self._inputs.grab_slot >= 0
-        ks[held] += self._inputs.grab_pull[self._inputs.grab_slot[held], 0]
-        if m.n_elements:
-            k = max_stiffness(m.elem_mu, m.elem_lambda)
-            ks += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k, m.n_vertices)
-            kd += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k * m.elem_damping, m.n_vertices)
-        return float(np.max(2 * ks * m.vertex_inv_mass)), float(np.max(2 * kd * m.vertex_inv_mass))
+        return diagnostics.stable_dt(self._model, self._control)
 
     def xpbd_substeps(self, strain: float = 0.01) -> int:
         """Substeps per ``dt`` at which XPBD holds the bodies up under their own weight.
@@ -1077,24 +823,8 @@ class World:
         if isinstance(strain, bool) or not isinstance(strain, (int, float, np.number)) \
                 or not 0.0 < float(strain) < 1.0:
             raise ValueError(f"strain must be a number in (0, 1), got {strain!r}")
-        g = math.hypot(*self.gravity)
-        if g == 0.0 or not self._bodies:
-            return 1
-        down = np.asarray(self.gravity, dtype=np.float64) / g
-        sweeps = self._integrator.iterations if self.integrator == "xpbd" else 1
-        need = 1
-        for body in self._bodies:
-            t = body.topology
-            x, e = t.rest_positions, t.springs
-            if len(e) == 0:
-                continue
-            spacing = float(np.median(np.hypot(*(x[e[:, 1]] - x[e[:, 0]]).T)))
-            height = float(np.ptp(x @ down))
-            if spacing <= 0.0 or height <= 0.0:
-                continue
-            h = spacing * math.sqrt(strain * sweeps / (2.0 * g * height))
-            need = max(need, math.ceil(self._dt / h - 1e-9))
-        return need
+        sweeps = self._integrator.options["iterations"] if self.integrator == "xpbd" else 1
+        return diagnostics.xpbd_substeps(self._bodies, self.gravity, self._dt, sweeps, float(strain))
 
     def energy(self, body: Body | None = None) -> Energy:
         """Kinetic, spring, gravitational and elastic (finite-element) energy in joules, of one body or all.
@@ -1108,23 +838,13 @@ class World:
         >>> w.energy().kinetic  # 3 kg at 2 m/s
         6.0
         """
-        m, s = self._model, self._state
+        m = self._model
         if body is None:
-            vs, es, ts = slice(None), slice(None), slice(None)
-        else:
-            b = self._own_body(body)
-            vs = body.vertex_slice
-            es = slice(int(m.body_spring_offsets[b]), int(m.body_spring_offsets[b + 1]))
-            ts = slice(int(m.body_elem_offsets[b]), int(m.body_elem_offsets[b + 1]))
-        x, v, mass = s.x[vs], s.v[vs], m.vertex_mass[vs]
-        kinetic = 0.5 * float(np.sum(mass * np.einsum("ij,ij->i", v, v)))
-        si, sj = m.spring_i[es], m.spring_j[es]
-        stretch = np.linalg.norm(s.x[sj] - s.x[si], axis=1) - m.spring_rest_length[es]
-        spring = 0.5 * float(np.sum(m.spring_stiffness[es] * stretch * stretch))
-        gravitational = -float(np.sum(mass * (x @ np.asarray(self.gravity))))
-        elastic = float(np.sum(element_energy(s.x, m.elem[ts], m.elem_b[ts], m.elem_area[ts], m.elem_mu[ts],
-                                              m.elem_lambda[ts], m.elem_kind[ts])))
-        return Energy(kinetic, spring, gravitational, elastic)
+            return diagnostics.energy(m, self._state, self.gravity)
+        b = self._own_body(body)
+        return diagnostics.energy(m, self._state, self.gravity, body.vertex_slice,
+                                  slice(int(m.body_spring_offsets[b]), int(m.body_spring_offsets[b + 1])),
+                                  slice(int(m.body_elem_offsets[b]), int(m.body_elem_offsets[b + 1])))
 
     def _repr_png_(self) -> bytes:
         """A picture of the world as it is now (PNG bytes, 400 px on the longer side): what a
@@ -1137,25 +857,3 @@ class World:
     def __repr__(self) -> str:
         return (f"World({len(self._bodies)} bodies, {self._model.n_vertices} vertices, "
                 f"{len(self._colliders)} colliders, t={self.time:.4g} s)")
-
-
-def xpbd_advice(world: World) -> str:
-    """What to do when ``world`` runs XPBD with fewer substeps than :meth:`World.xpbd_substeps`
-    asks for, in one clause; ``""`` otherwise (or under another integrator). The viewer,
-    ``deforma run`` and the lost-shape hint all say it in these words.
-
-    Examples
-    --------
-    >>> import deforma
-    >>> w = deforma.World(dt=1 / 60, integrator="xpbd")
-    >>> _ = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=28))
-    >>> xpbd_advice(w)
-    'under xpbd with substeps = 1 the bodies sag under their own weight (a sweep carries the support one mesh row): raise substeps to 22 (world.xpbd_substeps()) or use implicit-euler'
-    """
-    if world.integrator != "xpbd":
-        return ""
-    need = world.xpbd_substeps()
-    if world.substeps >= need:
-        return ""
-    return (f"under xpbd with substeps = {world.substeps} the bodies sag under their own weight (a sweep carries "
-            f"the support one mesh row): raise substeps to {need} (world.xpbd_substeps()) or use implicit-euler")

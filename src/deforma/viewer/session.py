@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..physics import Circle, Material, Polygon, Rect, Segment, available_integrators
-from ..physics.world import xpbd_advice
+from ..physics.diagnostics import xpbd_advice
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 from ..scene.build import pin_mask

@@ -31,8 +31,9 @@ def apply_pressure(model, state, dt: float) -> bool:
     return any_gas
 
 
-def limit_and_yield(model, state, dt: float) -> None:
-    """After a step of ``dt`` s: limit each body's stretch, then let its plastic strain flow."""
+def limit_and_yield(model, state_in, state_out, dt: float) -> None:
+    """After a step of ``dt`` s from ``state_in`` to ``state_out``: limit each body's stretch
+    (in ``state_out``), then let its plastic strain flow (in the Model's rest shape)."""
     for b, mat in enumerate(model.materials):
         if mat is None or (mat.max_stretch is None and mat.yield_strain is None):
             continue
@@ -41,15 +42,15 @@ def limit_and_yield(model, state, dt: float) -> None:
         if mat.max_stretch is not None:
             v0, v1 = model.body_vertex_offsets[b], model.body_vertex_offsets[b + 1]
             anchors = model.attachments(b) if model.pinned[v0:v1].any() else None
-            project_stretch(state.x[v0:v1], state.v[v0:v1], state.x_start[v0:v1], model.vertex_inv_mass[v0:v1],
+            project_stretch(state_out.x[v0:v1], state_out.v[v0:v1], state_in.x[v0:v1], model.vertex_inv_mass[v0:v1],
                             model.spring_i[s0:s1] - v0, model.spring_j[s0:s1] - v0, model.spring_rest_length[s0:s1],
                             model.elem[t0:t1] - v0, model.elem_b[t0:t1], mat.max_stretch, dt, anchors=anchors,
                             tolerance=LIMIT_TOLERANCE)
         if mat.yield_strain is not None:
             if s1 > s0:
-                yield_springs(state.x, model.spring_i[s0:s1], model.spring_j[s0:s1], model.spring_rest_length[s0:s1],
+                yield_springs(state_out.x, model.spring_i[s0:s1], model.spring_j[s0:s1], model.spring_rest_length[s0:s1],
                               model.spring_rest_length0[s0:s1], mat.yield_strain, mat.plastic_rate)
-            if t1 > t0 and yield_elements(state.x, model.elem[t0:t1], model.elem_b[t0:t1], model.elem_area[t0:t1],
+            if t1 > t0 and yield_elements(state_out.x, model.elem[t0:t1], model.elem_b[t0:t1], model.elem_area[t0:t1],
                                           model.elem_b0[t0:t1], model.elem_area0[t0:t1], mat.yield_strain,
                                           mat.plastic_rate):
                 model.version += 1

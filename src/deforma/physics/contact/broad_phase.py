@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .contacts import COLLIDE, SELF_COLLIDE, ST_ACTIVE
+from .contacts import COLLIDE, SELF_COLLIDE
 
 
 # -- broad phase -------------------------------------------------------------------------------
@@ -94,7 +94,7 @@ def build_grid(x, topo, scr, margin):
     scr.grid[0] = ox
     scr.grid[1] = oy
     scr.grid[2] = inv
-    for m in range(scr.status[ST_ACTIVE]):
+    for m in range(scr.status.active[0]):
         k = scr.active[m]
         scr.xq[k, 0] = x[cv[k], 0]
         scr.xq[k, 1] = x[cv[k], 1]
@@ -206,7 +206,7 @@ def activate_vertices(x, topo, scr):
     for b in range(flags.shape[0]):
         touching = touching or (flags[b] & SELF_COLLIDE) != 0
     if not touching:  # one colliding body, without self contact: nothing can touch
-        scr.status[ST_ACTIVE] = 0
+        scr.status.active[0] = 0
         return 0
     for b in range(flags.shape[0]):
         if flags[b] != 0:
@@ -240,5 +240,5 @@ def activate_vertices(x, topo, scr):
                     n_near += 1
             if n_near:
                 n = _activate_inner(x, topo, scr, b, n, near, n_near)
-    scr.status[ST_ACTIVE] = n
+    scr.status.active[0] = n
     return n

@@ -1,6 +1,7 @@
 """The contact stage's data: the bodies as it reads them (:class:`ContactTopology`), its
 scratch (:class:`ContactScratch`) and the contacts it finds (:class:`ContactBuffer`), the
-status slots, and :class:`Contacts`, what ``world.contacts`` shows a user.
+counters (:class:`ContactStatus`), :class:`Contacts`, which bundles them for a step, and
+:class:`ContactPoints`, what ``world.contacts`` shows a user.
 
 The three are namedtuples of arrays that :class:`~deforma.physics.model.Model`, the world
 and the integrators own; the kernels of :mod:`~deforma.physics.contact` read and write them.
@@ -15,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from ..colliders.response import make_hits
 from ..colliders.shapes import RECT_FRICTION, RECT_STATIC_FRICTION
 
 # Bits of ContactTopology.body_flags.
@@ -30,17 +32,19 @@ SIDE_MARGIN = 1e-3       # a crossing is put back at least this fraction of the 
 PROXIMITY = 1
 CROSSING = 2
 
-# Slots of ContactScratch.status.
-ST_CONTACTS = 0      # contacts found by the first narrow phase of the last substep
-ST_NEEDED = 1        # > 0: the buffer's contact arrays were too small, this many are needed
-ST_PAIRS_NEEDED = 2  # > 0: ... its candidate pair arrays
-ST_FAILSAFE = 3      # substeps that needed the impact-zone fail-safe (cumulative)
-ST_STAMP = 4         # substeps run through the stage (cumulative)
-ST_PAIRS = 5         # candidate pairs of the last substep
-ST_ACTIVE = 6        # collision vertices tested in the last substep
-ST_DIRTY = 7         # length of ContactScratch.dirty
-ST_GEN = 8           # generations of checks (cumulative)
-ST_TOUCHED = 9       # length of ContactScratch.touched
+ContactStatus = namedtuple("ContactStatus", [  # each a (1,) int64 array, so that kernels write it
+    "contacts",         # contacts found by the first narrow phase of the last substep
+    "needed",           # > 0: the buffer's contact arrays were too small, this many are needed
+    "pairs_needed",     # > 0: ... its candidate pair arrays
+    "failsafe",         # substeps that needed the impact-zone fail-safe (cumulative)
+    "stamp",            # substeps run through the stage (cumulative)
+    "pairs",            # candidate pairs of the last substep
+    "active",           # collision vertices tested in the last substep
+    "dirty",            # length of ContactScratch.dirty
+    "generation",       # generations of checks (cumulative)
+    "touched",          # length of ContactScratch.touched
+])
+
 
 ContactTopology = namedtuple("ContactTopology", [
     "cv_vertex",        # (V,) int32: global vertex index of each collision vertex: the outline
@@ -64,17 +68,17 @@ ContactTopology = namedtuple("ContactTopology", [
 
 ContactScratch = namedtuple("ContactScratch", [
     "xp",               # (V, 2): collision vertices at the start of the substep
-    "active",           # (V,) int32: the collision vertices tested this substep (status[ST_ACTIVE] of them)
+    "active",           # (V,) int32: the collision vertices tested this substep (status.active[0] of them)
     "body_box",         # (B, 4) float64: each body's swept box xmin, ymin, xmax, ymax
     "xq",               # (V, 2): ... when the grid was built
-    "dirty",            # (V,) int32: vertices the response moved since the last check (status[ST_DIRTY])
-    "dirty_mark",       # (V,) int64: the check generation (status[ST_GEN]) a vertex was listed in dirty
-    "touched",          # (V,) int32: every vertex the stage moved this substep (status[ST_TOUCHED])
-    "touched_mark",     # (V,) int64: the substep (status[ST_STAMP]) a vertex was listed in touched
+    "dirty",            # (V,) int32: vertices the response moved since the last check (status.dirty[0])
+    "dirty_mark",       # (V,) int64: the check generation (status.generation[0]) a vertex was listed in dirty
+    "touched",          # (V,) int32: every vertex the stage moved this substep (status.touched[0])
+    "touched_mark",     # (V,) int64: the substep (status.stamp[0]) a vertex was listed in touched
     "pair_ptr",         # (V + 1,) int64: CSR, the candidate pairs each vertex is part of (out.pair_index)
     "pair_fill",        # (V,) int64: fill cursors for it
     "zone_list",        # (V,) int32: the vertices in impact zones
-    "zone_mark",        # (V,) int64: the fail-safe call (status[ST_GEN]) a vertex joined a zone in
+    "zone_mark",        # (V,) int64: the fail-safe call (status.generation[0]) a vertex joined a zone in
     "ebox",             # (Ec, 4) float64: edge boxes xmin, ymin, xmax, ymax as in the grid
     "ecell",            # (Ec, 4) int64: the cells they cover, ix0, iy0, ix1, iy1
     "cell_start",       # (T + 1,) int64: bucket starts (T a power of two)
@@ -83,7 +87,7 @@ ContactScratch = namedtuple("ContactScratch", [
     "grid",             # (3,) float64: origin x, origin y, 1 / cell size
     "parent",           # (V,) int32: impact zones (union-find)
     "zone",             # (V, 5) float64: zone sums m vx, m vy, m, members, still
-    "status",           # (10,) int64: see ST_*
+    "status",           # ContactStatus: counters, each a (1,) int64 array
 ])
 
 ContactBuffer = namedtuple("ContactBuffer", [
@@ -122,7 +126,8 @@ def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScr
                           np.zeros(v + 1, np.int64), np.zeros(v, np.int64), np.zeros(v, np.int32), never.copy(),
                           np.zeros((n_edges, 4)), np.zeros((n_edges, 4), np.int64), np.zeros(t + 1, np.int64),
                           np.zeros(t, np.int64), np.zeros(16 * n_edges + 64, np.int32), np.zeros(3),
-                          np.zeros(v, np.int32), np.zeros((v, 5)), np.zeros(10, np.int64))
+                          np.zeros(v, np.int32), np.zeros((v, 5)),
+                          ContactStatus(*(np.zeros(1, np.int64) for _ in ContactStatus._fields)))
 
 
 def make_buffer(contacts: int, pairs: int) -> ContactBuffer:
@@ -140,16 +145,16 @@ def note_moved(k, dirty, dirty_mark, gen, touched, touched_mark, stamp, status):
     # list vertex k as moved: for the next check (dirty) and for the collider pass (touched)
     if dirty_mark[k] != gen:
         dirty_mark[k] = gen
-        dirty[status[ST_DIRTY]] = k
-        status[ST_DIRTY] += 1
+        dirty[status.dirty[0]] = k
+        status.dirty[0] += 1
     if touched_mark[k] != stamp:
         touched_mark[k] = stamp
-        touched[status[ST_TOUCHED]] = k
-        status[ST_TOUCHED] += 1
+        touched[status.touched[0]] = k
+        status.touched[0] += 1
 
 
 @dataclass(frozen=True)
-class Contacts:
+class ContactPoints:
     """The contacts of the last substep, as arrays (struct of arrays, one row per contact).
 
     Collider contacts come first: the vertices the collider response put back outside a
@@ -194,26 +199,93 @@ class Contacts:
         return self.collider < 0
 
 
-def snapshot(topo: ContactTopology, scr: ContactScratch, buf: ContactBuffer, hits, rects) -> Contacts:
-    """The contacts of the last substep as a :class:`Contacts`, in world vertex indices.
 
-    ``hits`` is the world's ``ColliderHits`` record and ``rects`` the packed colliders (for
-    the coefficients each collider contact used).
+
+class Contacts:
+    """The contact data a step fills and reads: the contact stage's buffer and scratch, the
+    record of collider hits, and their counters by name.
+
+    Made by the World for its Model's contact topology (:meth:`for_topology`) and handed to
+    the integrator every step; the kernels take its namedtuples (``buffer``, ``scratch``,
+    ``hits``). When a substep finds more contacts or candidate pairs than the buffer holds,
+    the kernels stop and say how many they need (``needed``); the World then grows the
+    buffer (:meth:`grow`) and runs the step again from its start.
+
+    Attributes
+    ----------
+    buffer : ContactBuffer
+        The contacts and candidate pairs of the last substep.
+    scratch : ContactScratch
+        The stage's working arrays; ``scratch.status`` holds the counters.
+    hits : ColliderHits
+        Per vertex, the last collider contact (:func:`~deforma.physics.colliders.response.make_hits`).
+
+    Examples
+    --------
+    >>> from deforma.physics.contact.contacts import empty_topology
+    >>> c = Contacts.for_topology(empty_topology(), n_vertices=3)
+    >>> c.needed, int(c.status.stamp[0])
+    ((0, 0), 0)
     """
-    n = int(scr.status[ST_CONTACTS])
-    k = buf.vertex[:n]
-    j = buf.edge[:n]
-    cv = topo.cv_vertex.astype(np.int64)
-    edge = np.stack([cv[topo.ce_a[j]], cv[topo.ce_b[j]]], axis=1) if n else np.zeros((0, 2), np.int64)
-    touched = np.flatnonzero(hits.stamp == scr.status[ST_STAMP]) if scr.status[ST_STAMP] > 0 else np.zeros(0, int)
-    col = hits.collider[touched].astype(np.int64)
-    m = len(touched)
-    return Contacts(
-        vertex=np.concatenate([touched.astype(np.int64), cv[k]]),
-        collider=np.concatenate([col, np.full(n, -1, np.int64)]),
-        edge=np.concatenate([np.full((m, 2), -1, np.int64), edge]),
-        weight=np.concatenate([np.zeros(m), buf.s[:n]]),
-        normal=np.concatenate([hits.normal[touched], buf.normal[:n]]),
-        depth=np.concatenate([hits.depth[touched], buf.depth[:n]]),
-        friction=np.concatenate([rects[col, RECT_FRICTION], buf.mu[:n, 0]]),
-        static_friction=np.concatenate([rects[col, RECT_STATIC_FRICTION], buf.mu[:n, 1]]))
+
+    def __init__(self, buffer: ContactBuffer, scratch: ContactScratch, hits):
+        self.buffer = buffer
+        self.scratch = scratch
+        self.hits = hits
+
+    @classmethod
+    def for_topology(cls, topo: ContactTopology, *, n_vertices: int, keep: "Contacts | None" = None) -> "Contacts":
+        """Empty contacts for a Model's contact topology ``topo`` and ``n_vertices`` vertices;
+        a buffer at least as large as ``keep``'s (a rebuilt Model, e.g. after a tear, whose
+        contacts go on: a smaller buffer would make the next step run twice)."""
+        n_bodies = len(topo.body_flags)
+        scratch = make_scratch(len(topo.cv_vertex), len(topo.ce_a), n_bodies)
+        n_outline = int(topo.body_interior[0])
+        grown = (len(keep.buffer.vertex), len(keep.buffer.pair_vertex)) if keep is not None else (0, 0)
+        buffer = make_buffer(max(n_outline + 64, grown[0]), max(4 * n_outline + 64, grown[1]))
+        return cls(buffer, scratch, make_hits(n_vertices))
+
+    @property
+    def status(self) -> ContactStatus:
+        """The counters (:class:`ContactStatus`)."""
+        return self.scratch.status
+
+    @property
+    def needed(self) -> tuple[int, int]:
+        """``(contacts, pairs)`` the buffer lacked room for in the last step (0, 0: it had room)."""
+        st = self.scratch.status
+        return int(st.needed[0]), int(st.pairs_needed[0])
+
+    def clear_needed(self) -> None:
+        """Forget what the last step lacked (before a step)."""
+        st = self.scratch.status
+        st.needed[0] = st.pairs_needed[0] = 0
+
+    def grow(self) -> None:
+        """Make the buffer twice what the last step needed (and no smaller than it is)."""
+        need_c, need_p = self.needed
+        b = self.buffer
+        self.buffer = make_buffer(max(2 * need_c, len(b.vertex)), max(2 * need_p, len(b.pair_vertex)))
+
+    def points(self, topo: ContactTopology, rects) -> "ContactPoints":
+        """The contacts of the last substep as a :class:`ContactPoints`, in world vertex
+        indices; ``rects`` are the packed colliders (for the coefficients each collider
+        contact used)."""
+        scr, buf, hits = self.scratch, self.buffer, self.hits
+        n = int(scr.status.contacts[0])
+        k = buf.vertex[:n]
+        j = buf.edge[:n]
+        cv = topo.cv_vertex.astype(np.int64)
+        edge = np.stack([cv[topo.ce_a[j]], cv[topo.ce_b[j]]], axis=1) if n else np.zeros((0, 2), np.int64)
+        touched = np.flatnonzero(hits.stamp == scr.status.stamp[0]) if scr.status.stamp[0] > 0 else np.zeros(0, int)
+        col = hits.collider[touched].astype(np.int64)
+        m = len(touched)
+        return ContactPoints(
+            vertex=np.concatenate([touched.astype(np.int64), cv[k]]),
+            collider=np.concatenate([col, np.full(n, -1, np.int64)]),
+            edge=np.concatenate([np.full((m, 2), -1, np.int64), edge]),
+            weight=np.concatenate([np.zeros(m), buf.s[:n]]),
+            normal=np.concatenate([hits.normal[touched], buf.normal[:n]]),
+            depth=np.concatenate([hits.depth[touched], buf.depth[:n]]),
+            friction=np.concatenate([rects[col, RECT_FRICTION], buf.mu[:n, 0]]),
+            static_friction=np.concatenate([rects[col, RECT_STATIC_FRICTION], buf.mu[:n, 1]]))

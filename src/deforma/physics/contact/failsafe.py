@@ -8,14 +8,7 @@ from numba import njit
 
 from ..colliders.geometry import path_hits
 from ..union_find import find_root
-from .contacts import (
-    ST_ACTIVE,
-    ST_GEN,
-    ST_NEEDED,
-    ST_PAIRS_NEEDED,
-    ST_STAMP,
-    note_moved,
-)
+from .contacts import note_moved
 from .narrow_phase import check_pairs, refresh_pairs
 
 
@@ -34,16 +27,16 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
     status = scr.status
     dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
     margin = topo.margin[0]
-    call = status[ST_GEN]  # marks this call's zone members
+    call = status.generation[0]  # marks this call's zone members
     nz = 0
-    for rounds in range(status[ST_ACTIVE] + 1):
+    for rounds in range(status.active[0] + 1):
         n_pairs, rebuilt = refresh_pairs(x, topo, scr, out, margin, n_pairs)
         if n_pairs < 0:
-            status[ST_PAIRS_NEEDED] = -n_pairs
+            status.pairs_needed[0] = -n_pairs
             return n_pairs
         n = check_pairs(x, topo, scr, out, first, n_pairs, rebuilt, True)
         if n < 0:
-            status[ST_NEEDED] = -n
+            status.needed[0] = -n
             return n
         if n == first:
             return rounds
@@ -74,7 +67,7 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
                 zone[r, 0] += mass * v[i, 0]
                 zone[r, 1] += mass * v[i, 1]
                 zone[r, 2] += mass
-        gen, stamp = status[ST_GEN], status[ST_STAMP]
+        gen, stamp = status.generation[0], status.stamp[0]
         frozen = False
         for m in range(nz):
             k = zl[m]
@@ -102,4 +95,4 @@ def impact_zones(x, v, inv_mass, topo, scr, out, first, n_pairs, rects, h):
                     v[i, 1] = 0.0
                     x[i, 0] = xp[k, 0]
                     x[i, 1] = xp[k, 1]
-    return status[ST_ACTIVE] + 1
+    return status.active[0] + 1

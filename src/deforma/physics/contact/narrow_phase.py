@@ -11,19 +11,7 @@ import numpy as np
 from numba import njit
 
 from .broad_phase import activate_vertices, build_grid, grid_bucket, index_pairs
-from .contacts import (
-    COLLIDE,
-    CROSSING,
-    PROXIMITY,
-    SELF_COLLIDE,
-    SIDE_MARGIN,
-    SPECULATIVE,
-    ST_ACTIVE,
-    ST_DIRTY,
-    ST_GEN,
-    ST_NEEDED,
-    ST_PAIRS_NEEDED,
-)
+from .contacts import COLLIDE, CROSSING, PROXIMITY, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE
 from .friction import mix
 
 
@@ -186,7 +174,7 @@ def narrow_phase(x, topo, scr, out):
     pcap = pair_vertex.shape[0]
     n_outline = topo.body_interior[0]
     n = 0
-    for m in range(scr.status[ST_ACTIVE]):
+    for m in range(scr.status.active[0]):
         k = active[m]
         bk = body[k]
         fk = flags[bk]
@@ -244,11 +232,11 @@ def collide_outlines(x, topo, scr, out):
         return 0, 0
     n_pairs = narrow_phase(x, topo, scr, out)
     if n_pairs < 0:
-        status[ST_PAIRS_NEEDED] = -n_pairs
+        status.pairs_needed[0] = -n_pairs
         return -1, 0
     n = check_pairs(x, topo, scr, out, 0, n_pairs, True, False)
     if n < 0:
-        status[ST_NEEDED] = -n
+        status.needed[0] = -n
         return -1, n_pairs
     return n, n_pairs
 
@@ -290,13 +278,13 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
     cap = o_vertex.shape[0]
     pair_sel = out.pair_sel
     status = scr.status
-    status[ST_GEN] += 1
+    status.generation[0] += 1
     n_sel = n_pairs
     if not every:
-        gen = status[ST_GEN]
+        gen = status.generation[0]
         ptr, index, mark, sel, dirty = scr.pair_ptr, out.pair_index, out.pair_mark, out.pair_sel, scr.dirty
         n_sel = 0
-        for d in range(status[ST_DIRTY]):
+        for d in range(status.dirty[0]):
             k = dirty[d]
             for q in range(ptr[k], ptr[k + 1]):
                 m = index[q]
@@ -304,7 +292,7 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
                     mark[m] = gen
                     sel[n_sel] = m
                     n_sel += 1
-    status[ST_DIRTY] = 0
+    status.dirty[0] = 0
     n = first
     for q in range(n_sel):
         m = q if every else pair_sel[q]
@@ -350,7 +338,7 @@ def refresh_pairs(x, topo, scr, out, margin, n_pairs):
     the grid was built (only moved vertices can have); returns ``(pairs, rebuilt)`` (pairs
     negative if they did not fit). After a rebuild every pair must be checked again."""
     cv, xq = topo.cv_vertex, scr.xq
-    for d in range(scr.status[ST_DIRTY]):
+    for d in range(scr.status.dirty[0]):
         k = scr.dirty[d]
         if abs(x[cv[k], 0] - xq[k, 0]) > margin or abs(x[cv[k], 1] - xq[k, 1]) > margin:
             build_grid(x, topo, scr, margin)

@@ -10,7 +10,7 @@ from numba import njit
 from ..colliders.geometry import jump_reach, n_colliders, path_hits
 from ..colliders.response import collide_point, record_hit
 from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
-from .contacts import ST_GEN, ST_STAMP, ST_TOUCHED, note_moved
+from .contacts import note_moved
 from .friction import coulomb
 
 
@@ -178,7 +178,7 @@ def solve_contacts(x, v, inv_mass, topo, scr, out, first, last, rects, h, iterat
     reach2 = jump_reach(rects)
     status = scr.status
     dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
-    gen, stamp = status[ST_GEN], status[ST_STAMP]
+    gen, stamp = status.generation[0], status.stamp[0]
     for c in range(first, last):  # the vertices this solve may move
         note_moved(o_vertex[c], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
         note_moved(ce_a[o_edge[c]], dirty, dirty_mark, gen, touched, touched_mark, stamp, status)
@@ -241,7 +241,7 @@ def collider_pass(x, v, topo, scr, rects, hits, h):
     status = scr.status
     dirty, dirty_mark, touched, touched_mark = scr.dirty, scr.dirty_mark, scr.touched, scr.touched_mark
     moved = 0
-    for m in range(status[ST_TOUCHED]):
+    for m in range(status.touched[0]):
         k = touched[m]
         i = cv[k]
         px, py = x[i, 0], x[i, 1]
@@ -252,7 +252,7 @@ def collider_pass(x, v, topo, scr, rects, hits, h):
         if near and path_hits(xp[k, 0], xp[k, 1], px, py, rects):
             x[i, 0], x[i, 1], v[i, 0], v[i, 1], hit, nx, ny, depth = collide_point(
                 xp[k, 0], xp[k, 1], px, py, v[i, 0], v[i, 1], rects, h)
-            record_hit(hits, i, status[ST_STAMP], hit, nx, ny, depth)
-            note_moved(k, dirty, dirty_mark, status[ST_GEN], touched, touched_mark, status[ST_STAMP], status)
+            record_hit(hits, i, status.stamp[0], hit, nx, ny, depth)
+            note_moved(k, dirty, dirty_mark, status.generation[0], touched, touched_mark, status.stamp[0], status)
             moved += 1
     return moved

@@ -7,18 +7,7 @@ from __future__ import annotations
 from numba import njit
 
 from .broad_phase import index_pairs
-from .contacts import (
-    CONTACT_ITERATIONS,
-    ST_CONTACTS,
-    ST_DIRTY,
-    ST_FAILSAFE,
-    ST_NEEDED,
-    ST_PAIRS,
-    ST_PAIRS_NEEDED,
-    ST_STAMP,
-    ST_TOUCHED,
-    VERIFY_ROUNDS,
-)
+from .contacts import CONTACT_ITERATIONS, VERIFY_ROUNDS
 from .failsafe import impact_zones
 from .narrow_phase import check_pairs, collide_outlines, refresh_pairs
 from .response import collider_pass, solve_contacts
@@ -31,7 +20,7 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h, follow=True):
     Call it after the integrator has moved the vertices, with ``scr.xp`` holding the
     collision vertices' positions at the start of the substep (:func:`gather_start`).
     Updates ``x`` and ``v`` in place. Returns the number of contacts found, or -1 if
-    ``out`` was too small (``scr.status[ST_NEEDED]`` / ``[ST_PAIRS_NEEDED]`` then say how
+    ``out`` was too small (``scr.status.needed[0]`` / ``[ST_PAIRS_NEEDED]`` then say how
     many are needed; the substep is incomplete).
 
     ``follow`` (default True): a velocity impulse also moves its three vertices by ``h``
@@ -45,16 +34,16 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h, follow=True):
     carries the change through the body.
     """
     status = scr.status
-    status[ST_STAMP] += 1
-    status[ST_CONTACTS] = 0
-    status[ST_PAIRS] = 0
-    status[ST_DIRTY] = 0
-    status[ST_TOUCHED] = 0
+    status.stamp[0] += 1
+    status.contacts[0] = 0
+    status.pairs[0] = 0
+    status.dirty[0] = 0
+    status.touched[0] = 0
     n0, n_pairs = collide_outlines(x, topo, scr, out)
     if n0 < 0:
         return -1
-    status[ST_CONTACTS] = n0
-    status[ST_PAIRS] = n_pairs
+    status.contacts[0] = n0
+    status.pairs[0] = n_pairs
     if n0 == 0:
         return 0  # no contact and no crossing (a crossing is a contact too): nothing moved
     index_pairs(topo, scr, out, n_pairs)
@@ -70,7 +59,7 @@ def contact_stage(x, v, inv_mass, topo, scr, out, rects, hits, h, follow=True):
         if r < 0:
             return -1
         if r > 0:
-            status[ST_FAILSAFE] += 1
+            status.failsafe[0] += 1
     return n0
 
 
@@ -86,11 +75,11 @@ def _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h, follow):
     for _ in range(VERIFY_ROUNDS):
         n_pairs, rebuilt = refresh_pairs(x, topo, scr, out, margin, n_pairs)
         if n_pairs < 0:
-            status[ST_PAIRS_NEEDED] = -n_pairs
+            status.pairs_needed[0] = -n_pairs
             return -1, n_pairs
         n = check_pairs(x, topo, scr, out, end, n_pairs, rebuilt, True)
         if n < 0:
-            status[ST_NEEDED] = -n
+            status.needed[0] = -n
             return -1, n_pairs
         if n == end:
             return end, n_pairs
@@ -100,5 +89,5 @@ def _verify(x, v, inv_mass, topo, scr, out, n0, n_pairs, rects, h, follow):
     if r < 0:
         return -1, n_pairs
     if r > 0:
-        status[ST_FAILSAFE] += 1
+        status.failsafe[0] += 1
     return end, n_pairs

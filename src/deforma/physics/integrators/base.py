@@ -1,34 +1,52 @@
-"""What every integrator shares: the registry by name, the seam, the position step's tail.
+"""What every integrator shares: the seam, its options, the registry by name, and the
+contact stages every substep runs before and after the integrator's own work.
 
-An integrator advances a :class:`~deforma.physics.model.Model` and its
-:class:`~deforma.physics.state.State` by ``substeps`` substeps of length ``h``, including
-the collision response (:func:`~deforma.physics.colliders.response.collide_point`, which
-needs the position before and after each substep), and reports how many vertices ended
-non-finite or faster than ``max_speed``. It also saves the state at the start of the step
-into ``state.x_start`` / ``state.v_start`` so the world can undo a failed step.
+An integrator is an object (one per world, free to keep scratch arrays between steps) with
+
+    report = integrator.step(model, state_in, state_out, control, contacts, h,
+                             substeps=1, max_speed=inf)
+
+which advances ``state_out`` by ``substeps`` substeps of ``h`` seconds and returns a
+:class:`StepReport`. ``state_in`` is the state the step started from: the integrator never
+writes it, so a failed step is undone by keeping it. ``state_out`` arrives holding what the
+integrator advances: ``state_in``, or what an earlier stage of the step made of it (the gas
+pressure's kick on the velocities). ``control`` (:class:`~deforma.physics.control.Control`)
+says what acts on the bodies, ``contacts`` (:class:`~deforma.physics.contact.contacts.Contacts`)
+is the contact data the substeps fill.
+
+Every substep of every integrator has the same frame: colliders moved to the substep's end;
+the integrator's own work; the collider response per vertex; then :func:`contact_epilogue`
+(collider corners against outlines, and the body contact stage of
+:mod:`deforma.physics.contact`). The integrators that hold contacts inside their solve or
+sweep (XPBD, implicit Euler) also list them first, for the predicted motion
+(:func:`held_contacts`), and end with velocities from positions (:func:`finish_position_step`).
 
 Three are registered, one module each, by :mod:`deforma.physics.integrators`:
 ``"symplectic-euler"`` (:mod:`~deforma.physics.integrators.symplectic`, the default),
 ``"implicit-euler"`` (:mod:`~deforma.physics.integrators.implicit`) and ``"xpbd"``
-(:mod:`~deforma.physics.integrators.xpbd`); another is a class with the same ``advance``
-signature registered with :func:`register_integrator`. An integrator class may set
-``unconditionally_stable = True``; ``World.stable_dt`` then reports no explicit step limit
-for it.
-
-The position-based integrators (XPBD, implicit Euler) end each substep alike: velocities from
-positions, then the collider response (:func:`finish_position_step`).
+(:mod:`~deforma.physics.integrators.xpbd`). Another is a subclass of :class:`Integrator`
+registered with :func:`register_integrator`; its :attr:`Integrator.OPTIONS` are its settings
+(``World(integrator_options=...)``, ``world.integrator_options``, the scene key
+``[physics.integrator_options]``).
 """
 
 from __future__ import annotations
 
-from typing import Callable, Protocol
+import difflib
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
 
 import numpy as np
 from numba import njit
 
 from ..colliders.geometry import jump_reach, n_colliders
-from ..colliders.response import collide_point, record_hit
+from ..colliders.response import collide_point, contact_planes, push_edges_off_corners, record_hit
 from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
+from ..contact.broad_phase import gather_start
+from ..contact.narrow_phase import detect_contacts
+from ..contact.response import hold_start_distance
+from ..contact.stage import contact_stage
 
 
 @njit(cache=True, inline="always")
@@ -92,42 +110,184 @@ def finish_position_step(x, v, x_prev, rects, hits, stamp, h, vmax2):
         bad += is_bad(px, py, vx, vy, vmax2)
     return bad
 
-class StepInputs(Protocol):
-    """What a world hands an integrator each step (duck-typed; see ``World``)."""
 
-    gravity: tuple[float, float]
-    air_drag: float            # 1/s: every velocity decays as dv/dt = -air_drag v
-    rects: np.ndarray          # (R, RECT_COLUMNS) packed colliders
-    hits: tuple                # colliders.ColliderHits: who touched which collider, per vertex
-    contact_scratch: tuple     # contacts.ContactScratch
-    contacts: tuple            # contacts.ContactBuffer
-    grab_slot: np.ndarray      # (N,) int32, grab entry per vertex or -1
-    grab_pull: np.ndarray      # (K, 3) float64, (S, S*tx, S*ty) per entry
-    max_speed: float           # m/s; faster counts as runaway
+@njit(cache=True)
+def held_contacts(x_prev, y, rects, planes, touch, h, topo, scr, buf):
+    """The contacts a stable solver holds inside its solve or sweep, for the motion from
+    ``x_prev`` to the prediction ``y``: the collider contact planes
+    (:func:`~deforma.physics.colliders.response.contact_planes`, into ``planes`` and
+    ``touch``) and the body contacts (:func:`~deforma.physics.contact.narrow_phase.detect_contacts`,
+    into ``buf``, each held no closer than its pair started:
+    :func:`~deforma.physics.contact.response.hold_start_distance`). Also notes the start of
+    the substep for the contact stage (:func:`~deforma.physics.contact.broad_phase.gather_start`).
+
+    Returns ``(count, n_body)``: how many collider and body contacts; ``n_body`` is -1 when
+    the buffer was too small (the World grows it and runs the step again).
+    """
+    count = contact_planes(x_prev, y, rects, planes, touch, h)
+    gather_start(x_prev, topo, scr)
+    n_body = detect_contacts(y, topo, scr, buf)  # of the predicted motion
+    if n_body >= 0:
+        hold_start_distance(x_prev, topo, buf, n_body)
+    return count, n_body
 
 
-class Integrator(Protocol):
-    """The seam: one object per world, free to keep scratch arrays between steps."""
+@njit(cache=True)
+def contact_epilogue(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow):
+    """The end of every substep, after the collider response: collider corners pushed off
+    body outlines (:func:`~deforma.physics.colliders.response.push_edges_off_corners`), then
+    the body contact stage (:func:`~deforma.physics.contact.stage.contact_stage`; ``follow``:
+    whether its velocity impulses move positions too). Returns the stage's result: -1 when
+    the buffer was too small (the World grows it and runs the step again)."""
+    push_edges_off_corners(x, v, inv_mass, topo.ce_a, topo.ce_b, topo.cv_vertex, rects)
+    return contact_stage(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow)
+
+
+@dataclass(frozen=True)
+class StepReport:
+    """What :meth:`Integrator.step` says of the step it ran.
+
+    Attributes
+    ----------
+    bad_vertices : int
+        Vertices that ended a substep non-finite or faster than ``max_speed``; the step
+        stopped there (``state_out`` is garbage: keep ``state_in``).
+    complete : bool
+        False when the contact buffer was too small: ``contacts.needed`` says how large it
+        must be; grow it and run the step again from ``state_in``.
+    """
+
+    bad_vertices: int = 0
+    complete: bool = True
+
+
+@dataclass(frozen=True)
+class Option:
+    """One setting of an integrator: its name, default and what values it takes.
+
+    ``kind`` is ``"int"`` (an integer in ``[low, high]``), ``"float"`` (a number in the open
+    interval ``(low, high)``) or ``"choice"`` (one of ``choices``).
+
+    Examples
+    --------
+    >>> Option("iterations", 3, "int", low=1, high=10_000, doc="sweeps").check(5, "xpbd")
+    5
+    """
 
     name: str
+    default: Any
+    kind: str
+    low: float = -math.inf
+    high: float = math.inf
+    choices: tuple = ()
+    doc: str = ""
 
-    def advance(self, model, state, inputs: StepInputs, h: float, substeps: int) -> int:
-        """Advance ``substeps`` substeps of ``h`` seconds; return the count of bad vertices."""
+    def allowed(self) -> str:
+        """What the option takes, in words."""
+        if self.kind == "int":
+            return f"an integer in [{self.low:g}, {self.high:g}]"
+        if self.kind == "float":
+            return f"a number in ({self.low:g}, {self.high:g})"
+        return "one of " + ", ".join(repr(c) for c in self.choices)
+
+    def check(self, value, integrator: str):
+        """``value`` as the option keeps it; ``ValueError`` saying what is allowed if it is not."""
+        bad = ValueError(f"{integrator} option {self.name} must be {self.allowed()}, got {value!r}")
+        if self.kind == "int":
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not self.low <= value <= self.high:
+                raise bad
+            return int(value)
+        if self.kind == "float":
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not self.low < float(value) < self.high:
+                raise bad
+            return float(value)
+        if value not in self.choices:
+            raise bad
+        return value
+
+
+class Integrator:
+    """The seam every integrator implements: :meth:`step`, and its options by name.
+
+    A subclass sets :attr:`name`, its :attr:`OPTIONS` and :meth:`step`; it is made available
+    as ``World(integrator=name)`` by :func:`register_integrator`. Its options are read as
+    ``self.options[name]``. ``unconditionally_stable = True`` tells ``World.stable_dt`` that
+    it has no explicit step limit. :meth:`stats` gives counters a user may want to see
+    (``world.integrator_stats``).
+
+    Examples
+    --------
+    >>> make_integrator("xpbd").options
+    {'iterations': 1}
+    """
+
+    name: str = ""
+    OPTIONS: tuple[Option, ...] = ()
+    unconditionally_stable = False
+
+    def __init__(self, **options):
+        self._options = {o.name: o.default for o in self.OPTIONS}
+        self.configure(options)
+
+    @property
+    def options(self) -> dict:
+        """The integrator's settings by name (a copy: set them with :meth:`configure`)."""
+        return dict(self._options)
+
+    def configure(self, options) -> None:
+        """Set the options named in the mapping ``options``; the others go back to their
+        defaults. Checks every value first: a bad one raises ``ValueError`` and changes nothing."""
+        if not hasattr(options, "items"):
+            raise ValueError(f"{self.name} options must be a table of name = value, got {options!r}")
+        mine = {o.name: o for o in self.OPTIONS}
+        new = {o.name: o.default for o in self.OPTIONS}
+        for key, value in options.items():
+            if key not in mine:
+                raise ValueError(unknown_option(key, self.name))
+            new[key] = mine[key].check(value, self.name)
+        self._options = new
+        self._options_changed()
+
+    def _options_changed(self) -> None:
+        """Called after the options changed (a subclass drops what depended on them)."""
+
+    def stats(self) -> dict:
+        """Counters of the work done so far (per integrator; empty by default)."""
+        return {}
+
+    def step(self, model, state_in, state_out, control, contacts, h: float, *, substeps: int = 1,
+             max_speed: float = math.inf) -> StepReport:
+        """Advance ``state_out`` by ``substeps`` substeps of ``h`` seconds (see the module docstring)."""
+        raise NotImplementedError
+
+
+def unknown_option(key, integrator: str) -> str:
+    """The message for an option ``key`` that ``integrator`` does not take: which integrator
+    does take it, or the nearest of its own names."""
+    others = [n for n, cls in _REGISTRY.items() if n != integrator and any(o.name == key for o in cls.OPTIONS)]
+    mine = [o.name for o in _REGISTRY[integrator].OPTIONS] if integrator in _REGISTRY else []
+    takes = f"{integrator} takes " + (", ".join(mine) if mine else "no options")
+    if others:
+        return f"{key!r} is an option of {' and '.join(others)}, not of {integrator} ({takes})"
+    near = difflib.get_close_matches(str(key), mine, n=1)
+    hint = f" (did you mean {near[0]!r}?)" if near else ""
+    return f"unknown {integrator} option {key!r}{hint}; {takes}"
 
 
 _REGISTRY: dict[str, Callable[[], Integrator]] = {}
 
 
 def register_integrator(name: str):
-    """Class decorator: make an integrator available as ``World(integrator=name)``.
+    """Class decorator: make an :class:`Integrator` subclass available as ``World(integrator=name)``.
 
     Examples
     --------
     >>> @register_integrator("noop")
-    ... class Noop:
+    ... class Noop(Integrator):
     ...     name = "noop"
-    ...     def advance(self, model, state, inputs, h, substeps):
-    ...         return 0
+    ...     def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
+    ...         return StepReport()
     >>> "noop" in available_integrators()
     True
     >>> _ = _REGISTRY.pop("noop")
@@ -135,6 +295,8 @@ def register_integrator(name: str):
     def deco(cls):
         if name in _REGISTRY:
             raise ValueError(f"an integrator named {name!r} is already registered")
+        if not (isinstance(cls, type) and issubclass(cls, Integrator)):
+            raise ValueError(f"integrator {name!r} must be a subclass of deforma.physics.integrators.Integrator")
         _REGISTRY[name] = cls
         return cls
     return deco
@@ -151,10 +313,14 @@ def available_integrators() -> list[str]:
     return list(_REGISTRY)
 
 
-def make_integrator(name: str) -> Integrator:
-    """A new integrator instance by name; ``ValueError`` naming the choices if unknown."""
+def make_integrator(name: str, options=None) -> Integrator:
+    """A new integrator instance by name with ``options`` (a mapping; defaults for the rest);
+    ``ValueError`` naming the choices if the name is unknown, or saying what is wrong with an option."""
     try:
         factory = _REGISTRY[name]
     except (KeyError, TypeError):
         raise ValueError(f"unknown integrator {name!r}; available: {', '.join(available_integrators())}") from None
-    return factory()
+    integrator = factory()
+    if options:
+        integrator.configure(options)
+    return integrator

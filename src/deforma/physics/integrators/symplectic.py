@@ -8,10 +8,12 @@ Semi-implicit (symplectic) Euler, per substep::
     x, v = push_edges_off_corners(x, v)         # collider corners against body outlines
     x, v = contact_stage(x_before, x, v)        # bodies against bodies and themselves
 
-Every integrator ends its substeps with the same two responses: the collider response per
-vertex (fused into its last pass over the vertices) and then the body contact stage of
-:mod:`~deforma.physics.contact` (collide, solve, verify), which needs the boundary's
-positions at the start of the substep (``contacts.gather_start``).
+Every integrator ends its substeps with the same responses: the collider response per vertex
+(fused into its last pass over the vertices), then the shared epilogue
+(:func:`~deforma.physics.integrators.base.contact_epilogue`: collider corners against
+outlines, the body contact stage of :mod:`~deforma.physics.contact`), which needs the
+boundary's positions at the start of the substep
+(:func:`~deforma.physics.contact.broad_phase.gather_start`).
 
 It is fused into two passes over memory per substep: springs, each thread scattering a
 contiguous run of them into its own force buffer, then one per-vertex pass that sums the
@@ -30,15 +32,13 @@ import numpy as np
 from numba import njit, prange
 
 from ..colliders.geometry import advance_colliders, jump_reach, n_colliders
-from ..colliders.response import collide_point, push_edges_off_corners, record_hit
+from ..colliders.response import collide_point, record_hit
 from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
 from ..contact.broad_phase import gather_start
-from ..contact.contacts import ST_STAMP
-from ..contact.stage import contact_stage
 from ..elements.springs import scatter_spring_forces
 from ..elements.triangles import element_forces
 from ..jit import serial_and_parallel
-from .base import is_bad, register_integrator
+from .base import Integrator, Option, StepReport, contact_epilogue, is_bad, register_integrator
 
 # Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
 PARALLEL_MIN_VERTICES = 512
@@ -62,18 +62,20 @@ def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, keep, h):
 # Numba does not always prune (a helper taking a dozen arrays made the step 10x slower).
 # Scalar-only helpers are free.
 
-def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
+def _symplectic_euler(x, v, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
                       elem_ptr, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind, elem_damped,
-                      inv_mass, gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps,
-                      vmax2):
+                      inv_mass, gx, gy, keep, force, has_force, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h,
+                      substeps, vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions.
 
     ``fbuf`` (T, N, 2) are zeroed force buffers, one per chunk ``t`` of springs
     (``chunk_ptr[t]:chunk_ptr[t + 1]``) and of triangle elements (``elem_ptr[t]:elem_ptr[t +
     1]``; see :mod:`deforma.physics.elements.triangles` for ``elem*``), and are left zeroed; chunk
     ``t`` touches only the vertices ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see
-    :func:`spring_chunks`). A vertex with ``inv_mass`` 0 is pinned: it stays where it is. Saves the start state into ``x_start`` /
-    ``v_start``; stops early and returns the number of vertices that ended non-finite or
+    :func:`spring_chunks`). ``force`` (N, 2) is added to every vertex's force if
+    ``has_force`` (applied forces, and the forces of element kinds outside this driver). A
+    vertex with ``inv_mass`` 0 is pinned: it stays where it is. Advances ``x``, ``v`` in
+    place; stops early and returns the number of vertices that ended non-finite or
     faster than ``sqrt(vmax2)`` m/s (or 0 at once when the contact buffer ``cbuf`` is too
     small: ``cscr.status`` says so). ``hits`` records collider contacts (written only on a
     hit); ``ctopo``, ``cscr``, ``cbuf``: the contact stage's topology, scratch and buffer.
@@ -88,7 +90,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
     for sub in range(substeps):
         advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
         gather_start(x, ctopo, cscr)
-        stamp = cscr.status[ST_STAMP] + 1  # the contact stage counts this substep when it runs
+        stamp = cscr.status.stamp[0] + 1  # the contact stage counts this substep when it runs
         for t in prange(n_chunks):
             lo, hi = chunk_ptr[t], chunk_ptr[t + 1]
             scatter_spring_forces(x, v, spring_i[lo:hi], spring_j[lo:hi], rest[lo:hi], ks[lo:hi], kd[lo:hi], fbuf[t])
@@ -96,12 +98,9 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
             if hi > lo:
                 element_forces(x, v, elem[lo:hi], elem_b[lo:hi], elem_area[lo:hi], elem_mu[lo:hi], elem_lam[lo:hi],
                                elem_beta[lo:hi], elem_kind[lo:hi], elem_damped, fbuf[t])
-        save = sub == 0
         bad = 0
         for i in prange(x.shape[0]):
             x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
-            if save:
-                x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x0, y0, vx, vy
             if n_chunks == 1:  # one buffer over every vertex: no range test (~7% of a 1e3-vertex step)
                 fx = fbuf[0, i, 0]
                 fy = fbuf[0, i, 1]
@@ -116,6 +115,9 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
                         fy += fbuf[t, i, 1]
                         fbuf[t, i, 0] = 0.0
                         fbuf[t, i, 1] = 0.0
+            if has_force:
+                fx += force[i, 0]
+                fy += force[i, 1]
             g = grab_slot[i]
             if g >= 0:  # the grab pull: strength * (target - x), summed over the grabs holding i
                 fx += grab_pull[g, 1] - grab_pull[g, 0] * x0
@@ -138,8 +140,7 @@ def _symplectic_euler(x, v, x_start, v_start, fbuf, chunk_ptr, chunk_vertices, s
             bad += is_bad(px, py, vx, vy, vmax2)
         if bad:
             return bad
-        push_edges_off_corners(x, v, inv_mass, ctopo.ce_a, ctopo.ce_b, ctopo.cv_vertex, rects)
-        if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
+        if contact_epilogue(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h, True) < 0:
             return 0
     return 0
 
@@ -208,7 +209,7 @@ def spring_chunks(spring_i, spring_j, n_chunks: int) -> tuple[np.ndarray, np.nda
 
 
 @register_integrator("symplectic-euler")
-class SymplecticEuler:
+class SymplecticEuler(Integrator):
     """Semi-implicit Euler (the original's): ``v += h F/m; x += h v``, then collisions.
 
     Stable for ``h`` below roughly ``2 / omega_max`` (see ``World.stable_dt``); energy
@@ -220,8 +221,13 @@ class SymplecticEuler:
     a barrier every pass are fast on an idle machine but can be 100x slower when other
     processes keep the cores busy, so now and then two steps run on the other driver (every
     16 steps, backing off to every 4096 while it keeps losing) and the faster one (median of
-    its last three timed steps) is used. Set ``mode`` to ``"serial"`` or ``"parallel"`` to
-    pin one (benchmarks, tests).
+    its last three timed steps) is used.
+
+    Options
+    -------
+    mode : {"auto", "serial", "parallel"}
+        ``"auto"`` (default) measures which driver is faster, as above; ``"serial"`` or
+        ``"parallel"`` pins one (benchmarks, tests). The result is the same bit for bit.
 
     Examples
     --------
@@ -231,8 +237,11 @@ class SymplecticEuler:
     """
 
     name = "symplectic-euler"
+    OPTIONS = (Option("mode", "auto", "choice", choices=("auto", "serial", "parallel"),
+                      doc="which driver runs: measured (auto), one thread (serial) or all threads (parallel)"),)
 
-    def __init__(self):
+    def __init__(self, **options):
+        super().__init__(**options)
         self._fbuf = np.zeros((0, 0, 2))
         self._model = None
         self._chunks = np.zeros(1, np.int64)
@@ -241,7 +250,6 @@ class SymplecticEuler:
         self._threads = None  # numba.get_num_threads(), re-read every 1024 steps
         self._ticks = 0
         self._reset_timing()
-        self.mode = "auto"
 
     def _reset_timing(self):
         self._samples = {"serial": [], "parallel": []}  # recent seconds per substep
@@ -278,7 +286,7 @@ class SymplecticEuler:
         self._last_best = best
         return other
 
-    def advance(self, model, state, inputs, h, substeps):
+    def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
         n = model.n_vertices
         self._ticks += 1
         if self._ticks >= 1024 or self._threads is None:  # costs 1 us: a few % of a small step
@@ -286,7 +294,8 @@ class SymplecticEuler:
         threads = self._threads
         # the chunking, and so the result, depends on the body size and thread count only
         n_chunks = threads if n >= PARALLEL_MIN_VERTICES and threads > 1 else 1
-        may_parallel = n_chunks > 1 and self.mode != "serial"
+        mode = self._options["mode"]
+        may_parallel = n_chunks > 1 and mode != "serial"
         if self._model is not model or self._fbuf.shape[:2] != (n_chunks, n):
             # scratch kept between steps: the kernels allocate nothing and leave it zeroed
             self._model = model  # a new Model means new topology: new chunks
@@ -294,26 +303,23 @@ class SymplecticEuler:
             self._chunks, self._elem_chunks, self._chunk_vertices = merged_chunks(
                 model.spring_i, model.spring_j, model.elem, n_chunks)
             self._reset_timing()
-        if self.mode not in ("auto", "serial", "parallel"):
-            raise ValueError(f"mode must be 'auto', 'serial' or 'parallel', got {self.mode!r}")
         if not may_parallel:
             which = "serial"
-        elif self.mode == "parallel":
+        elif mode == "parallel":
             which = "parallel"
         else:
             which = self._choose()
         kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
-        gx, gy = inputs.gravity
+        gx, gy = model.gravity
         start = time.perf_counter()
-        bad = kernel(state.x, state.v, state.x_start, state.v_start, self._fbuf, self._chunks, self._chunk_vertices,
+        bad = kernel(state_out.x, state_out.v, self._fbuf, self._chunks, self._chunk_vertices,
                      model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
                      model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
                      model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
                      bool(model.elem_damping.any()), model.vertex_inv_mass, float(gx), float(gy),
-                     1.0 / (1.0 + float(h) * inputs.air_drag), inputs.grab_slot,
-                     inputs.grab_pull, inputs.rects, inputs.hits, model.contact, inputs.contact_scratch,
-                     inputs.contacts,
-                     float(h), int(substeps), float(inputs.max_speed) ** 2)
+                     1.0 / (1.0 + float(h) * model.air_drag), control.force, control.has_force, control.grab_slot,
+                     control.grab_pull, control.colliders, contacts.hits, model.contact, contacts.scratch,
+                     contacts.buffer, float(h), int(substeps), float(max_speed) ** 2)
         if may_parallel:
             took = (time.perf_counter() - start) / substeps
             if which == self._last:  # the driver ran last call too: threads awake, caches warm
@@ -322,8 +328,4 @@ class SymplecticEuler:
                 del smp[:-3]
                 self._estimate[which] = sorted(smp)[len(smp) // 2]  # median: one outlier is ignored
             self._last = which
-        return bad
-
-
-# Registered after SymplecticEuler so that it stays first (the default) in the listing; the
-# two modules import register_integrator from this one, which is complete by now.
+        return StepReport(int(bad), contacts.needed == (0, 0))

@@ -48,26 +48,27 @@ a correction across about one spring per substep against the sweep order (and ac
 whole body along it), so a large stiff body behaves softer than ``ks`` unless the substeps
 are many; ``docs/integrators.md`` gives measured figures. The sweep is serial and goes
 colour by colour (:func:`sweep_order`: no two springs, or elements, of a colour share a
-vertex), the elements' colours in an order drawn afresh for each step from a counter of
-steps (:func:`colour_sequence`), so results are deterministic.
+vertex), the elements' colours in an order drawn afresh for each step from the step's index
+(``control.step``, :func:`colour_sequence`), so results are deterministic, and a step
+repeated (after a failure, or after the contact buffer grew) draws the same order.
 
 Units: m, m/s, kg, N/m, N*s/m, s.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from ..colliders.geometry import advance_colliders
-from ..colliders.response import contact_planes, push_edges_off_corners
-from ..contact.broad_phase import gather_start
-from ..contact.contacts import ST_NEEDED, ST_PAIRS_NEEDED, ST_STAMP
-from ..contact.narrow_phase import detect_contacts
-from ..contact.response import hold_start_distance, project_contacts
-from ..contact.stage import contact_stage
+from ..contact.response import project_contacts
+from ..elements.springs import project_springs
 from ..elements.triangles import project_elements
-from .base import finish_position_step, register_integrator
+from .base import (Integrator, Option, StepReport, contact_epilogue, finish_position_step, held_contacts,
+                   register_integrator)
+
 
 COLOURS = 64  # colours of the sweep order's greedy colouring (one bit each in a uint64 per vertex)
 
@@ -141,18 +142,79 @@ def colour_sequence(seed, out):
 
 
 @njit(cache=True)
-def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j, rest, ks, kd,
+def predict(x, v, x_prev, inv_mass, gx, gy, keep, force, has_force, grab_slot, grab_pull, h):
+    """Start an XPBD substep: ``x_prev = x``, the velocity kicked by gravity and the applied
+    ``force`` (if ``has_force``) and damped by air drag (``keep = 1 / (1 + h air_drag)``),
+    ``x`` moved to its prediction ``x + h v``, and a held vertex pulled to its grab target
+    exactly (a zero-length spring of compliance ``1 / S``). A pinned vertex stays."""
+    h2 = h * h
+    for i in range(x.shape[0]):
+        x_prev[i, 0] = x[i, 0]
+        x_prev[i, 1] = x[i, 1]
+        if inv_mass[i] == 0.0:  # pinned: it stays
+            v[i, 0] = 0.0
+            v[i, 1] = 0.0
+            continue
+        if has_force:
+            v[i, 0] = (v[i, 0] + h * (gx + force[i, 0] * inv_mass[i])) * keep
+            v[i, 1] = (v[i, 1] + h * (gy + force[i, 1] * inv_mass[i])) * keep
+        else:
+            v[i, 0] = (v[i, 0] + h * gx) * keep
+            v[i, 1] = (v[i, 1] + h * gy) * keep
+        px = x[i, 0] + h * v[i, 0]
+        py = x[i, 1] + h * v[i, 1]
+        g = grab_slot[i]
+        if g >= 0:
+            # zero-length spring to the target with compliance 1/S, solved exactly:
+            # x = (x* + h^2 w S t) / (1 + h^2 w S)
+            a = h2 * inv_mass[i]
+            den = 1.0 + a * grab_pull[g, 0]
+            px = (px + a * grab_pull[g, 1]) / den
+            py = (py + a * grab_pull[g, 2]) / den
+        x[i, 0] = px
+        x[i, 1] = py
+
+
+@njit(cache=True)
+def project_collider_contacts(x, x_prev, inv_mass, planes, touch, count):
+    """One sweep over the collider contacts ``planes[:count]`` (vertices ``touch``): each
+    vertex put back on the outside of its plane, with Coulomb friction at position level.
+
+    Stick or slide is decided once, by the first sweep (``planes[k, 7]`` -1: not yet; the
+    predicted motion's push is the substep's normal impulse, as in the collider rule): a stuck
+    vertex has its tangential motion since the substep began undone in every sweep, a sliding
+    one is held back by the dynamic coefficient times each sweep's push (relative to the
+    collider's surface, which moved by ``planes[k, 5:7]``).
+    """
+    for k in range(count):
+        i = touch[k]
+        nx, ny = planes[k, 0], planes[k, 1]
+        gap = x[i, 0] * nx + x[i, 1] * ny - planes[k, 2]
+        if inv_mass[i] == 0.0:
+            continue
+        push = -gap if gap < 0.0 else 0.0
+        # tangential motion since the substep began (t = (-ny, nx))
+        slide = (x_prev[i, 0] + planes[k, 5] - x[i, 0]) * -ny + (x_prev[i, 1] + planes[k, 6] - x[i, 1]) * nx
+        if planes[k, 7] < 0.0:
+            planes[k, 7] = 1.0 if abs(slide) <= planes[k, 3] * push else 0.0
+        if planes[k, 7] == 0.0:
+            slide = min(abs(slide), planes[k, 4] * push) * (1.0 if slide > 0.0 else -1.0)
+        x[i, 0] += push * nx - slide * ny
+        x[i, 1] += push * ny + slide * nx
+
+
+@njit(cache=True)
+def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j, rest, ks, kd,
                   spring_order, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind,
-                  elem_order, elem_starts, seed, elem_lam_acc, gx, gy, keep, grab_slot, grab_pull, rects, hits, ctopo,
-                  cscr, cbuf, h, substeps, iterations, vmax2):
-    """``substeps`` XPBD substeps of ``h`` s with ``iterations`` Gauss-Seidel sweeps each.
+                  elem_order, elem_starts, seed, elem_lam_acc, gx, gy, keep, force, has_force, grab_slot, grab_pull,
+                  rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
+    """``substeps`` XPBD substeps of ``h`` s with ``iterations`` Gauss-Seidel sweeps each,
+    over the built-in element kinds (springs and triangles): the compiled driver for them.
 
     Parameters
     ----------
     x, v : (N, 2) float64
         Positions (m) and velocities (m/s), advanced in place.
-    x_start, v_start : (N, 2) float64
-        Receive the state at the start of the call.
     x_prev : (N, 2) float64
         Scratch: positions at the start of the current substep.
     lam : (E,) float64
@@ -181,6 +243,8 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
         Gravity (m/s^2).
     keep : float
         ``1 / (1 + h air_drag)``: the part of each velocity air drag leaves per substep.
+    force : (N, 2) float64
+        Applied forces (N), read if ``has_force``.
     grab_slot : (N,) int32
         Grab entry per vertex or -1.
     grab_pull : (K, 3) float64
@@ -212,152 +276,81 @@ def xpbd_substeps(x, v, x_start, v_start, x_prev, lam, planes, touch, inv_mass, 
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
     >>> elem = np.zeros((0, 3), np.int32)
     >>> no_elements = (elem, np.zeros((0, 4)), *[np.zeros(0)] * 4, np.zeros(0, np.int32), *sweep_order(elem, 2))
-    >>> bad = xpbd_substeps(x, v, x.copy(), v.copy(), x.copy(), np.zeros(1), np.zeros((2, 8)),
+    >>> bad = xpbd_substeps(x, v, x.copy(), np.zeros(1), np.zeros((2, 8)),
     ...                     np.zeros(2, np.int32), np.ones(2),
     ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
     ...                     np.zeros(1), sweep_order(np.array([[0, 1]], np.int32), 2)[0], *no_elements, 0,
-    ...                     np.zeros((0, 3)), 0.0, 0.0, 1.0, np.full(2, -1, np.int32), np.zeros((0, 3)),
-    ...                     np.zeros((0, 19)), make_hits(2), empty_topology(), make_scratch(0, 0), make_buffer(0, 0),
-    ...                     0.01, 1, 1, 1e6)
+    ...                     np.zeros((0, 3)), 0.0, 0.0, 1.0, np.zeros((0, 2)), False, np.full(2, -1, np.int32),
+    ...                     np.zeros((0, 3)), np.zeros((0, 19)), make_hits(2), empty_topology(), make_scratch(0, 0),
+    ...                     make_buffer(0, 0), 0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
     1.0
     """
-    n = x.shape[0]
-    h2 = h * h
     sequence = np.empty(COLOURS, np.int64)
-    for i in range(n):
-        x_start[i, 0], x_start[i, 1], v_start[i, 0], v_start[i, 1] = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
     for sub in range(substeps):
         advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
-        for i in range(n):
-            x_prev[i, 0] = x[i, 0]
-            x_prev[i, 1] = x[i, 1]
-            if inv_mass[i] == 0.0:  # pinned: it stays
-                v[i, 0] = 0.0
-                v[i, 1] = 0.0
-                continue
-            v[i, 0] = (v[i, 0] + h * gx) * keep
-            v[i, 1] = (v[i, 1] + h * gy) * keep
-            px = x[i, 0] + h * v[i, 0]
-            py = x[i, 1] + h * v[i, 1]
-            g = grab_slot[i]
-            if g >= 0:
-                # zero-length spring to the target with compliance 1/S, solved exactly:
-                # x = (x* + h^2 w S t) / (1 + h^2 w S)
-                a = h2 * inv_mass[i]
-                den = 1.0 + a * grab_pull[g, 0]
-                px = (px + a * grab_pull[g, 1]) / den
-                py = (py + a * grab_pull[g, 2]) / den
-            x[i, 0] = px
-            x[i, 1] = py
+        predict(x, v, x_prev, inv_mass, gx, gy, keep, force, has_force, grab_slot, grab_pull, h)
         for e in range(spring_i.shape[0]):
             lam[e] = 0.0
         for e in range(elem.shape[0]):
             elem_lam_acc[e, 0] = 0.0
             elem_lam_acc[e, 1] = 0.0
             elem_lam_acc[e, 2] = 0.0
-        count = contact_planes(x_prev, x, rects, planes, touch, h)
+        count, n_body = held_contacts(x_prev, x, rects, planes, touch, h, ctopo, cscr, cbuf)
         for k in range(count):
             planes[k, 7] = -1.0  # stick or slide: not decided yet
-        gather_start(x_prev, ctopo, cscr)
-        n_body = detect_contacts(x, ctopo, cscr, cbuf)  # of the predicted motion
         if n_body < 0:
             return 0  # the contact buffer is too small; the world grows it and repeats the step
-        hold_start_distance(x_prev, ctopo, cbuf, n_body)
         stick = np.full(n_body, -1.0)  # the body contacts' stick or slide: not decided yet
         for it in range(iterations):
             if sub == 0 and it == 0:
                 colour_sequence(seed, sequence)
             # collider contacts first, so that the springs carry their support through the sweep
-            for k in range(count):
-                i = touch[k]
-                nx, ny = planes[k, 0], planes[k, 1]
-                gap = x[i, 0] * nx + x[i, 1] * ny - planes[k, 2]
-                if inv_mass[i] == 0.0:
-                    continue
-                push = -gap if gap < 0.0 else 0.0
-                # tangential motion since the substep began (t = (-ny, nx)). Stick or slide
-                # is decided once, by the first sweep (the predicted motion's push is the
-                # substep's normal impulse, as in the collider rule); a stuck vertex has its
-                # tangential motion undone in every sweep, a sliding one is held back by the
-                # dynamic coefficient times each sweep's push
-                # (relative to the collider's surface, which moved by planes[k, 5:7])
-                slide = (x_prev[i, 0] + planes[k, 5] - x[i, 0]) * -ny + (x_prev[i, 1] + planes[k, 6] - x[i, 1]) * nx
-                if planes[k, 7] < 0.0:
-                    planes[k, 7] = 1.0 if abs(slide) <= planes[k, 3] * push else 0.0
-                if planes[k, 7] == 0.0:
-                    slide = min(abs(slide), planes[k, 4] * push) * (1.0 if slide > 0.0 else -1.0)
-                x[i, 0] += push * nx - slide * ny
-                x[i, 1] += push * ny + slide * nx
+            project_collider_contacts(x, x_prev, inv_mass, planes, touch, count)
             project_contacts(x, x_prev, inv_mass, ctopo, cbuf, n_body, stick)
-            for q in range(spring_order.shape[0]):
-                e = spring_order[q]
-                i = np.uint64(spring_i[e])
-                j = np.uint64(spring_j[e])
-                wi = inv_mass[i]
-                wj = inv_mass[j]
-                dx = x[j, 0] - x[i, 0]
-                dy = x[j, 1] - x[i, 1]
-                length = np.sqrt(dx * dx + dy * dy)
-                if length == 0.0:
-                    continue  # no direction to push along
-                nx = dx / length
-                ny = dy / length
-                kt = ks[e] * h2
-                dt = kd[e] * h
-                rate = ((x[j, 0] - x_prev[j, 0]) - (x[i, 0] - x_prev[i, 0])) * nx \
-                    + ((x[j, 1] - x_prev[j, 1]) - (x[i, 1] - x_prev[i, 1])) * ny
-                dlam = -(kt * (length - rest[e]) + lam[e] + dt * rate) / ((kt + dt) * (wi + wj) + 1.0)
-                lam[e] += dlam
-                x[i, 0] -= wi * nx * dlam
-                x[i, 1] -= wi * ny * dlam
-                x[j, 0] += wj * nx * dlam
-                x[j, 1] += wj * ny * dlam
+            project_springs(x, x_prev, inv_mass, spring_i, spring_j, rest, ks, kd, spring_order, lam, h)
             project_elements(x, x_prev, inv_mass, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind,
                              elem_order, elem_starts, sequence, elem_lam_acc, h)
-        bad = finish_position_step(x, v, x_prev, rects, hits, cscr.status[ST_STAMP] + 1, h, vmax2)
+        bad = finish_position_step(x, v, x_prev, rects, hits, cscr.status.stamp[0] + 1, h, vmax2)
         if bad:
             return bad
         # cscr.xp still holds x_prev (detect_contacts only read it): no second gather_start
-        push_edges_off_corners(x, v, inv_mass, ctopo.ce_a, ctopo.ce_b, ctopo.cv_vertex, rects)
-        if contact_stage(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h) < 0:
+        if contact_epilogue(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h, True) < 0:
             return 0  # the contact buffer is too small; the world grows it and repeats the step
     return 0
 
 
 @register_integrator("xpbd")
-class XPBD:
+class XPBD(Integrator):
     """XPBD with substeps: compliance ``1 / stiffness``, damping ``kd`` along each spring.
 
     Unconditionally stable (a constraint projection cannot overshoot); a large stiff body
     needs many substeps to look as stiff as ``stiffness`` says (``world.substeps``).
 
-    Attributes
-    ----------
+    Options
+    -------
     iterations : int
-        Gauss-Seidel sweeps over the springs per substep (>= 1; default 1, as in "Small
-        Steps": more substeps beat more iterations).
+        Gauss-Seidel sweeps over the springs and elements per substep (in [1, 10000];
+        default 1, as in "Small Steps": more substeps beat more iterations).
 
     Examples
     --------
     >>> from deforma.physics.integrators import make_integrator
-    >>> make_integrator("xpbd").iterations
+    >>> make_integrator("xpbd").options["iterations"]
     1
     """
 
     name = "xpbd"
     unconditionally_stable = True
+    OPTIONS = (Option("iterations", 1, "int", low=1, high=10_000,
+                      doc="Gauss-Seidel sweeps per substep (more substeps beat more sweeps)"),)
 
-    def __init__(self):
-        self.iterations = 1
+    def __init__(self, **options):
+        super().__init__(**options)
         self._n = (-1, -1, -1)
         self._orders = (None,)  # (model, spring order, element order, where each colour starts)
-        self._sweeps = 0  # calls so far: seeds each substep's order of colours
 
-    def advance(self, model, state, inputs, h, substeps):
-        if isinstance(self.iterations, bool) or not isinstance(self.iterations, (int, np.integer)) \
-                or self.iterations < 1:
-            raise ValueError(f"iterations must be an integer >= 1, got {self.iterations!r}")
+    def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
         shape = (model.n_vertices, model.n_springs, model.n_elements)
         if self._n != shape:  # scratch kept between steps
             self._x_prev = np.empty((shape[0], 2))
@@ -369,19 +362,16 @@ class XPBD:
         if self._orders[0] is not model:  # a Model's springs and elements never change in place
             self._orders = (model, sweep_order(np.stack([model.spring_i, model.spring_j], axis=1), shape[0])[0],
                             *sweep_order(model.elem, shape[0]))
-        gx, gy = inputs.gravity
-        bad = xpbd_substeps(state.x, state.v, state.x_start, state.v_start, self._x_prev, self._lam,
-                             self._planes, self._touch,
-                             model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
-                             model.spring_stiffness, model.spring_damping, self._orders[1], model.elem,
-                             model.elem_b, model.elem_area, model.elem_mu, model.elem_lambda, model.elem_damping,
-                             model.elem_kind, self._orders[2], self._orders[3], self._sweeps, self._elem_lam,
-                             float(gx), float(gy),
-                             1.0 / (1.0 + float(h) * inputs.air_drag),
-                             inputs.grab_slot, inputs.grab_pull, inputs.rects, inputs.hits, model.contact,
-                             inputs.contact_scratch, inputs.contacts, float(h), int(substeps),
-                             int(self.iterations), float(inputs.max_speed) ** 2)
-        status = inputs.contact_scratch.status
-        if not (status[ST_NEEDED] or status[ST_PAIRS_NEEDED]):  # a step the world repeats keeps its seed
-            self._sweeps += 1
-        return bad
+        gx, gy = model.gravity
+        # the colours' order is drawn from the step's index: a step repeated (after the
+        # contact buffer grew) draws the same
+        bad = xpbd_substeps(state_out.x, state_out.v, self._x_prev, self._lam, self._planes, self._touch,
+                            model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
+                            model.spring_stiffness, model.spring_damping, self._orders[1], model.elem,
+                            model.elem_b, model.elem_area, model.elem_mu, model.elem_lambda, model.elem_damping,
+                            model.elem_kind, self._orders[2], self._orders[3], int(control.step), self._elem_lam,
+                            float(gx), float(gy), 1.0 / (1.0 + float(h) * model.air_drag), control.force,
+                            control.has_force, control.grab_slot, control.grab_pull, control.colliders, contacts.hits,
+                            model.contact, contacts.scratch, contacts.buffer, float(h), int(substeps),
+                            int(self._options["iterations"]), float(max_speed) ** 2)
+        return StepReport(int(bad), contacts.needed == (0, 0))

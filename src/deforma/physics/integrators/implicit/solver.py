@@ -70,20 +70,16 @@ Units: m, m/s, kg, N/m, N*s/m, s.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
 from ...colliders.geometry import advance_colliders
-from ...colliders.response import contact_planes, push_edges_off_corners
-from ...contact.broad_phase import gather_start
-from ...contact.contacts import ST_STAMP
-from ...contact.narrow_phase import detect_contacts
-from ...contact.response import hold_start_distance
-from ...contact.stage import contact_stage
 from ...elements.triangles import implicit_element_rhs
-from ..base import finish_position_step, register_integrator
+from ..base import (Integrator, Option, StepReport, contact_epilogue, finish_position_step, held_contacts,
+                    register_integrator)
 from .assembly import element_weights, system_matrix, with_entries
 from .updated_factor import UpdatedFactor
 
@@ -296,44 +292,47 @@ def _row_items(t) -> np.ndarray:
 
 
 @register_integrator("implicit-euler")
-class ImplicitEuler:
+class ImplicitEuler(Integrator):
     """Backward Euler with prefactored local/global iterations (Liu et al. 2013).
 
     Unconditionally stable: any ``h`` and stiffness give a finite, bounded answer, at the
     price of numerical damping (see the module docstring and ``docs/integrators.md``).
 
-    Attributes
-    ----------
+    Options
+    -------
     iterations : int
-        Local/global iterations per substep (>= 1). Each costs one pass over the springs and
-        one pair of triangular solves. Three keep a 1e5-vertex step at 1/60 s within 0.1 s
-        here (0.071 s; four took 0.089 s) and measured within 0.3% of four in the resting
-        height of a 1e4-vertex body (``benchmarks/bench_integrators.py --sag``).
+        Local/global iterations per substep (in [1, 10000]; default 3). Each costs one pass
+        over the springs and elements and one pair of triangular solves. Three keep a
+        1e5-vertex step at 1/60 s within 0.1 s here (0.071 s; four took 0.089 s) and
+        measured within 0.3% of four in the resting height of a 1e4-vertex body
+        (``benchmarks/bench_integrators.py --sag``).
     contact_weight : float
         Weight of a contact (collider or body) in the solve, in multiples of the diagonal
-        entry of its vertex (default 10; in (0, 1e12); larger holds contacts tighter in
+        entry of its vertex (in (0, 1e12); default 10; larger holds contacts tighter in
         few iterations).
-    factorizations : int
-        How many times the matrix was factored: at the start, and after changes of the
-        parameters, ``h`` or ``contact_weight``, and after small changes (tears, contact
-        sets, grabs) have added up (:mod:`~deforma.physics.integrators.implicit.updated_factor`).
-    updates : int
-        How many times a small change of the matrix was taken into the factor by a low-rank
-        correction instead of factoring again.
+
+    :meth:`stats` (``world.integrator_stats``) counts ``factorizations``, how many times the
+    matrix was factored (at the start, and after changes of the parameters, ``h`` or
+    ``contact_weight``, and after small changes, tears, contact sets and grabs, have added
+    up: :mod:`~deforma.physics.integrators.implicit.updated_factor`), and ``updates``, how
+    many times a small change of the matrix was taken into the factor by a low-rank
+    correction instead of factoring again.
 
     Examples
     --------
     >>> from deforma.physics.integrators import make_integrator
-    >>> make_integrator("implicit-euler").iterations
-    3
+    >>> make_integrator("implicit-euler", {"iterations": 5}).options
+    {'iterations': 5, 'contact_weight': 10.0}
     """
 
     name = "implicit-euler"
     unconditionally_stable = True
+    OPTIONS = (Option("iterations", 3, "int", low=1, high=10_000, doc="local/global iterations per substep"),
+               Option("contact_weight", 10.0, "float", low=0.0, high=1e12,
+                      doc="a contact's weight in the solve, in multiples of its vertex's diagonal entry"))
 
-    def __init__(self):
-        self.iterations = 3
-        self.contact_weight = 10.0
+    def __init__(self, **options):
+        super().__init__(**options)
         self.factorizations = 0
         self.updates = 0
         self._key = None
@@ -344,17 +343,21 @@ class ImplicitEuler:
         self._dirty = None  # the vertices whose contact-free columns may differ from the reference's (None: any)
         self._scratch_n = -1
 
-    def _base_if_needed(self, model, inputs, h):
+    def stats(self) -> dict:
+        """``{"factorizations": ..., "updates": ...}`` so far (see the class docstring)."""
+        return {"factorizations": self.factorizations, "updates": self.updates}
+
+    def _base_if_needed(self, model, control, h):
         # Everything the contact-free matrix depends on: the Model's parameters through its
         # version counter (bumped by every in-place change), the grabbed vertices and their
         # strengths (compared by value: moving a grab's target changes only the right side),
         # h and the air drag.
         old = self._key
         if old is not None and old[0] is model and old[1] == model.version and old[2] == h \
-                and old[5] == inputs.air_drag and np.array_equal(old[3], inputs.grab_slot) \
-                and np.array_equal(old[4], inputs.grab_pull[:, 0]):
+                and old[5] == model.air_drag and np.array_equal(old[3], control.grab_slot) \
+                and np.array_equal(old[4], control.grab_pull[:, 0]):
             return
-        key = (model, model.version, h, inputs.grab_slot.copy(), inputs.grab_pull[:, 0].copy(), inputs.air_drag)
+        key = (model, model.version, h, control.grab_slot.copy(), control.grab_pull[:, 0].copy(), model.air_drag)
         # The factor stays usable through a change of the matrix when each vertex's row in its
         # reference matrix is known: the same Model, or one a tear rebuilt from it (each vertex
         # then comes from a vertex of the old one). Anything else factors again.
@@ -368,9 +371,9 @@ class ImplicitEuler:
         # Air drag -c v joins backward Euler as (1 + h c) M (x - y) / h^2 = f(x) + M g with
         # y = x_n + (h v_n + h^2 g) / (1 + h c): the heavier mass is in the matrix, so that
         # forces (not only gravity) balance at rest as they do without drag.
-        mass = model.vertex_mass * (1.0 + h * inputs.air_drag)
+        mass = model.vertex_mass * (1.0 + h * model.air_drag)
         patch = None
-        if torn is not None and self._patchable(old, model, torn, inputs, h):
+        if torn is not None and self._patchable(old, model, torn, control, h):
             # a tear: only the columns of the vertices it touched are assembled again
             source = torn[1]
             fresh = torn[2] | (mass != self._mass[source]) | (model.pinned != old[0].pinned[source])
@@ -379,7 +382,7 @@ class ImplicitEuler:
         self._dirty = self._dirty[patch[2]] | patch[3] if patch is not None and self._dirty is not None else None
         self._mass = mass
         self._we = element_weights(model, h)
-        self._a, self._diag = system_matrix(model, inputs.grab_slot, inputs.grab_pull, h, mass, patch, self._we)
+        self._a, self._diag = system_matrix(model, control.grab_slot, control.grab_pull, h, mass, patch, self._we)
         self._rows = None  # its rows, for free_estimate, made when a contact first needs them
         self._key = key
         self._wk = h * h * model.spring_stiffness
@@ -388,16 +391,16 @@ class ImplicitEuler:
         self._touching = None  # the contact terms must be added again
 
     @staticmethod
-    def _patchable(old, model, torn, inputs, h) -> bool:
+    def _patchable(old, model, torn, control, h) -> bool:
         """Whether the matrix of ``old``'s Model (the key it was built for) is that of the torn
         ``model`` but for the vertices the tear touched: neither Model changed in place since
         (a parameter, plastic flow; the new Model took over the old one's rest shape), the same
         ``h``, air drag and grabs."""
         was = old[0]
-        if old[1] != was.version or torn[3] != model.version or old[2] != h or old[5] != inputs.air_drag:
+        if old[1] != was.version or torn[3] != model.version or old[2] != h or old[5] != model.air_drag:
             return False
         source = torn[1]
-        return np.array_equal(old[3][source], inputs.grab_slot) and np.array_equal(old[4], inputs.grab_pull[:, 0])
+        return np.array_equal(old[3][source], control.grab_slot) and np.array_equal(old[4], control.grab_pull[:, 0])
 
     def _matrix_if_changed(self, model, touching, triples, s):
         """The matrix with this contact set, when it differs from the one the factor solves
@@ -406,7 +409,8 @@ class ImplicitEuler:
         # contacts their vertex-to-edge-point springs: a new set changes the matrix. A body
         # contact keeps the edge parameter s it had when the matrix was built (it is in the
         # matrix), so a resting heap, whose s only jitters, keeps its factor.
-        if self._touching is not None and self._weight_used == self.contact_weight \
+        weight = self._options["contact_weight"]
+        if self._touching is not None and self._weight_used == weight \
                 and np.array_equal(self._touching, touching) and np.array_equal(self._triples, triples):
             return None
         s = s.copy()
@@ -416,12 +420,12 @@ class ImplicitEuler:
             # and new s for all of them made each change touch every pair's rows)
             _, new, old = np.intersect1d(_row_items(triples), _row_items(self._triples), return_indices=True)
             s[new] = self._s[old]
-        self._weight_used = self.contact_weight
+        self._weight_used = weight
         self._touching = touching.copy()
         self._triples = triples.copy()
         self._s = s
-        self._contact_weight = self.contact_weight * self._diag[touching]
-        self._pair_weight = self.contact_weight * self._diag[triples[:, 0]]
+        self._contact_weight = weight * self._diag[touching]
+        self._pair_weight = weight * self._diag[triples[:, 0]]
         a = self._a
         if len(touching) or len(triples):
             co = np.stack([np.ones_like(s), s - 1.0, -s], axis=1)  # D's coefficients: sum 0
@@ -457,13 +461,7 @@ class ImplicitEuler:
         self.factorizations += 1
         return self._factor.solve(b)
 
-    def advance(self, model, state, inputs, h, substeps):
-        if isinstance(self.iterations, bool) or not isinstance(self.iterations, (int, np.integer)) \
-                or self.iterations < 1:
-            raise ValueError(f"iterations must be an integer >= 1, got {self.iterations!r}")
-        if isinstance(self.contact_weight, bool) or not isinstance(self.contact_weight, (int, float, np.number)) \
-                or not 0.0 < self.contact_weight < 1e12:
-            raise ValueError(f"contact_weight must be a number in (0, 1e12), got {self.contact_weight!r}")
+    def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
         n = model.n_vertices
         if self._scratch_n != n:
             self._x_n = np.empty((n, 2))
@@ -473,17 +471,17 @@ class ImplicitEuler:
             self._z = np.empty((n, 2))
             self._touch = np.empty(n, np.int32)
             self._scratch_n = n
-        self._base_if_needed(model, inputs, h)
-        x, v = state.x, state.v
+        self._base_if_needed(model, control, h)
+        x, v = state_out.x, state_out.v
         x_n, y, b = self._x_n, self._y, self._b
-        gx, gy = inputs.gravity
+        gx, gy = model.gravity
         h2 = h * h
-        vmax2 = float(inputs.max_speed) ** 2
-        np.copyto(state.x_start, x)
-        np.copyto(state.v_start, v)
-        keep = 1.0 / (1.0 + h * inputs.air_drag)
+        vmax2 = float(max_speed) ** 2
+        keep = 1.0 / (1.0 + h * model.air_drag)
+        rects, hits, scr, topo, buf = control.colliders, contacts.hits, contacts.scratch, model.contact, contacts.buffer
+        iterations = self._options["iterations"]
         for _ in range(substeps):
-            advance_colliders(inputs.rects, h)  # moving colliders to where they are at the end of the substep
+            advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
             np.copyto(x_n, x)
             if keep != 1.0:  # air drag: the prediction's share here, the mass's in the matrix (see _base_if_needed)
                 v *= keep
@@ -491,25 +489,23 @@ class ImplicitEuler:
             y += x
             y[:, 0] += h2 * keep * gx  # so that free motion gives (v + h g) / (1 + h air_drag), as the
             y[:, 1] += h2 * keep * gy  # other integrators do
+            if control.has_force:
+                y += (h2 * keep) * control.force * model.vertex_inv_mass[:, None]
             # x starts at x_n: the first iteration is then backward Euler linearised at the
             # start of the substep (Baraff & Witkin's one Newton step, with the directions
             # of x_n). Starting at the prediction y measured worse on impacts: y can already
             # have a row of vertices pushed through the next, and the iteration keeps it.
-            count = contact_planes(x_n, y, inputs.rects, self._planes, self._touch, float(h))
-            scr, topo, buf = inputs.contact_scratch, model.contact, inputs.contacts
-            gather_start(x_n, topo, scr)
-            n_body = detect_contacts(y, topo, scr, buf)  # of the predicted motion
+            count, n_body = held_contacts(x_n, y, rects, self._planes, self._touch, float(h), topo, scr, buf)
             if n_body < 0:
-                return 0  # the contact buffer is too small; the world grows it and repeats the step
-            hold_start_distance(x_n, topo, buf, n_body)
+                return StepReport(0, False)  # the contact buffer is too small; the world grows it and repeats
             cv = topo.cv_vertex
             edge = buf.edge[:n_body]
             triples = np.stack([cv[buf.vertex[:n_body]], cv[topo.ce_a[edge]], cv[topo.ce_b[edge]]], axis=1)
             changed = self._matrix_if_changed(model, self._touch[:count], triples, buf.s[:n_body])
             self._listed = np.concatenate([self._touch[:count], triples.ravel()])  # the vertices the contacts read
-            for it in range(self.iterations):
+            for it in range(iterations):
                 implicit_rhs(x, x_n, y, self._mass, model.spring_i, model.spring_j, model.spring_rest_length,
-                             self._wk, self._wd, inputs.grab_slot, inputs.grab_pull, h2, b)
+                             self._wk, self._wd, control.grab_slot, control.grab_pull, h2, b)
                 if len(model.elem):
                     implicit_element_rhs(x, x_n, model.elem, model.elem_b, model.elem_area, model.elem_mu,
                                          model.elem_lambda, model.elem_damping, model.elem_kind, self._we, h, b)
@@ -532,14 +528,11 @@ class ImplicitEuler:
                     changed = None
                 else:
                     x[...] = self._factor.solve(b)
-            bad = finish_position_step(x, v, x_n, inputs.rects, inputs.hits, scr.status[ST_STAMP] + 1, float(h), vmax2)
+            bad = finish_position_step(x, v, x_n, rects, hits, scr.status.stamp[0] + 1, float(h), vmax2)
             if bad:
-                return bad
-            # scr.xp still holds x_n (detect_contacts only read it): no second gather_start
-            topo = model.contact
-            push_edges_off_corners(x, v, model.vertex_inv_mass, topo.ce_a, topo.ce_b, topo.cv_vertex, inputs.rects)
-            # the stage's impulses change velocities only (contact_stage says why)
-            if contact_stage(x, v, model.vertex_inv_mass, model.contact, scr, inputs.contacts, inputs.rects,
-                             inputs.hits, float(h), False) < 0:
-                return 0  # the contact buffer is too small; the world grows it and repeats the step
-        return 0
+                return StepReport(int(bad), True)
+            # scr.xp still holds x_n (detect_contacts only read it): no second gather_start; the
+            # stage's impulses change velocities only (contact_stage says why)
+            if contact_epilogue(x, v, model.vertex_inv_mass, topo, scr, buf, rects, hits, float(h), False) < 0:
+                return StepReport(0, False)  # the contact buffer is too small; the world grows it and repeats
+        return StepReport()
