@@ -218,26 +218,12 @@ def _check_states_path(path: str) -> None:
 
 def _check_folder(path) -> None:
     """The folder ``path`` goes into exists and is writable, checked before any work."""
-    from .render.video import check_folder
+    from .files import check_folder
 
     try:
         check_folder(path, Path(path).parent)
     except ValueError as e:
         raise CliError(str(e)) from None
-
-
-def _write_atomic(path: Path, write) -> None:
-    """Call ``write(file)`` on a temporary file beside ``path``, then rename it into place."""
-    from .render.video import publish, temp_beside
-
-    tmp = temp_beside(path)
-    try:
-        with open(tmp, "wb") as f:
-            write(f)
-        publish(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def _collider_arrays(colliders, poses) -> dict:
@@ -315,7 +301,9 @@ def _save_states(path: str, world, scene, times, frames, poses, *, kept_in=None)
     arrays.update(_collider_arrays(world.colliders, poses))
     base = Path(path).parent if kept_in is None else Path(kept_in)
     arrays["scene_toml"] = np.array(tomli_w.dumps(scene_to_dict(scene, base_dir=base.resolve())))
-    _write_atomic(Path(path), lambda f: np.savez_compressed(f, **arrays))
+    from .files import write_atomic
+
+    write_atomic(path, lambda f: np.savez_compressed(f, **arrays))
 
 
 def _progress(total: int, enabled: bool, label: str):
@@ -570,7 +558,9 @@ def cmd_mesh(a) -> int:
     caption = (f"{what}: {len(m.vertices)} points, {len(m.triangles)} triangles, "
                f"min angle {min_angle:.1f}\N{DEGREE SIGN}")
     img = _mesh_picture(m, picture, a.width, caption)
-    _write_atomic(out, lambda f: img.save(f, format="PNG"))
+    from .files import write_atomic
+
+    write_atomic(out, lambda f: img.save(f, format="PNG"))
     print(f"{caption} (meshed in {seconds:.2f} s) -> {a.output}")
     return 0
 

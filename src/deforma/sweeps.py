@@ -706,9 +706,10 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     if video is not None:
         (outdir / VIDEOS_FOLDER).mkdir(exist_ok=True)
     started = connect(workers=workers, address=address)
+    import pyarrow.parquet as pq
     import ray
 
-    from .cli import _write_atomic
+    from .files import write_atomic
 
     remote = ray.remote(num_cpus=1, max_retries=0)(_worker_run)
     kept = str((outdir / STATES_FOLDER).resolve()) if states else False  # where the NPZs go
@@ -731,14 +732,14 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
             states_path = None
             if row.get("states") is not None:
                 target = outdir / STATES_FOLDER / f"{run.run_id}.npz"
-                _write_atomic(target, lambda f, data=row["states"]: f.write(data))
+                write_atomic(target, lambda f, data=row["states"]: f.write(data))
                 states_path = f"{STATES_FOLDER}/{run.run_id}.npz"
             video_path = None
             if row.get("video") is not None:
                 video_path = f"{VIDEOS_FOLDER}/{run.run_id}.{video}"
-                _write_atomic(outdir / video_path, lambda f, data=row["video"]: f.write(data))
+                write_atomic(outdir / video_path, lambda f, data=row["video"]: f.write(data))
             table = _row_table(spec, run, row, states_path, video_path)
-            _write_part(outdir / RESULTS_NAME / f"part-{run.run_id}.parquet", table, _write_atomic)
+            write_atomic(outdir / RESULTS_NAME / f"part-{run.run_id}.parquet", lambda f: pq.write_table(table, f))
             counts[row["status"]] += 1
             finished += 1
             if progress is not None:
@@ -779,10 +780,4 @@ def _check_video(video, size):
         raise SweepError(f"video_size: expected (width, height) in pixels, width in [16, 7680] and height in "
                          f"[16, 4320], got {size!r}")
     return video
-
-
-def _write_part(path: Path, table, write_atomic) -> None:
-    import pyarrow.parquet as pq
-
-    write_atomic(path, lambda f: pq.write_table(table, f))
 

@@ -151,18 +151,13 @@ class Animation:
         ValueError
             An unknown suffix or a folder that does not exist.
         """
-        from .video import check_output, open_writer, publish, temp_beside
+        from ..files import write_atomic
+        from .video import check_output, open_writer
 
         kind = check_output(path)
         target = Path(path)
         if kind == self.format:
-            tmp = temp_beside(target)
-            try:
-                tmp.write_bytes(self.data)
-                publish(tmp, target)
-            except BaseException:
-                tmp.unlink(missing_ok=True)
-                raise
+            write_atomic(target, lambda f: f.write(self.data))
             return target
         with open_writer(path, fps=self.fps) as writer:
             for frame in self.frames():
