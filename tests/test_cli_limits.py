@@ -206,7 +206,7 @@ def test_a_recent_temporary_file_of_a_dead_process_is_kept(tmp_path):
     # last written after this run began: another machine's run may be writing it into a shared folder
     import time
 
-    from deforma.render.video import remove_stale_partials
+    from deforma.files import remove_stale_partials
 
     f = tmp_path / f".out.{_dead_pid()}.abcd1234.partial.mp4"
     f.write_bytes(b"")

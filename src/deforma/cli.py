@@ -218,104 +218,12 @@ def _check_states_path(path: str) -> None:
 
 def _check_folder(path) -> None:
     """The folder ``path`` goes into exists and is writable, checked before any work."""
-    from .render.video import check_folder
+    from .files import check_folder
 
     try:
         check_folder(path, Path(path).parent)
     except ValueError as e:
         raise CliError(str(e)) from None
-
-
-def _write_atomic(path: Path, write) -> None:
-    """Call ``write(file)`` on a temporary file beside ``path``, then rename it into place."""
-    from .render.video import publish, temp_beside
-
-    tmp = temp_beside(path)
-    try:
-        with open(tmp, "wb") as f:
-            write(f)
-        publish(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-def _collider_arrays(colliders, poses) -> dict:
-    """The ``--states`` arrays that describe the colliders (docs/cli.md): every shape, its pose
-    per frame (``poses``: per frame, ``(cx, cy, angle)`` per collider) and at the end."""
-    from .physics import Circle, Polygon, Rect, Segment
-
-    kinds = {Rect: "rect", Circle: "circle", Polygon: "polygon", Segment: "segment"}
-    rows, outlines, holes = [], [], {}
-    for j, c in enumerate(colliders):
-        # w, h: a rect's size; for the other shapes their box in their own frame, what a reader
-        # that draws every row as a rectangle (as before there were other shapes) draws instead
-        if isinstance(c, Rect):
-            w, h = c.size
-        elif isinstance(c, Circle):
-            w = h = 2 * c.radius
-        elif isinstance(c, Segment):
-            w, h = c.length + 2 * c.radius, 2 * c.radius
-        else:
-            t = np.radians(c.angle)
-            local = (np.asarray(c.points) - np.asarray(c.center)) @ np.array([[np.cos(t), -np.sin(t)],
-                                                                               [np.sin(t), np.cos(t)]])
-            w, h = np.ptp(local, axis=0)
-        rows.append([*c.center, w, h, c.angle])
-        outlines.append(np.asarray(c.outline(), dtype=np.float64))
-        if isinstance(c, Polygon) and c.holes:
-            holes[f"collider{j}_holes"] = _padded(c.holes)
-    n = len(colliders)
-    return {
-        "colliders": np.array(rows, dtype=np.float64).reshape(-1, 5),
-        "collider_kind": np.array([kinds.get(type(c), type(c).__name__.lower()) for c in colliders], dtype="U8"),
-        "collider_radius": np.array([getattr(c, "radius", np.nan) for c in colliders], dtype=np.float64),
-        "collider_velocity": np.array([c.velocity for c in colliders], dtype=np.float64).reshape(-1, 2),
-        "collider_angular_velocity": np.array([c.angular_velocity for c in colliders], dtype=np.float64),
-        "collider_outline": _padded(outlines) if outlines else np.zeros((0, 0, 2)),
-        "collider_pose": np.array(poses, dtype=np.float64).reshape(len(poses), n, 3),
-        **holes,
-    }
-
-
-def _padded(loops) -> np.ndarray:
-    """(L, K, 2) from loops of different lengths, NaN after each loop's last point."""
-    out = np.full((len(loops), max(len(p) for p in loops), 2), np.nan)
-    for k, p in enumerate(loops):
-        out[k, :len(p)] = p
-    return out
-
-
-def _save_states(path: str, world, scene, times, frames, poses, *, kept_in=None) -> None:
-    """Write ``deforma run --states``' NPZ to ``path``. The scene's texture files are named
-    relative to ``kept_in``, the folder the file will be read from (default: its own)."""
-    import tomli_w
-
-    from .scene.schema import scene_to_dict
-
-    arrays = {"time": np.asarray(times), "fps": np.float64(scene.run.fps), "dt": np.float64(world.dt)}
-    for i, b in enumerate(world.bodies):
-        counts = [len(f[i]) for f in frames]
-        if min(counts) == max(counts):
-            arrays[f"body{i}_positions"] = np.stack([f[i] for f in frames])
-        else:
-            # a body that tore: a tear keeps the vertex numbers and appends the copies, so every
-            # frame is a prefix of the final numbering; vertices not made yet are NaN
-            pos = np.full((len(frames), max(counts), 2), np.nan)
-            for k, f in enumerate(frames):
-                pos[k, :counts[k]] = f[i]
-            arrays[f"body{i}_positions"] = pos
-            arrays[f"body{i}_vertex_count"] = np.asarray(counts)
-        arrays[f"body{i}_triangles"] = np.asarray(b.triangles)
-        arrays[f"body{i}_springs"] = np.asarray(b.springs)
-        arrays[f"body{i}_rest"] = np.asarray(b.topology.rest_positions)
-        uv = getattr(b.mesh, "uv", None)
-        if uv is not None:
-            arrays[f"body{i}_uv"] = np.asarray(uv)
-    arrays.update(_collider_arrays(world.colliders, poses))
-    base = Path(path).parent if kept_in is None else Path(kept_in)
-    arrays["scene_toml"] = np.array(tomli_w.dumps(scene_to_dict(scene, base_dir=base.resolve())))
-    _write_atomic(Path(path), lambda f: np.savez_compressed(f, **arrays))
 
 
 def _progress(total: int, enabled: bool, label: str):
@@ -351,6 +259,7 @@ def _run_scene(a, watch, shown: dict) -> int:
 
     from . import scene as scenes
     from .physics import SimulationUnstable
+    from .scene.playback import Playback, frame_count
 
     scene = scenes.load(a.scene)  # SceneError is a one-line ValueError
     if a.springs:
@@ -366,7 +275,7 @@ def _run_scene(a, watch, shown: dict) -> int:
     if a.states:
         _check_states_path(a.states)
     world = scene.build()
-    n_frames = max(1, int(round(seconds * fps)))
+    n_frames = frame_count(seconds, fps)
     from .physics.diagnostics import xpbd_advice
 
     advice = xpbd_advice(world)
@@ -385,8 +294,6 @@ def _run_scene(a, watch, shown: dict) -> int:
         if a.wireframe:
             view.wireframe = True
 
-    script = scenes.Script(scene, world)  # its [[event]] explosions and [[pull]] grabs
-    times, frames, poses = [], [], []
     label = Path(a.scene).stem if a.scene.endswith(".toml") else a.scene
     # tqdm draws only on a terminal; elsewhere (a pipe, a log, --quiet) it is not even imported:
     # its import is 65 ms of the start-up to the first frame (issue 18)
@@ -398,21 +305,15 @@ def _run_scene(a, watch, shown: dict) -> int:
         if a.output:
             # inside the try: from here on an interrupt removes the temporary file
             writer = open_writer(a.output, fps=fps)
-        for k in range(n_frames):
-            t_frame = k / fps
-            script.advance(t_frame)  # step until the world's clock reaches this frame
-            if writer is not None:
-                writer.write(view.draw())
-            if a.states:
-                times.append(world.time)
-                frames.append([b.positions.copy() for b in world.bodies])
-                poses.append([(*c.center, c.angle) for c in world.colliders])
+        # the scene's [[event]] explosions and [[pull]] grabs, frame by frame
+        playback = Playback(scene, world, fps=fps, view=view, writer=writer, record=bool(a.states))
+        for _ in playback.frames(n_frames):
             if bar is not None:
                 bar.update(1)
         if writer is not None:
             writer.close()
         if a.states:
-            _save_states(a.states, world, scene, times, frames, poses)
+            playback.recording.save(a.states)
     except SimulationUnstable as e:
         raise CliError(f"{a.scene}: simulation became unstable at t = {world.time:.3f} s: {e}; "
                        f"nothing was written", EXIT_UNSTABLE) from None
@@ -570,7 +471,9 @@ def cmd_mesh(a) -> int:
     caption = (f"{what}: {len(m.vertices)} points, {len(m.triangles)} triangles, "
                f"min angle {min_angle:.1f}\N{DEGREE SIGN}")
     img = _mesh_picture(m, picture, a.width, caption)
-    _write_atomic(out, lambda f: img.save(f, format="PNG"))
+    from .files import write_atomic
+
+    write_atomic(out, lambda f: img.save(f, format="PNG"))
     print(f"{caption} (meshed in {seconds:.2f} s) -> {a.output}")
     return 0
 

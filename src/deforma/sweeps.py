@@ -396,7 +396,7 @@ def simulate(scene, *, states=False, video: str | None = None, video_size=VIDEO_
     import numpy as np
 
     from .physics import SimulationUnstable
-    from .scene import Script
+    from .scene.playback import Playback, frame_count
 
     t0 = time.perf_counter()
     row = {"status": "ok", "message": "", "hint": "", "steps": 0, "simulated_s": 0.0, "final_energy_j": math.nan,
@@ -406,36 +406,28 @@ def simulate(scene, *, states=False, video: str | None = None, video_size=VIDEO_
     try:
         world = scene.build()
         fps = scene.run.fps
-        n_frames = max(1, int(round(scene.run.seconds * fps)))
         if video is not None:
             from .render import open_writer
 
             view = _video_view(world, video_size)  # before the simulation: without GL, fail at once
             folder = Path(tempfile.mkdtemp(prefix="deforma-sweep-"))
             writer = open_writer(folder / f"video.{video}", fps=fps)
-        script = Script(scene, world)
-        times, frames, poses = [], [], []
+        playback = Playback(scene, world, fps=fps, view=view, writer=writer, record=bool(states))
         strain = 0.0
         resting_since = None  # the first frame of the current run of frames at rest
-        for k in range(n_frames + 1):  # frame k at k / fps, the last one at the end of the run
-            script.advance(k / fps)
+        # frame k at k / fps, the last one at the end of the run
+        for _ in playback.frames(frame_count(scene.run.seconds, fps) + 1):
             strain = max(strain, _largest_spring_strain(world))
             if _largest_speed(world) < REST_SPEED:
                 resting_since = world.time if resting_since is None else resting_since
             else:
                 resting_since = None
-            if states:
-                times.append(world.time)
-                frames.append([b.positions.copy() for b in world.bodies])
-                poses.append([(*c.center, c.angle) for c in world.colliders])
-            if writer is not None:
-                writer.write(view.draw())
         row["max_spring_strain"] = strain
         row["time_to_rest_s"] = math.nan if resting_since is None else float(resting_since)
         row["final_energy_j"] = float(world.energy().total)
         row["centroid"] = [[float(v) for v in np.mean(b.positions, axis=0)] for b in world.bodies]
         if states:
-            row["states"] = _states_bytes(world, scene, times, frames, poses, None if states is True else states)
+            row["states"] = playback.recording.to_bytes(kept_in=None if states is True else states)
         if writer is not None:
             writer.close()
             row["video"] = (folder / f"video.{video}").read_bytes()
@@ -457,21 +449,6 @@ def simulate(scene, *, states=False, video: str | None = None, video_size=VIDEO_
         row["simulated_s"] = float(world.time)
     row["wall_s"] = time.perf_counter() - t0
     return row
-
-
-def _states_bytes(world, scene, times, frames, poses, kept_in=None) -> bytes:
-    """The ``deforma run --states`` NPZ, written by the same function, as bytes (the worker may be
-    on another machine than the sweep's folder), its texture files named relative to
-    ``kept_in`` (default: the working folder), where the file will be read, not to the
-    temporary folder it is written in."""
-    import tempfile
-
-    from .cli import _save_states
-
-    with tempfile.TemporaryDirectory(prefix="deforma-sweep-") as folder:
-        path = Path(folder) / "states.npz"
-        _save_states(str(path), world, scene, times, frames, poses, kept_in=Path.cwd() if kept_in is None else kept_in)
-        return path.read_bytes()
 
 
 def _worker_run(scene, states, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
@@ -706,9 +683,10 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     if video is not None:
         (outdir / VIDEOS_FOLDER).mkdir(exist_ok=True)
     started = connect(workers=workers, address=address)
+    import pyarrow.parquet as pq
     import ray
 
-    from .cli import _write_atomic
+    from .files import write_atomic
 
     remote = ray.remote(num_cpus=1, max_retries=0)(_worker_run)
     kept = str((outdir / STATES_FOLDER).resolve()) if states else False  # where the NPZs go
@@ -731,14 +709,14 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
             states_path = None
             if row.get("states") is not None:
                 target = outdir / STATES_FOLDER / f"{run.run_id}.npz"
-                _write_atomic(target, lambda f, data=row["states"]: f.write(data))
+                write_atomic(target, lambda f, data=row["states"]: f.write(data))
                 states_path = f"{STATES_FOLDER}/{run.run_id}.npz"
             video_path = None
             if row.get("video") is not None:
                 video_path = f"{VIDEOS_FOLDER}/{run.run_id}.{video}"
-                _write_atomic(outdir / video_path, lambda f, data=row["video"]: f.write(data))
+                write_atomic(outdir / video_path, lambda f, data=row["video"]: f.write(data))
             table = _row_table(spec, run, row, states_path, video_path)
-            _write_part(outdir / RESULTS_NAME / f"part-{run.run_id}.parquet", table, _write_atomic)
+            write_atomic(outdir / RESULTS_NAME / f"part-{run.run_id}.parquet", lambda f: pq.write_table(table, f))
             counts[row["status"]] += 1
             finished += 1
             if progress is not None:
@@ -779,10 +757,4 @@ def _check_video(video, size):
         raise SweepError(f"video_size: expected (width, height) in pixels, width in [16, 7680] and height in "
                          f"[16, 4320], got {size!r}")
     return video
-
-
-def _write_part(path: Path, table, write_atomic) -> None:
-    import pyarrow.parquet as pq
-
-    write_atomic(path, lambda f: pq.write_table(table, f))
 

@@ -151,18 +151,13 @@ class Animation:
         ValueError
             An unknown suffix or a folder that does not exist.
         """
-        from .video import check_output, open_writer, publish, temp_beside
+        from ..files import write_atomic
+        from .video import check_output, open_writer
 
         kind = check_output(path)
         target = Path(path)
         if kind == self.format:
-            tmp = temp_beside(target)
-            try:
-                tmp.write_bytes(self.data)
-                publish(tmp, target)
-            except BaseException:
-                tmp.unlink(missing_ok=True)
-                raise
+            write_atomic(target, lambda f: f.write(self.data))
             return target
         with open_writer(path, fps=self.fps) as writer:
             for frame in self.frames():
@@ -318,6 +313,8 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
     >>> anim._repr_html_().startswith(("<video", "<img"))
     True
     """
+    from ..scene.playback import Playback, frame_count
+
     seconds = _number(seconds, "seconds", SECONDS_MAX, "s")
     fps = _number(fps, "fps", FPS_MAX, "frames/s")
     width, height = _check_size(size)
@@ -325,14 +322,13 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
     world, scene = _world_and_scene(scene_or_world)
     seconds = seconds if seconds is not None else scene.run.seconds
     fps = fps if fps is not None else scene.run.fps
-    n_frames = max(1, int(round(seconds * fps)))
+    n_frames = frame_count(seconds, fps)
     if n_frames > MAX_FRAMES:
         raise ValueError(f"seconds * fps = {seconds:g} s * {fps:g} frames/s gives {n_frames} frames; at most "
                          f"{MAX_FRAMES} are put into a notebook: pass fewer seconds or a lower fps")
     camera = _camera(world, scene)
     picture = _picture_size(width, height, camera)
 
-    from ..scene.script import Script
     from .renderer import Renderer
     from .video import open_writer
     from .world_view import WorldView
@@ -346,17 +342,13 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
     renderer = Renderer.headless(picture, samples=4)
     try:
         view = WorldView(renderer, world, replace(scene, camera=camera), overlay=bool(overlay), looks_from=looks)
-        # the scene's explosions and pulls that are still ahead of the world's clock
-        script = Script(scene, world)
-        start = world.time
         with tempfile.TemporaryDirectory(prefix="deforma-show-") as tmp:
             path = Path(tmp) / f"animation.{format}"
             with open_writer(path, fps=fps) as writer:
-                for k in range(n_frames):
-                    script.advance(start + k / fps)  # step until the world's clock reaches this frame
-                    frame = view.draw()
-                    writer.write(frame)
+                # the scene's explosions and pulls that are still ahead of the world's clock
+                playback = Playback(scene, world, fps=fps, view=view, writer=writer)
+                playback.play(n_frames)
             data = path.read_bytes()
     finally:
         renderer.release()
-    return Animation(data, format=format, fps=fps, size=picture, n_frames=n_frames, last_frame=frame)
+    return Animation(data, format=format, fps=fps, size=picture, n_frames=n_frames, last_frame=playback.last_frame)

@@ -4,6 +4,13 @@ A scene holds everything needed to reproduce a run: the bodies and how their mes
 made, the physics parameters, the colliders, the camera and how long to run. See
 ``docs/scenes.md`` for every key.
 
+The modules, each importing only ones listed before it: ``assets`` (built-in scenes and
+pictures, references to them), ``tables`` (the file's tables as frozen dataclasses),
+``construct`` (a World from a Scene), ``schema`` (the :class:`Scene`, read from TOML and written
+back), ``build`` (load a scene, read a world's scene back, save it), ``script`` (events and
+pulls), ``recording`` (a run's states as an NPZ) and ``playback`` (the frame loop of every
+headless runner).
+
 Examples
 --------
 >>> import deforma
@@ -14,11 +21,13 @@ True
 """
 
 from .assets import builtin_levels, builtin_patterns, builtin_scenes, builtin_textures, load_texture
-from .build import body_specs, build, collider_spec, load, load_scene, make_colliders, make_mesh, save_scene, scene_of
-from .schema import (BoxBody, CameraSettings, CircleCollider, ColliderSpec, Event, ImageBody, ImageCollider,
-                     InteractionSettings, MeshBody, PhysicsSettings, PolygonCollider, Pull, RectCollider, RunSettings,
-                     Scene, SceneError, SceneInfo, SegmentCollider, parse_scene, with_springs)
+from .build import body_specs, collider_spec, load, load_scene, save_scene, scene_of
+from .construct import build, make_colliders, make_mesh
+from .schema import Scene, parse_scene, with_springs
 from .script import Script
+from .tables import (BoxBody, CameraSettings, CircleCollider, ColliderSpec, Event, ImageBody, ImageCollider,
+                     InteractionSettings, MeshBody, PhysicsSettings, PolygonCollider, Pull, RectCollider, RunSettings,
+                     SceneError, SceneInfo, SegmentCollider)
 
 __all__ = [
     "BoxBody", "CameraSettings", "CircleCollider", "ColliderSpec", "Event", "ImageBody", "ImageCollider",

@@ -7,6 +7,7 @@ resolves scene references to them and caches the pictures a renderer draws.
 
 from __future__ import annotations
 
+import os
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -159,9 +160,16 @@ def texture_reference(value: str, *, base_dir) -> str:
     """What to write in a file for a resolved texture: the name, or a path relative to ``base_dir``."""
     if value in _drawn():
         return value
-    from .schema import relative_path
-
     return relative_path(value, Path(base_dir).resolve())
+
+
+def relative_path(target: str, base_dir: Path) -> str:
+    """``target`` relative to ``base_dir`` when that is short and sensible, else absolute."""
+    try:
+        rel = os.path.relpath(target, base_dir)
+    except ValueError:  # different drives on Windows
+        return target
+    return rel if rel.count("..") <= 3 else target
 
 
 def texture_file(value: str) -> Path:

@@ -1,9 +1,8 @@
-"""Scene <-> World: build a world from a scene, read the scene back from a (changed) world.
+"""Scene files and worlds: load a scene (:func:`load`, :func:`load_scene`), read the scene of a
+(changed) world back (:func:`scene_of`) and save it (:func:`save_scene`).
 
-The world does not know where its meshes came from, so the scene layer remembers it: each
-world built here is registered (weakly) with its scene and the spec of every body and
-collider. :func:`scene_of` then reads the world's current parameters and puts them together
-with what only the scene knows (mesh recipes, colours, camera, run length).
+The world itself is made by :func:`deforma.scene.construct.build` (``scene.build()``), which
+remembers what each world was built from; :func:`scene_of` reads that record.
 """
 
 from __future__ import annotations
@@ -12,34 +11,23 @@ import math
 import os
 import re
 import tempfile
-import weakref
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from .assets import picture_file, scene_path
-from .schema import (BEHAVIOUR_KEYS, MATERIAL_KEYS, BoxBody, CircleCollider, ColliderSpec, ImageBody, ImageCollider,
-                     InteractionSettings, MaterialKeyError, MeshBody, PhysicsSettings, PolygonCollider, Scene,
-                     SceneError, SegmentCollider, material_settings, parse_scene, scene_to_dict)
+from .assets import scene_path
+from .construct import box_mask, build, build_record, pin_mask
+from .schema import Scene, parse_scene, scene_to_dict
+from .tables import (BEHAVIOUR_KEYS, MATERIAL_KEYS, CircleCollider, ColliderSpec, InteractionSettings, MeshBody,
+                     PhysicsSettings, PolygonCollider, SceneError, SegmentCollider, material_settings)
 
 try:  # Python >= 3.11
     import tomllib
 except ImportError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["build", "collider_spec", "load", "load_scene", "make_colliders", "make_mesh", "pin_mask", "save_scene",
-           "scene_of"]
-
-
-@dataclass
-class _Record:
-    scene: Scene
-    bodies: list      # [(weakref to Body, body spec)]
-    colliders: list   # [(collider, its spec, (center, angle) as built)]; an image spec once per polygon
-
-
-_REGISTRY: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+__all__ = ["body_specs", "build", "collider_spec", "load", "load_scene", "save_scene", "scene_of"]
 
 
 #: Deepest nesting of arrays and tables a scene needs (a polygon collider's holes are
@@ -89,198 +77,6 @@ def load(name_or_path) -> Scene:
         raise SceneError(f"{shown}: values nested too deep (a scene needs at most {SCENE_MAX_NESTING} "
                          f"levels)") from None
     return replace(scene, path=str(path.resolve()))
-
-
-def make_mesh(spec):
-    """The :class:`deforma.mesh.Mesh` a body spec describes (before it is placed)."""
-    from .. import mesh as meshes
-
-    if isinstance(spec, BoxBody):
-        return meshes.box(spec.corners, detail=spec.detail, edges=spec.edges)
-    if isinstance(spec, ImageBody):
-        from .assets import builtin_patterns
-
-        if spec.source in builtin_patterns():
-            raise ValueError(f"source {spec.source!r} is a pattern, a picture with no shape to mesh: draw it with "
-                             f"texture = {spec.source!r} on a body; source takes one of "
-                             f"{', '.join(map(repr, meshes.image.BUILTIN_TEXTURES))} or an image file")
-        # a built-in name or an absolute path: from_image takes either
-        return meshes.from_image(spec.source, resolution=spec.resolution, detect_edges=spec.detect_edges,
-                                 edge_step=spec.edge_step, scale=spec.scale, background=spec.background,
-                                 threshold=spec.threshold)
-    if isinstance(spec, MeshBody):
-        return meshes.Mesh(np.array(spec.vertices, float), np.array(spec.triangles, np.int32),
-                           uv=None if spec.uv is None else np.array(spec.uv, float))
-    raise TypeError(f"not a body spec: {spec!r}")
-
-
-def _material(settings, *, world=False):
-    from ..physics import Material
-
-    if settings is None or (world and settings == {"model": "springs"}):
-        return None  # a body following the world; a world of the seed's plain springs
-    return Material(**settings)
-
-
-def _box_mask(box, positions) -> np.ndarray:
-    (x0, y0), (x1, y1) = box
-    x, y = positions[:, 0], positions[:, 1]
-    return (x >= min(x0, x1)) & (x <= max(x0, x1)) & (y >= min(y0, y1)) & (y <= max(y0, y1))
-
-
-def pin_mask(spec, positions) -> np.ndarray:
-    """(N,) bool: the vertices a body spec pins (its ``pin`` box and its ``pin_vertices``).
-
-    Parameters
-    ----------
-    spec : BoxBody, ImageBody or MeshBody
-    positions : (N, 2) array
-        The body's vertices where the scene places them, metres.
-
-    Raises
-    ------
-    ValueError
-        A ``pin`` box holding no vertex, or a ``pin_vertices`` index past the last vertex;
-        the message starts with the key (``pin: ...``).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> pin_mask(BoxBody(pin=((-1, -1), (0, 1))), np.array([[-0.5, 0.0], [0.5, 0.0]])).tolist()
-    [True, False]
-    """
-    x = np.asarray(positions, dtype=np.float64)
-    mask = np.zeros(len(x), bool)
-    if spec.pin is not None:
-        inside = _box_mask(spec.pin, x)
-        if not inside.any():
-            (x0, y0), (x1, y1) = spec.pin
-            lo, hi = x.min(axis=0), x.max(axis=0)
-            raise ValueError(f"pin: the box [[{x0:g}, {y0:g}], [{x1:g}, {y1:g}]] holds no vertex of the body, which "
-                             f"spans x {lo[0]:.3g}..{hi[0]:.3g} m, y {lo[1]:.3g}..{hi[1]:.3g} m once placed: move "
-                             f"the box over the part to hold")
-        mask |= inside
-    if spec.pin_vertices:
-        idx = np.asarray(spec.pin_vertices, dtype=np.int64)
-        if idx.min() < 0 or idx.max() >= len(x):
-            bad = int(idx[(idx < 0) | (idx >= len(x))][0])
-            raise ValueError(f"pin_vertices: vertex index {bad} is out of range; the body has vertices "
-                             f"0..{len(x) - 1}")
-        mask[idx] = True
-    return mask
-
-
-def build(scene: Scene):
-    """A new :class:`deforma.World` holding the scene's bodies and colliders.
-
-    Raises
-    ------
-    SceneError
-        If the world or a mesh rejects a value (e.g. a concave box); the message names the
-        scene file and the body.
-    """
-    from ..physics import World
-
-    source = _shown(scene.path)
-    p = scene.physics
-    try:
-        world = World(gravity=p.gravity, dt=p.dt, substeps=p.substeps, mass=p.mass, stiffness=p.stiffness,
-                      damping=p.damping, friction=p.friction, static_friction=p.static_friction,
-                      grab_strength=scene.interaction.mouse_strength, max_speed=p.max_speed,
-                      integrator=p.integrator, contact_thickness=p.contact_thickness, air_drag=p.air_drag,
-                      material=_material(material_settings(p), world=True))
-    except MaterialKeyError as e:
-        raise SceneError(f"{source}: physics{'' if e.key is None else '.' + e.key}: {e}") from None
-    except ValueError as e:
-        raise SceneError(f"{source}: physics: {e}") from None
-    bodies = []
-    for i, spec in enumerate(scene.body):
-        try:
-            material = _material(material_settings(p, spec))
-            m = make_mesh(spec)
-            b = world.add_body(m, position=spec.position, material=material, mass=spec.mass,
-                               stiffness=spec.stiffness, damping=spec.damping, collide=spec.collide,
-                               self_collision=spec.self_collision, friction=spec.friction,
-                               static_friction=spec.static_friction)
-        except MaterialKeyError as e:
-            raise SceneError(f"{source}: body[{i}]{'' if e.key is None else '.' + e.key}: {e}") from None
-        except ValueError as e:
-            raise SceneError(f"{source}: body[{i}]: {e}") from None
-        if spec.pressure is not None:
-            try:
-                b.pressure = spec.pressure
-            except ValueError as e:  # e.g. an outline that is not one closed loop
-                raise SceneError(f"{source}: body[{i}].pressure: {e}") from None
-        try:
-            mask = pin_mask(spec, b.positions)
-        except ValueError as e:  # the message starts with the key: body[i].pin: ...
-            raise SceneError(f"{source}: body[{i}].{e}") from None
-        if mask.any():
-            b.pin(mask)
-        bodies.append((weakref.ref(b), spec))
-    colliders = []
-    for i, c in enumerate(scene.collider):
-        try:
-            made = make_colliders(c)
-        except ValueError as e:  # the constructors' messages start with the key: "radius must be ..."
-            raise SceneError(f"{source}: collider[{i}]: {e}") from None
-        for r in made:
-            world.add_collider(r)
-            colliders.append((r, c, (r.center, r.angle)))
-    _REGISTRY[world] = _Record(scene, bodies, colliders)
-    return world
-
-
-def make_colliders(spec) -> list:
-    """The colliders a ``[[collider]]`` spec describes: one, or for ``shape = "image"`` one
-    :class:`deforma.Polygon` per connected piece of the picture.
-
-    Raises
-    ------
-    ValueError
-        What the collider's constructor refuses (a polygon that crosses itself, a picture
-        with no foreground), in one line.
-
-    Examples
-    --------
-    >>> from deforma.scene.schema import SegmentCollider
-    >>> make_colliders(SegmentCollider(a=(0.0, 0.0), b=(2.0, 0.0), radius=0.1, angular_velocity=90.0))
-    [Segment(a=(0.0, 0.0), b=(2.0, 0.0), radius=0.1, angular_velocity=90)]
-    """
-    from ..physics import Circle, Polygon, Rect, Segment, colliders_from_image
-
-    common = dict(friction=spec.friction, static_friction=spec.static_friction)
-    motion = dict(velocity=spec.velocity, angular_velocity=spec.angular_velocity)
-    if isinstance(spec, ColliderSpec):
-        return [Rect(spec.center, spec.size, spec.angle, **common, **motion)]
-    if isinstance(spec, CircleCollider):
-        return [Circle(spec.center, spec.radius, **common, **motion)]
-    if isinstance(spec, SegmentCollider):
-        return [Segment(spec.a, spec.b, radius=spec.radius, **common, **motion)]
-    if isinstance(spec, PolygonCollider):
-        p = Polygon(spec.points, holes=spec.holes, **common, **motion)
-        p.angle = spec.angle  # about its centroid, the point it was built around
-        return [p]
-    if isinstance(spec, ImageCollider):
-        pieces = colliders_from_image(str(picture_file(spec.source)), scale=spec.scale, position=spec.position,
-                                      tolerance=spec.tolerance, background=spec.background,
-                                      threshold=spec.threshold, min_area=spec.min_area, **common)
-        for p in pieces:
-            p.velocity, p.angular_velocity = spec.velocity, spec.angular_velocity
-        return pieces
-    raise TypeError(f"not a collider spec: {spec!r}")
-
-
-def _shown(path) -> str:
-    """A scene file's path for messages: relative to the working folder when it is inside it
-    (as a user types it; the Scene keeps the absolute path to find its pictures), else as is."""
-    if path is None:
-        return "<scene>"
-    try:
-        rel = os.path.relpath(path)
-    except ValueError:  # another drive (Windows)
-        return str(path)
-    return str(path) if rel.split(os.sep, 1)[0] == os.pardir else rel  # outside it ("..foo.toml" is inside)
 
 
 def load_scene(name_or_path):
@@ -369,7 +165,7 @@ def _pin_keys(spec, body) -> dict:
             return {}
     except ValueError:  # the spec's pins do not fit this body (e.g. a mesh made in code)
         pass
-    if spec.pin is not None and np.array_equal(mask, _box_mask(spec.pin, rest)):
+    if spec.pin is not None and np.array_equal(mask, box_mask(spec.pin, rest)):
         return dict(pin_vertices=None)
     pinned = tuple(int(i) for i in np.flatnonzero(mask))
     return dict(pin=None, pin_vertices=pinned or None)
@@ -389,7 +185,7 @@ def scene_of(world) -> Scene:
     ``pin`` box is kept while the body's pinned vertices are exactly those inside it;
     otherwise they are written as ``pin_vertices``.
     """
-    rec = _REGISTRY.get(world)
+    rec = build_record(world)
     scene = rec.scene if rec is not None else Scene()
     physics = PhysicsSettings(
         dt=float(world.dt), substeps=int(world.substeps), gravity=tuple(float(g) for g in world.gravity),

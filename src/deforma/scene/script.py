@@ -1,9 +1,10 @@
 """A scene's scripted input, applied to a world as its clock passes: ``[[event]]`` explosions
 (the space key) and ``[[pull]]`` grabs (the mouse).
 
-One :class:`Script` drives every headless runner (``deforma run`` and ``deforma.show``), so
-a scene plays the same way in both. The viewer does not play it: there a person presses the
-keys and holds the mouse.
+One :class:`Script` drives every headless runner (``deforma run``, ``deforma sweep`` and
+``deforma.show``, through their one frame loop, :class:`deforma.scene.playback.Playback`), so a
+scene plays the same way in all of them. The viewer does not play it: there a person presses
+the keys and holds the mouse.
 """
 
 from __future__ import annotations

@@ -618,21 +618,16 @@ class Viewer:
             img = self.screenshot()
             from PIL import Image
 
-            from ..render.video import publish, temp_beside
+            from ..files import write_atomic
 
             for path in self._screenshot_requests:
-                tmp = None
                 try:
                     # whole or not at all, like every other output: a full disk leaves no half PNG
-                    tmp = temp_beside(Path(path))
-                    Image.fromarray(img).save(tmp, format="PNG")
-                    publish(tmp, path)
+                    write_atomic(path, lambda f: Image.fromarray(img).save(f, format="PNG"))
                     self.screenshot_errors.pop(path, None)
                     if self.panel_visible:
                         self.inspector.say(f"screenshot saved to {path}")
                 except (OSError, ValueError) as e:
-                    if tmp is not None:
-                        tmp.unlink(missing_ok=True)
                     self.screenshot_errors[path] = str(e)
                     self.inspector.say(f"cannot save the screenshot: {e}", error=True)
             self._screenshot_requests.clear()
@@ -809,7 +804,7 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
         out = Path(screenshot)
         if out.suffix.lower() != ".png":
             raise ValueError(f"{screenshot}: a screenshot is written as PNG; give a name ending in .png")
-        from ..render.video import check_folder
+        from ..files import check_folder
 
         check_folder(screenshot, out.parent)  # exists and writable, before a window opens
     session = Session(scene)  # a bad scene fails before a window opens

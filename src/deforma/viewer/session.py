@@ -31,8 +31,8 @@ from ..physics import Circle, Material, Polygon, Rect, Segment, available_integr
 from ..physics.diagnostics import xpbd_advice
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
-from ..scene.build import pin_mask
-from ..scene.schema import MATERIAL_MODELS, BodyPhysics
+from ..scene.construct import pin_mask
+from ..scene.tables import MATERIAL_MODELS, BodyPhysics
 
 def _builtin_texture_names() -> tuple:
     """The built-in textures the Selected menu offers, in the original's order where it has them
