@@ -28,10 +28,10 @@ def patched_matrices(monkeypatch):
     full = implicit.system_matrix
     checked = []
 
-    def system_matrix(m, grab_slot, grab_pull, h, mass=None, patch=None, weights=None):
-        a, diag = full(m, grab_slot, grab_pull, h, mass, patch, weights)
+    def system_matrix(m, grab_slot, grab_pull, h, mass=None, patch=None, weights=None, fused=True):
+        a, diag = full(m, grab_slot, grab_pull, h, mass, patch, weights, fused)
         if patch is not None:
-            b, diag_b = full(m, grab_slot, grab_pull, h, mass)  # its own weights, too
+            b, diag_b = full(m, grab_slot, grab_pull, h, mass, fused=fused)  # its own weights, too
             for got, want in ((a.indptr, b.indptr), (a.indices, b.indices), (a.data, b.data), (diag, diag_b)):
                 np.testing.assert_array_equal(got, want)
             checked.append(patch[3])

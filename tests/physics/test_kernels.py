@@ -136,7 +136,7 @@ def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_los
 
 
 def test_the_implicit_matrix_assembly_matches_a_dense_sum():
-    from deforma.physics.integrators.implicit.assembly import element_weights, system_matrix, with_entries
+    from deforma.physics.integrators.implicit.assembly import system_matrix, with_entries
 
     w = deforma.World(stiffness=300.0, damping=0.7)
     w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.5), (0, 0.5)), detail=3), position=(0, 1))  # springs
@@ -157,7 +157,7 @@ def test_the_implicit_matrix_assembly_matches_a_dense_sum():
     ws = h * h * m.spring_stiffness + h * m.spring_damping
     for i, j, wk in zip(m.spring_i, m.spring_j, ws):
         dense[[i, j, i, j], [j, i, i, j]] += [-wk, -wk, wk, wk]
-    for tri, b, we in zip(m.elem, m.elem_b, element_weights(m, h)):
+    for tri, b, we in zip(m.elem, m.elem_b, m.triangles.matrix_weights(h)):
         bb = b.reshape(2, 2)
         d = np.stack([-bb[0] - bb[1], bb[0], bb[1]])
         dense[np.ix_(tri, tri)] += we * d @ d.T

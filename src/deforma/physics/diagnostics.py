@@ -18,7 +18,7 @@ import numpy as np
 
 from ..checks import MAX_SUBSTEPS
 from .behaviours.strain import spring_strains
-from .elements.triangles import element_energy, gradient_row_sums, max_stiffness, signed_areas
+from .elements.triangles import element_energy, signed_areas
 
 # A body has lost its shape when a spring is this many times its rest length, or its area
 # falls below this share of its rest area; checked every SHAPE_CHECK_EVERY steps.
@@ -65,7 +65,9 @@ class Energy:
 
 
 def energy(model, state, gravity, vertices=slice(None), springs=slice(None), elements=slice(None)) -> Energy:
-    """The :class:`Energy` of the vertices, springs and elements in the given slices (all by default)."""
+    """The :class:`Energy` of the vertices, springs and triangle elements in the given slices
+    (all by default); ``elastic`` also holds the registered element kinds' energy of those
+    vertices."""
     x, v, mass = state.x[vertices], state.v[vertices], model.vertex_mass[vertices]
     kinetic = 0.5 * float(np.sum(mass * np.einsum("ij,ij->i", v, v)))
     si, sj = model.spring_i[springs], model.spring_j[springs]
@@ -75,25 +77,26 @@ def energy(model, state, gravity, vertices=slice(None), springs=slice(None), ele
     ts = elements
     elastic = float(np.sum(element_energy(state.x, model.elem[ts], model.elem_b[ts], model.elem_area[ts],
                                           model.elem_mu[ts], model.elem_lambda[ts], model.elem_kind[ts])))
+    lo, hi = (0, model.n_vertices) if vertices == slice(None) else (vertices.start, vertices.stop)
+    for kind in model.elements:  # the registered kinds' elements of these vertices
+        if kind is model.springs or kind is model.triangles:  # counted above
+            continue
+        mine = (kind.vertices[:, 0] >= lo) & (kind.vertices[:, 0] < hi)
+        elastic += float(np.sum(kind.energy(state.x)[mine]))
     return Energy(kinetic, spring, gravitational, elastic)
 
 
 def explicit_rates(model, control) -> tuple[float, float]:
     """``(omega^2, gamma)`` of :func:`stable_dt`: the largest stiffness and damping rates over
-    the vertices (1/s^2, 1/s), with the grabs of ``control``."""
-    m = model
-    # (float: bincount of no springs gives integers)
-    ks = np.bincount(m.spring_i, m.spring_stiffness, m.n_vertices) + \
-        np.bincount(m.spring_j, m.spring_stiffness, m.n_vertices).astype(np.float64)
-    kd = np.bincount(m.spring_i, m.spring_damping, m.n_vertices) + \
-        np.bincount(m.spring_j, m.spring_damping, m.n_vertices).astype(np.float64)
+    the vertices (1/s^2, 1/s), from every element kind's row sums and ``control``'s grabs."""
+    n = model.n_vertices
+    ks, kd = np.zeros(n), np.zeros(n)
+    for kind in model.elements:
+        ks += kind.stiffness_rows(n)
+        kd += kind.damping_rows(n)
     held = control.grab_slot >= 0
     ks[held] += control.grab_pull[control.grab_slot[held], 0]
-    if m.n_elements:
-        k = max_stiffness(m.elem_mu, m.elem_lambda)
-        ks += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k, m.n_vertices)
-        kd += gradient_row_sums(m.elem, m.elem_b, m.elem_area, k * m.elem_damping, m.n_vertices)
-    return float(np.max(2 * ks * m.vertex_inv_mass)), float(np.max(2 * kd * m.vertex_inv_mass))
+    return float(np.max(2 * ks * model.vertex_inv_mass)), float(np.max(2 * kd * model.vertex_inv_mass))
 
 
 def stable_dt(model, control) -> float:

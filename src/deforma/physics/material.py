@@ -35,11 +35,25 @@ from __future__ import annotations
 import math
 from dataclasses import KW_ONLY, dataclass
 
-MODELS = ("springs", "corotated", "neo-hookean")
+from .elements.kind import BUILT_IN, registered_models
+
+MODELS = BUILT_IN  # more come from registered element kinds (material_models)
 # Element kind codes stored per triangle in the Model (springs bodies have no elements).
 KIND_COROTATED = 0
 KIND_NEO_HOOKEAN = 1
 KIND_CODES = {"corotated": KIND_COROTATED, "neo-hookean": KIND_NEO_HOOKEAN}
+
+
+def material_models() -> tuple[str, ...]:
+    """The material models ``Material`` takes: the built-in ones, then those of the element
+    kinds registered with :func:`~deforma.physics.elements.kind.register_element_kind`.
+
+    Examples
+    --------
+    >>> material_models()[:3]
+    ('springs', 'corotated', 'neo-hookean')
+    """
+    return MODELS + tuple(m for m in registered_models() if m not in MODELS)
 
 
 def _number(value, name: str) -> float:
@@ -119,8 +133,9 @@ class Material:
     max_stretch: float | None = None
 
     def __post_init__(self):
-        if self.model not in MODELS:
-            raise ValueError(f"material model must be one of {', '.join(repr(m) for m in MODELS)}, "
+        models = material_models()
+        if self.model not in models:
+            raise ValueError(f"material model must be one of {', '.join(repr(m) for m in models)}, "
                              f"got {self.model!r}")
         self._check_behaviours()
         given = [k for k in ("youngs_modulus", "poisson_ratio", "density") if getattr(self, k) is not None]
@@ -177,14 +192,15 @@ class Material:
 
     @property
     def is_fem(self) -> bool:
-        """True for the finite-element models (``"corotated"``, ``"neo-hookean"``)."""
+        """True for the finite-element models (``"corotated"``, ``"neo-hookean"``, and those of
+        registered element kinds): the body weighs ``density * area``."""
         return self.model != "springs"
 
     @property
     def kind(self) -> int:
         """The element kind code the kernels read (``KIND_COROTATED`` / ``KIND_NEO_HOOKEAN``)."""
-        if not self.is_fem:
-            raise ValueError("the 'springs' material has no elements")
+        if self.model not in KIND_CODES:
+            raise ValueError(f"the {self.model!r} material has no triangle elements of a built-in kind")
         return KIND_CODES[self.model]
 
     def lame(self) -> tuple[float, float]:

@@ -9,7 +9,10 @@ import uuid
 import numpy as np
 
 from .contact.contacts import COLLIDE, SELF_COLLIDE, SIDE_MARGIN, SPECULATIVE, ContactTopology
-from .elements.triangles import rest_geometry
+from .elements.kind import BodyElements, element_kind
+from .elements.springs import SpringKind
+from .elements.triangles import TriangleKind, rest_geometry
+from .material import KIND_CODES
 from .topology import element_geometry, lumped_areas, off_outline
 
 
@@ -78,6 +81,10 @@ class Model:
     gravity : (float, float)
         Acceleration of gravity (m/s^2), and ``air_drag`` (1/s): the World's, which it sets
         in place when they change (the Model is not rebuilt for them).
+    elements : list of ElementKind
+        The element kinds (:mod:`deforma.physics.elements.kind`): the springs, the triangle
+        elements, then one entry per registered kind a body's material uses. ``fused`` says
+        whether the integrators' compiled drivers can run them all.
     contact : ContactTopology
         Every body as the contact stage reads it (outline and other vertices, outline edges,
         triangles, per-vertex contact thickness, per-body flags, thickness and friction);
@@ -109,10 +116,13 @@ class Model:
         self._attachments = {}  # body -> its long-range attachments, until the pins change
         nb = len(self.topologies)
         materials = [None] * nb if materials is None else list(materials)
+        # a finite-element body (or one of a registered element kind) weighs density * area and
+        # has no springs; only the corotated and Neo-Hookean ones have triangle elements here
         fem = [m is not None and m.is_fem for m in materials]
+        has_tri = [m is not None and m.model in KIND_CODES for m in materials]
         nv = [t.n_vertices for t in self.topologies]
         ne = [0 if f else t.n_springs for t, f in zip(self.topologies, fem)]
-        nt = [len(t.triangles) if f else 0 for t, f in zip(self.topologies, fem)]
+        nt = [len(t.triangles) if f else 0 for t, f in zip(self.topologies, has_tri)]
         self.body_vertex_offsets = np.zeros(nb + 1, np.int64)
         self.body_spring_offsets = np.zeros(nb + 1, np.int64)
         self.body_elem_offsets = np.zeros(nb + 1, np.int64)
@@ -139,6 +149,9 @@ class Model:
                 self.spring_i[s0:s1] = t.springs[:, 0] + v0
                 self.spring_j[s0:s1] = t.springs[:, 1] + v0
                 self.spring_rest_length[s0:s1] = t.spring_rest_length
+                continue
+            if not has_tri[b]:  # another element kind's body: its mass comes from its area
+                self.vertex_area[v0:v0 + t.n_vertices] = element_geometry(t)[3]
                 continue
             t0, t1 = self.body_elem_offsets[b], self.body_elem_offsets[b + 1]
             if b in torn:
@@ -218,6 +231,18 @@ class Model:
         for b in range(nb):
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
+        # the built-in kinds by name (the compiled drivers and the matrix assembly run them from
+        # the arrays above), then the registered kinds' elements
+        self.springs = SpringKind(self)
+        self.triangles = TriangleKind(self)
+        self.elements = [self.springs, self.triangles]
+        custom = {}
+        for b, m in enumerate(materials):
+            kind = element_kind(m.model) if fem[b] and not has_tri[b] else None
+            if kind is not None:
+                custom.setdefault(kind, []).append(
+                    BodyElements(b, self.topologies[b], m, int(self.body_vertex_offsets[b])))
+        self.elements += [kind.build(bodies) for kind, bodies in custom.items()]
 
     def _torn_elements(self, body: int, old: "Model", old_body: int) -> None:
         """Fill body ``body``'s elements from body ``old_body`` of Model ``old``, which a tear
@@ -308,6 +333,12 @@ class Model:
         self.pressure_b = np.ascontiguousarray(edges[:, 1])
 
     @property
+    def fused(self) -> bool:
+        """Whether every element kind is one the integrators' compiled drivers run themselves
+        (the built-in springs and triangles); otherwise they loop over ``elements``."""
+        return all(k.fused for k in self.elements)
+
+    @property
     def n_vertices(self) -> int:
         """Total number of vertices over all bodies."""
         return len(self.vertex_mass)
@@ -348,11 +379,12 @@ class Model:
                              "switch between springs and elements")
         self.materials[body] = material
         t0, t1 = self.body_elem_offsets[body], self.body_elem_offsets[body + 1]
-        mu, lam = material.lame()
-        self.elem_mu[t0:t1] = mu
-        self.elem_lambda[t0:t1] = lam
-        self.elem_damping[t0:t1] = material.damping
-        self.elem_kind[t0:t1] = material.kind
+        if t1 > t0:
+            mu, lam = material.lame()
+            self.elem_mu[t0:t1] = mu
+            self.elem_lambda[t0:t1] = lam
+            self.elem_damping[t0:t1] = material.damping
+            self.elem_kind[t0:t1] = material.kind
         v0, v1 = self.body_vertex_offsets[body], self.body_vertex_offsets[body + 1]
         self.vertex_mass[v0:v1] = material.density * self.vertex_area[v0:v1]
         self._inverse_masses(v0, v1)

@@ -96,3 +96,43 @@ def size_constraint(f00, f01, f10, f11):
     """
     c, s, t = polar_rotation(f00, f01, f10, f11)
     return t - 2.0, c, -s, s, c
+
+
+@njit(cache=True)
+def stress_derivative(f00, f01, f10, f11, mu, lam, out):
+    """The energy density's Hessian in ``F`` (Pa), ``d^2 psi / dF^2`` as a 4 x 4 matrix over
+    ``vec F = (F00, F01, F10, F11)``, into ``out``.
+
+    With ``c = F00 + F11``, ``s = F10 - F01`` and ``r = |(c, s)| = tr S``, the energy is
+    ``mu (|F|^2 - 2 r + 2) + lambda / 2 (r - 2)^2``; ``(c, s) = A vec F`` with ``A = [[1, 0,
+    0, 1], [0, -1, 1, 0]]``, so ``dr = A^T (c, s) / r`` and ``d^2 r = A^T (I / r - (c, s)(c,
+    s)^T / r^3) A``, and the Hessian is ``2 mu I + (lambda (r - 2) - 2 mu) d^2 r + lambda dr
+    dr^T``. Where ``r = 0`` (no rotational part) the ``d^2 r`` term is left out.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = np.zeros((4, 4))
+    >>> stress_derivative(1.0, 0.0, 0.0, 1.0, 1.0, 0.0, h)  # at rest, lambda 0: 2 mu on the shear
+    >>> np.linalg.eigvalsh(h).round(9).tolist()
+    [0.0, 2.0, 2.0, 2.0]
+    """
+    c = f00 + f11
+    s = f10 - f01
+    r = np.sqrt(c * c + s * s)
+    a = np.array([[1.0, 0.0, 0.0, 1.0], [0.0, -1.0, 1.0, 0.0]])
+    for p in range(4):
+        for q in range(4):
+            out[p, q] = 2.0 * mu if p == q else 0.0
+    if r == 0.0:
+        return
+    u0, u1 = c / r, s / r
+    dr = np.empty(4)
+    for p in range(4):
+        dr[p] = a[0, p] * u0 + a[1, p] * u1
+    k = (lam * (r - 2.0) - 2.0 * mu) / r
+    for p in range(4):
+        for q in range(4):
+            # d^2 r = A^T (I - u u^T) A / r, u = (c, s) / r
+            m = a[0, p] * a[0, q] + a[1, p] * a[1, q] - dr[p] * dr[q]
+            out[p, q] += k * m + lam * dr[p] * dr[q]

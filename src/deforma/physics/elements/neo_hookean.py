@@ -124,3 +124,31 @@ def size_constraint(f00, f01, f10, f11):
     -2.0
     """
     return f00 * f11 - f01 * f10 - 1.0, f11, -f10, -f01, f00
+
+
+@njit(cache=True)
+def stress_derivative(f00, f01, f10, f11, mu, lam, out):
+    """The energy density's Hessian in ``F`` (Pa), ``d^2 psi / dF^2`` as a 4 x 4 matrix over
+    ``vec F = (F00, F01, F10, F11)``, into ``out``: ``mu I + lambda' g g^T + lambda' (J -
+    alpha) H_J`` with ``g = dJ/dF = (F11, -F10, -F01, F00)`` and ``H_J`` the constant Hessian of
+    ``J = F00 F11 - F01 F10`` (1 at (F00, F11), -1 at (F01, F10), and their mirrors).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = np.zeros((4, 4))
+    >>> stress_derivative(1.0, 0.0, 0.0, 1.0, 1.0, 1.0, h)
+    >>> round(float(np.linalg.eigvalsh(h).max()), 9)  # 2 (mu + lambda) at rest, as max_curvature says
+    4.0
+    """
+    lp, alpha = bulk(mu, lam)
+    g0, g1, g2, g3 = f11, -f10, -f01, f00
+    g = (g0, g1, g2, g3)
+    k = lp * (f00 * f11 - f01 * f10 - alpha)
+    for p in range(4):
+        for q in range(4):
+            out[p, q] = (mu if p == q else 0.0) + lp * g[p] * g[q]
+    out[0, 3] += k
+    out[3, 0] += k
+    out[1, 2] -= k
+    out[2, 1] -= k

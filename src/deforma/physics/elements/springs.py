@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .kind import ElementKind, sweep_order
+
 
 @njit(cache=True)
 def scatter_spring_forces(x, v, spring_i, spring_j, rest, ks, kd, f):
@@ -114,3 +116,157 @@ def project_springs(x, x_prev, inv_mass, spring_i, spring_j, rest, ks, kd, order
         x[i, 1] -= wi * ny * dlam
         x[j, 0] += wj * nx * dlam
         x[j, 1] += wj * ny * dlam
+
+
+@njit(cache=True)
+def spring_rhs(x, x_n, spring_i, spring_j, rest, wk, wd, b):
+    """Add the springs' local step at the iterate ``x`` to implicit Euler's right-hand side
+    ``b`` (N, 2): ``sum_e (wk_e l_e d_e + wd_e p_e) (e_j - e_i)``, with ``d_e`` the spring's
+    direction and ``p_e`` its vector minus its stretch since the substep began (``x_n``),
+    ``wk = h^2 ks``, ``wd = h kd`` (kg). See :mod:`deforma.physics.integrators.implicit.solver`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [2.0, 0.0]])
+    >>> b = np.zeros((2, 2))
+    >>> spring_rhs(x, x, np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.ones(1), np.zeros(1), b)
+    >>> b.tolist()  # the rest-length target 1 m along the spring
+    [[-1.0, 0.0], [1.0, 0.0]]
+    """
+    for e in range(spring_i.shape[0]):
+        i = np.uint64(spring_i[e])
+        j = np.uint64(spring_j[e])
+        dx = x[j, 0] - x[i, 0]
+        dy = x[j, 1] - x[i, 1]
+        length = np.sqrt(dx * dx + dy * dy)
+        if length > 0.0:
+            nx = dx / length
+            ny = dy / length
+        else:  # coincident ends: no direction, target the current (zero) vector
+            nx = 0.0
+            ny = 0.0
+        # p_e: x_ij minus its stretch since the substep began, along d
+        s = (dx - (x_n[j, 0] - x_n[i, 0])) * nx + (dy - (x_n[j, 1] - x_n[i, 1])) * ny
+        tx = wk[e] * rest[e] * nx + wd[e] * (dx - s * nx)
+        ty = wk[e] * rest[e] * ny + wd[e] * (dy - s * ny)
+        b[i, 0] -= tx
+        b[i, 1] -= ty
+        b[j, 0] += tx
+        b[j, 1] += ty
+
+
+@njit(cache=True)
+def spring_gradient_hessian(x, spring_i, spring_j, rest, ks, grad, hess):
+    """Gradient (E, 2, 2) and Hessian blocks (E, 4, 4) of each spring's energy ``ks/2 (L -
+    l)^2``, corners ``i`` then ``j``, x then y. The block is ``[[K, -K], [-K, K]]`` with
+    ``K = ks (d d^T + max(1 - l / L, 0) (I - d d^T))``: the transverse term of a compressed
+    spring (negative) is left out, so that the block is positive semi-definite."""
+    for e in range(spring_i.shape[0]):
+        i, j = spring_i[e], spring_j[e]
+        dx = x[j, 0] - x[i, 0]
+        dy = x[j, 1] - x[i, 1]
+        length = np.sqrt(dx * dx + dy * dy)
+        k = ks[e]
+        if length > 0.0:
+            nx, ny = dx / length, dy / length
+            t = max(1.0 - rest[e] / length, 0.0)
+        else:  # coincident ends: no direction; the stiffness along any is k, none across
+            nx, ny, t = 1.0, 0.0, 0.0
+        f = k * (length - rest[e])
+        grad[e, 0, 0], grad[e, 0, 1] = -f * nx, -f * ny
+        grad[e, 1, 0], grad[e, 1, 1] = f * nx, f * ny
+        k00 = k * (nx * nx + t * (1.0 - nx * nx))
+        k01 = k * (nx * ny - t * nx * ny)
+        k11 = k * (ny * ny + t * (1.0 - ny * ny))
+        for a in range(2):
+            for c in range(2):
+                sign = 1.0 if a == c else -1.0
+                hess[e, 2 * a, 2 * c] = sign * k00
+                hess[e, 2 * a, 2 * c + 1] = sign * k01
+                hess[e, 2 * a + 1, 2 * c] = sign * k01
+                hess[e, 2 * a + 1, 2 * c + 1] = sign * k11
+
+
+class SpringKind(ElementKind):
+    """The springs of every body of the ``"springs"`` material: a view of the Model's
+    ``spring_*`` arrays (which plasticity and the body parameters change in place).
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World()
+    >>> _ = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
+    >>> kind = w._model.elements[0]
+    >>> kind.name, kind.n_elements, float(kind.energy(w.bodies[0].positions).sum())
+    ('springs', 3, 0.0)
+    """
+
+    name = "springs"
+    models = ("springs",)
+    fused = True
+
+    def __init__(self, model):
+        self._model = model
+        self._order = None  # XPBD's sweep order, made on first use (a Model's springs never change)
+        self._lam = np.zeros(model.n_springs)
+
+    @property
+    def vertices(self) -> np.ndarray:
+        m = self._model
+        return np.stack([m.spring_i, m.spring_j], axis=1)
+
+    def energy(self, x) -> np.ndarray:
+        m = self._model
+        stretch = np.linalg.norm(x[m.spring_j] - x[m.spring_i], axis=1) - m.spring_rest_length
+        return 0.5 * m.spring_stiffness * stretch * stretch
+
+    def gradient_hessian(self, x):
+        m = self._model
+        grad, hess = np.zeros((m.n_springs, 2, 2)), np.zeros((m.n_springs, 4, 4))
+        spring_gradient_hessian(x, m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness, grad, hess)
+        return grad, hess
+
+    def forces(self, x, v, f) -> None:
+        m = self._model
+        scatter_spring_forces(x, v, m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness,
+                              m.spring_damping, f)
+
+    def begin_substep(self) -> None:
+        self._lam[:] = 0.0
+
+    def project(self, x, x_prev, inv_mass, h, sequence) -> None:
+        m = self._model
+        if self._order is None:
+            self._order = sweep_order(self.vertices, m.n_vertices)[0]
+        project_springs(x, x_prev, inv_mass, m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness,
+                        m.spring_damping, self._order, self._lam, h)
+
+    def matrix_weights(self, h):
+        """``(h^2 ks, h kd)`` per spring (kg): the stretch's and the damping's weights."""
+        m = self._model
+        return h * h * m.spring_stiffness, h * m.spring_damping
+
+    def matrix_entries(self, h, weights=None):
+        """The springs' graph Laplacian weighted by ``h^2 ks + h kd``."""
+        m = self._model
+        wk, wd = self.matrix_weights(h) if weights is None else weights
+        w = wk + wd
+        i, j = m.spring_i.astype(np.int64), m.spring_j.astype(np.int64)
+        return np.concatenate([i, j, i, j]), np.concatenate([i, j, j, i]), np.concatenate([w, w, -w, -w])
+
+    def rhs(self, x, x_n, h, weights, b) -> None:
+        m = self._model
+        wk, wd = weights
+        spring_rhs(x, x_n, m.spring_i, m.spring_j, m.spring_rest_length, wk, wd, b)
+
+    def stiffness_rows(self, n: int) -> np.ndarray:
+        m = self._model
+        # (float: bincount of no springs gives integers)
+        return np.bincount(m.spring_i, m.spring_stiffness, n) + \
+            np.bincount(m.spring_j, m.spring_stiffness, n).astype(np.float64)
+
+    def damping_rows(self, n: int) -> np.ndarray:
+        m = self._model
+        return np.bincount(m.spring_i, m.spring_damping, n) + \
+            np.bincount(m.spring_j, m.spring_damping, n).astype(np.float64)

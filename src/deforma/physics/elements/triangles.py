@@ -29,6 +29,7 @@ import numpy as np
 from numba import njit
 
 from ..material import KIND_COROTATED
+from .kind import ElementKind, sweep_order
 from . import corotated, neo_hookean
 
 
@@ -342,7 +343,7 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, or
     (:func:`~deforma.physics.elements.neo_hookean.size_constraint`), Neo-Hookean ``J - 1`` (after
     Macklin and Mueller 2021; :func:`~deforma.physics.elements.neo_hookean.size_constraint`).
     Damping ``beta`` gives each constraint ``kd = beta * stiffness``. ``order`` (T,) is the
-    order of the sweep (:func:`deforma.physics.integrators.xpbd.sweep_order`); ``lam_acc`` (T, 3) holds
+    order of the sweep (:func:`deforma.physics.elements.kind.sweep_order`); ``lam_acc`` (T, 3) holds
     the multipliers of the substep.
 
     The shear constraints are linear in the positions (their gradients are constant), which
@@ -409,3 +410,145 @@ def project_elements(x, x_prev, inv_mass, elem, b, area, mu, lam, beta, kind, or
             x[j, 1] += wj * (g1[3] * dl1 + g2[3] * dl2 + g3[3] * dl3)
             x[k, 0] += wk * (g1[4] * dl1 + g2[4] * dl2 + g3[4] * dl3)
             x[k, 1] += wk * (g1[5] * dl1 + g2[5] * dl2 + g3[5] * dl3)
+
+
+@njit(cache=True)
+def triangle_gradient_hessian(x, elem, b, area, mu, lam, kind, grad, hess):
+    """Gradient (T, 3, 2) and Hessian blocks (T, 6, 6) of each element's energy ``A psi(F)``,
+    corners ``i, j, k`` (x then y). The gradient at corner ``v`` is ``A P D_v``; the block is
+    ``A G^T H_F G`` with ``H_F`` the energy density's Hessian in ``F``
+    (``corotated.stress_derivative``, ``neo_hookean.stress_derivative``) projected to its
+    positive part (its negative eigenvalues set to zero) and ``G`` the map from the corners'
+    coordinates to ``vec F``, so the block is positive semi-definite."""
+    hf = np.empty((4, 4))
+    g = np.zeros((4, 6))
+    for e in range(elem.shape[0]):
+        i, j, k, b0, b1, b2, b3 = corners(elem, b, e)
+        f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
+        p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
+        jx, jy, kx, ky = _columns(p00, p01, p10, p11, b0, b1, b2, b3, area[e])
+        grad[e, 0, 0], grad[e, 0, 1] = -jx - kx, -jy - ky
+        grad[e, 1, 0], grad[e, 1, 1] = jx, jy
+        grad[e, 2, 0], grad[e, 2, 1] = kx, ky
+        if kind[e] == KIND_COROTATED:
+            corotated.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
+        else:
+            neo_hookean.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
+        w, vec = np.linalg.eigh(hf)
+        for p in range(4):
+            for q in range(4):
+                s = 0.0
+                for m in range(4):
+                    if w[m] > 0.0:
+                        s += vec[p, m] * w[m] * vec[q, m]
+                hf[p, q] = s
+        # vec F = G (x_i, y_i, x_j, y_j, x_k, y_k): F[r, c] = sum_v x_v[r] D_v[c]
+        d = ((-b0 - b2, -b1 - b3), (b0, b1), (b2, b3))
+        for v in range(3):
+            for r in range(2):
+                for c in range(2):
+                    g[2 * r + c, 2 * v + r] = d[v][c]
+        for p in range(6):
+            for q in range(6):
+                s = 0.0
+                for m in range(4):
+                    for n in range(4):
+                        s += g[m, p] * hf[m, n] * g[n, q]
+                hess[e, p, q] = area[e] * s
+
+
+def triangle_weights(area, beta, mu, lam, h: float) -> np.ndarray:
+    """Weight (kg) of each element in implicit Euler's constant matrix: ``A (h^2 + h beta) k``,
+    ``k`` its stiffness bound (:func:`max_stiffness`)."""
+    return area * (h * h + h * beta) * max_stiffness(mu, lam)
+
+
+class TriangleKind(ElementKind):
+    """The triangle elements of every body of a ``"corotated"`` or ``"neo-hookean"``
+    material: a view of the Model's ``elem*`` arrays (which plasticity and a new material
+    change in place).
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World(material=deforma.Material("corotated", youngs_modulus=1e3, poisson_ratio=0.3,
+    ...                                              density=1.0))
+    >>> _ = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
+    >>> kind = w._model.elements[1]
+    >>> kind.name, kind.n_elements, float(kind.energy(w.bodies[0].positions).sum())
+    ('triangles', 1, 0.0)
+    """
+
+    name = "triangles"
+    models = ("corotated", "neo-hookean")
+    fused = True
+
+    def __init__(self, model):
+        self._model = model
+        self._order = None  # XPBD's order: (elements by colour, where each colour starts)
+        self._lam = np.zeros((model.n_elements, 3))
+
+    @property
+    def vertices(self) -> np.ndarray:
+        return self._model.elem
+
+    def energy(self, x) -> np.ndarray:
+        m = self._model
+        return element_energy(x, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_kind)
+
+    def gradient_hessian(self, x):
+        m = self._model
+        grad, hess = np.zeros((m.n_elements, 3, 2)), np.zeros((m.n_elements, 6, 6))
+        triangle_gradient_hessian(x, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_kind, grad,
+                                  hess)
+        return grad, hess
+
+    def forces(self, x, v, f) -> None:
+        m = self._model
+        if m.n_elements:
+            element_forces(x, v, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_damping,
+                           m.elem_kind, bool(m.elem_damping.any()), f)
+
+    def begin_substep(self) -> None:
+        self._lam[:] = 0.0
+
+    def project(self, x, x_prev, inv_mass, h, sequence) -> None:
+        m = self._model
+        if self._order is None:
+            self._order = sweep_order(m.elem, m.n_vertices)
+        project_elements(x, x_prev, inv_mass, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda,
+                         m.elem_damping, m.elem_kind, self._order[0], self._order[1], sequence, self._lam, h)
+
+    def matrix_weights(self, h):
+        m = self._model
+        return triangle_weights(m.elem_area, m.elem_damping, m.elem_mu, m.elem_lambda, h)
+
+    def matrix_entries(self, h, weights=None):
+        """``sum_e w_e D D^T``: each element's weight times the dot products of its
+        shape-function gradients, over its corners' pairs."""
+        m = self._model
+        w = self.matrix_weights(h) if weights is None else weights
+        bb = m.elem_b.reshape(-1, 2, 2)
+        d = np.stack([-bb[:, 0] - bb[:, 1], bb[:, 0], bb[:, 1]], axis=1)  # (T, 3, 2): D_i, D_j, D_k
+        dots = np.einsum("tvc,twc->tvw", d, d) * w[:, None, None]
+        t = m.elem.astype(np.int64)
+        return np.repeat(t, 3, axis=1).ravel(), np.tile(t, (1, 3)).ravel(), dots.ravel()
+
+    def rhs(self, x, x_n, h, weights, b) -> None:
+        m = self._model
+        if m.n_elements:
+            implicit_element_rhs(x, x_n, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_damping,
+                                 m.elem_kind, weights, h, b)
+
+    def stiffness_rows(self, n: int) -> np.ndarray:
+        m = self._model
+        if not m.n_elements:
+            return np.zeros(n)
+        return gradient_row_sums(m.elem, m.elem_b, m.elem_area, max_stiffness(m.elem_mu, m.elem_lambda), n)
+
+    def damping_rows(self, n: int) -> np.ndarray:
+        m = self._model
+        if not m.n_elements:
+            return np.zeros(n)
+        k = max_stiffness(m.elem_mu, m.elem_lambda)
+        return gradient_row_sums(m.elem, m.elem_b, m.elem_area, k * m.elem_damping, n)

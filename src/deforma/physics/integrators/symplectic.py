@@ -312,14 +312,18 @@ class SymplecticEuler(Integrator):
         kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
         gx, gy = model.gravity
         start = time.perf_counter()
-        bad = kernel(state_out.x, state_out.v, self._fbuf, self._chunks, self._chunk_vertices,
-                     model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
-                     model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
-                     model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
-                     bool(model.elem_damping.any()), model.vertex_inv_mass, float(gx), float(gy),
-                     1.0 / (1.0 + float(h) * model.air_drag), control.force, control.has_force, control.grab_slot,
-                     control.grab_pull, control.colliders, contacts.hits, model.contact, contacts.scratch,
-                     contacts.buffer, float(h), int(substeps), float(max_speed) ** 2)
+        common = (model.vertex_inv_mass, float(gx), float(gy), 1.0 / (1.0 + float(h) * model.air_drag))
+        tail = (control.grab_slot, control.grab_pull, control.colliders, contacts.hits, model.contact,
+                contacts.scratch, contacts.buffer, float(h))
+        if model.fused:  # the compiled driver runs the springs and triangles itself, every substep
+            bad = kernel(state_out.x, state_out.v, self._fbuf, self._chunks, self._chunk_vertices,
+                         model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
+                         model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
+                         model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
+                         bool(model.elem_damping.any()), *common, control.force, control.has_force, *tail,
+                         int(substeps), float(max_speed) ** 2)
+        else:
+            bad = self._step_kinds(kernel, model, state_out, control, contacts, substeps, max_speed, common, tail)
         if may_parallel:
             took = (time.perf_counter() - start) / substeps
             if which == self._last:  # the driver ran last call too: threads awake, caches warm
@@ -329,3 +333,25 @@ class SymplecticEuler(Integrator):
                 self._estimate[which] = sorted(smp)[len(smp) // 2]  # median: one outlier is ignored
             self._last = which
         return StepReport(int(bad), contacts.needed == (0, 0))
+
+    def _step_kinds(self, kernel, model, state, control, contacts, substeps, max_speed, common, tail) -> int:
+        """The substeps one at a time, the forces of every element kind summed by the kinds
+        themselves and handed to the driver as applied forces (with the step's own); the
+        driver then runs no element. The same arithmetic as the fused driver on one chunk."""
+        x, v = state.x, state.v
+        force = np.zeros_like(x)
+        no_springs = (np.zeros(0, np.int32), np.zeros(0, np.int32), *(np.zeros(0),) * 3)
+        no_elements = (np.zeros((0, 3), np.int32), np.zeros((0, 4)), *(np.zeros(0),) * 4, np.zeros(0, np.int32),
+                       False)
+        ptr = np.zeros(len(self._chunks), np.int64)
+        for _ in range(substeps):
+            force[...] = 0.0
+            for kind in model.elements:
+                kind.forces(x, v, force)
+            if control.has_force:
+                force += control.force
+            bad = kernel(x, v, self._fbuf, ptr, self._chunk_vertices, *no_springs, ptr, *no_elements, *common,
+                         force, True, *tail, 1, float(max_speed) ** 2)
+            if bad or contacts.needed != (0, 0):
+                return bad
+        return 0

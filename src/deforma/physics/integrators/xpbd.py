@@ -64,81 +64,11 @@ from numba import njit
 
 from ..colliders.geometry import advance_colliders
 from ..contact.response import project_contacts
+from ..elements.kind import COLOURS, colour_sequence, sweep_order
 from ..elements.springs import project_springs
 from ..elements.triangles import project_elements
 from .base import (Integrator, Option, StepReport, contact_epilogue, finish_position_step, held_contacts,
                    register_integrator)
-
-
-COLOURS = 64  # colours of the sweep order's greedy colouring (one bit each in a uint64 per vertex)
-
-
-@njit(cache=True)
-def sweep_order(items, n_vertices):
-    """The Gauss-Seidel sweep's order of springs or elements ``items`` (M, k): coloured
-    greedily so that no two of a colour share a vertex, colour after colour, in their own
-    order within a colour.
-
-    Returns ``(order, starts)``: the items (M,) int64 colour after colour, and where each of
-    the ``COLOURS`` colours starts in ``order`` (``COLOURS + 1`` entries). The springs are
-    swept in this order; the elements colour by colour in an order of colours drawn for each
-    step (:func:`colour_sequence`), since any fixed order let a box dropped flat walk
-    sideways as it landed (15 cm in the Model's order, 3 cm in this one; 0.6 cm drawn).
-
-    Taken in the Model's order (sorted by first vertex, row after row of a mesh), one sweep
-    carries a correction through the whole body along that order, and with velocities taken
-    from the positions the substep as a whole amplified some motions: a 2500-vertex sheet of
-    springs (2e6 N/m) stretched 2% between two clamps and let go, at 1/600 s with one
-    substep, ran away in 36 steps. In colour order a correction crosses at most as many items
-    as there are colours per sweep, and it stays near rest (``tests/physics/test_integrators.py``).
-    The price is convergence: a stiff spinning block stretches its springs up to 3.0% where
-    the Model's order kept 2%. A vertex with more than ``COLOURS`` colours around it puts the
-    rest in the last colour: the order stays valid, only less spread.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> order, starts = sweep_order(np.array([[0, 1], [1, 2], [2, 3], [3, 4]]), 5)
-    >>> order.tolist(), starts[:3].tolist()  # colour 0: springs 0 and 2; colour 1: 1 and 3
-    ([0, 2, 1, 3], [0, 2, 4])
-    """
-    m = items.shape[0]
-    used = np.zeros(n_vertices, np.uint64)
-    colour = np.empty(m, np.int64)
-    count = np.zeros(COLOURS + 1, np.int64)
-    for e in range(m):
-        taken = np.uint64(0)
-        for c in range(items.shape[1]):
-            taken |= used[items[e, c]]
-        k = 0
-        while k < COLOURS - 1 and (taken >> np.uint64(k)) & np.uint64(1):
-            k += 1
-        colour[e] = k
-        count[k + 1] += 1
-        for c in range(items.shape[1]):
-            used[items[e, c]] |= np.uint64(1) << np.uint64(k)
-    for k in range(COLOURS):
-        count[k + 1] += count[k]
-    starts = count.copy()
-    order = np.empty(m, np.int64)
-    for e in range(m):
-        order[count[colour[e]]] = e
-        count[colour[e]] += 1
-    return order, starts
-
-
-@njit(cache=True, inline="always")
-def colour_sequence(seed, out):
-    """A permutation of ``range(len(out))`` into ``out``, a different one for each ``seed``
-    (a Fisher-Yates shuffle driven by a 64-bit linear congruential generator)."""
-    n = out.shape[0]
-    for c in range(n):
-        out[c] = c
-    state = np.uint64(seed) * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
-    for c in range(n - 1, 0, -1):
-        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
-        r = np.int64((state >> np.uint64(33)) % np.uint64(c + 1))
-        out[c], out[r] = out[r], out[c]
 
 
 @njit(cache=True)
@@ -363,6 +293,9 @@ class XPBD(Integrator):
             self._orders = (model, sweep_order(np.stack([model.spring_i, model.spring_j], axis=1), shape[0])[0],
                             *sweep_order(model.elem, shape[0]))
         gx, gy = model.gravity
+        if not model.fused:
+            bad = self._step_kinds(model, state_out, control, contacts, h, substeps, max_speed)
+            return StepReport(int(bad), contacts.needed == (0, 0))
         # the colours' order is drawn from the step's index: a step repeated (after the
         # contact buffer grew) draws the same
         bad = xpbd_substeps(state_out.x, state_out.v, self._x_prev, self._lam, self._planes, self._touch,
@@ -375,3 +308,37 @@ class XPBD(Integrator):
                             model.contact, contacts.scratch, contacts.buffer, float(h), int(substeps),
                             int(self._options["iterations"]), float(max_speed) ** 2)
         return StepReport(int(bad), contacts.needed == (0, 0))
+
+    def _step_kinds(self, model, state, control, contacts, h, substeps, max_speed) -> int:
+        """:func:`xpbd_substeps` with the loop over the element kinds in Python: each kind
+        projects its own constraints (``ElementKind.project``) where the compiled driver
+        projects the springs and triangles. The same arithmetic, in the same order."""
+        x, v = state.x, state.v
+        gx, gy = model.gravity
+        keep = 1.0 / (1.0 + float(h) * model.air_drag)
+        rects, topo, scr, buf = control.colliders, model.contact, contacts.scratch, contacts.buffer
+        sequence = np.empty(COLOURS, np.int64)
+        colour_sequence(int(control.step), sequence)
+        vmax2 = float(max_speed) ** 2
+        for _ in range(substeps):
+            advance_colliders(rects, h)
+            predict(x, v, self._x_prev, model.vertex_inv_mass, float(gx), float(gy), keep, control.force,
+                    control.has_force, control.grab_slot, control.grab_pull, h)
+            for kind in model.elements:
+                kind.begin_substep()
+            count, n_body = held_contacts(self._x_prev, x, rects, self._planes, self._touch, h, topo, scr, buf)
+            self._planes[:count, 7] = -1.0  # stick or slide: not decided yet
+            if n_body < 0:
+                return 0  # the contact buffer is too small; the world grows it and repeats the step
+            stick = np.full(n_body, -1.0)
+            for _ in range(self._options["iterations"]):
+                project_collider_contacts(x, self._x_prev, model.vertex_inv_mass, self._planes, self._touch, count)
+                project_contacts(x, self._x_prev, model.vertex_inv_mass, topo, buf, n_body, stick)
+                for kind in model.elements:
+                    kind.project(x, self._x_prev, model.vertex_inv_mass, h, sequence)
+            bad = finish_position_step(x, v, self._x_prev, rects, contacts.hits, scr.status.stamp[0] + 1, h, vmax2)
+            if bad:
+                return bad
+            if contact_epilogue(x, v, model.vertex_inv_mass, topo, scr, buf, rects, contacts.hits, h, True) < 0:
+                return 0
+        return 0

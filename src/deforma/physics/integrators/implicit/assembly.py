@@ -11,7 +11,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from ...elements.triangles import max_stiffness
 
 if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
     import scipy.sparse as sp
@@ -43,17 +42,14 @@ def sort_few(keys, count):
         keys[q + 1] = r
 
 
-def element_weights(model, h: float) -> np.ndarray:
-    """Weight (kg) of each element in the solve: ``A (h^2 + h beta) k``, ``k`` its stiffness bound."""
-    return model.elem_area * (h * h + h * model.elem_damping) * max_stiffness(model.elem_mu, model.elem_lambda)
-
-
-def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None, weights=None):
+def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None, weights=None, fused=True):
     """The constant global matrix ``M + L_w + K_w + h^2 S_grab`` (N x N, kg), canonical CSC,
-    each pinned row the identity's, and its diagonal before the pinning (N,).
+    each pinned row the identity's, and its diagonal before the pinning (N,): the compiled
+    assembly of the built-in element kinds.
 
     ``L_w`` is the graph Laplacian of the springs weighted by ``h^2 ks + h kd``, ``K_w`` the
-    elements' ``sum_e w_e D D^T`` (:func:`element_weights`); the x and y coordinates share
+    elements' ``sum_e w_e D D^T`` (``TriangleKind.matrix_weights``); with ``fused`` False
+    both are left out (the caller merges every kind's ``matrix_entries``). The x and y coordinates share
     it, so one N x N factor serves both. ``mass`` replaces ``M``'s diagonal (the solve uses
     ``M (1 + h air_drag)``). A pinned row's equation is ``x_p = b_p`` (the caller puts the
     pinned position in ``b_p``), while the free rows keep their coupling to it, so that it
@@ -64,8 +60,8 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None, 
     a copy of its vertex ``source[i]``, and only the ``fresh`` vertices (N,) bool have
     springs, elements or a mass the tear changed (:attr:`Model.torn_from`). Their columns
     are assembled; every other column is the old one, its rows renumbered: the same numbers,
-    as it sums the same terms in the same order. ``weights``: :func:`element_weights` of
-    ``model`` and ``h``, when the caller has them already.
+    as it sums the same terms in the same order. ``weights``: the kinds' ``matrix_weights``
+    for ``h``, in the order of ``model.elements``, when the caller has them already.
 
     Examples
     --------
@@ -91,10 +87,17 @@ def system_matrix(model, grab_slot, grab_pull, h: float, mass=None, patch=None, 
         source = np.ascontiguousarray(source, dtype=np.int64)
         first = first_index(source, a.shape[0])
         old = (a.indptr, a.indices, a.data, old_diag)  # SciPy's own arrays (int32 here): no copies
-    ptr, ind, val = _assemble(diag, model.spring_i, model.spring_j,
-                              h * h * model.spring_stiffness + h * model.spring_damping,
-                              model.elem, model.elem_b, element_weights(model, h) if weights is None else weights,
-                              model.pinned,
+    if fused:
+        # the kinds' weights for h, in the order of model.elements (made here unless given)
+        weights = {id(k): w for k, w in zip(model.elements, weights)} if weights is not None else \
+            {id(k): k.matrix_weights(h) for k in (model.springs, model.triangles)}
+        wk, wd = weights[id(model.springs)]
+        springs = (model.spring_i, model.spring_j, wk + wd)
+        elements = (model.elem, model.elem_b, weights[id(model.triangles)])
+    else:
+        springs = (np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0))
+        elements = (np.zeros((0, 3), np.int32), np.zeros((0, 4)), np.zeros(0))
+    ptr, ind, val = _assemble(diag, *springs, *elements, model.pinned,
                               np.ascontiguousarray(fresh, dtype=np.bool_), source, first, *old)
     a = sp.csc_matrix((val, ind, ptr), shape=(n, n))
     a.has_sorted_indices = True

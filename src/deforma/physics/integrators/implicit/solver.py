@@ -28,6 +28,13 @@ rigid rotation (a spinning body keeps spinning).
 The mouse pull is in the matrix (it changes ``A``'s diagonal, so a new grab or release
 changes the factor; moving a held grab changes only the right-hand side). Gravity is in ``y``.
 
+Every element kind takes part the same way (:mod:`deforma.physics.elements.kind`): its
+``matrix_weights`` and ``matrix_entries`` give its part of ``A`` (the springs' ``L_w``, the
+triangles' ``sum_e w_e D D^T``), its ``rhs`` its local step at the current iterate
+(:func:`inertia_rhs` gives ``M y`` and the grabs'). The built-in kinds' part of ``A`` is
+assembled in one compiled pass (:func:`~deforma.physics.integrators.implicit.assembly.system_matrix`);
+another kind's entries are merged into it.
+
 Contacts are inside the solve (the projective-dynamics way). The vertices whose
 prediction ``y`` lies inside a collider are listed with the plane of the face they would
 leave by (:func:`~deforma.physics.colliders.response.contact_planes`); each gets the term
@@ -77,10 +84,9 @@ import numpy as np
 from numba import njit
 
 from ...colliders.geometry import advance_colliders
-from ...elements.triangles import implicit_element_rhs
 from ..base import (Integrator, Option, StepReport, contact_epilogue, finish_position_step, held_contacts,
                     register_integrator)
-from .assembly import element_weights, system_matrix, with_entries
+from .assembly import system_matrix, with_entries
 from .updated_factor import UpdatedFactor
 
 if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first built (0.1 s at start-up)
@@ -88,24 +94,16 @@ if TYPE_CHECKING:  # SciPy's sparse module is imported when a matrix is first bu
 
 
 @njit(cache=True)
-def implicit_rhs(x, x_n, y, vertex_mass, spring_i, spring_j, rest, wk, wd, grab_slot, grab_pull, h2, b):
-    """Right-hand side ``b`` (N, 2) of the global solve for the current iterate ``x``.
-
-    ``b = M y + h^2 S target + sum_e (wk_e l_e d_e + wd_e p_e) (e_j - e_i)``, the local step
-    (spring directions ``d_e`` and damping targets ``p_e``) fused into the assembly.
+def inertia_rhs(y, vertex_mass, grab_slot, grab_pull, h2, b):
+    """The inertia's and the grabs' part of the global solve's right-hand side: ``b = M y + h^2
+    S target`` (N, 2), kg m; the element kinds add theirs (``ElementKind.rhs``).
 
     Parameters
     ----------
-    x, x_n, y : (N, 2) float64
-        Current iterate, start of the substep, inertial prediction (m).
+    y : (N, 2) float64
+        Inertial prediction (m).
     vertex_mass : (N,) float64
-        kg.
-    spring_i, spring_j : (E,) int32
-        Spring ends.
-    rest : (E,) float64
-        Rest lengths (m).
-    wk, wd : (E,) float64
-        ``h^2 ks`` and ``h kd`` per spring (kg).
+        kg (times ``1 + h air_drag``).
     grab_slot : (N,) int32
         Grab entry per vertex or -1.
     grab_pull : (K, 3) float64
@@ -118,14 +116,13 @@ def implicit_rhs(x, x_n, y, vertex_mass, spring_i, spring_j, rest, wk, wd, grab_
     Examples
     --------
     >>> import numpy as np
-    >>> x = np.array([[0.0, 0.0], [2.0, 0.0]])
     >>> b = np.zeros((2, 2))
-    >>> implicit_rhs(x, x, x, np.ones(2), np.array([0], np.int32), np.array([1], np.int32), np.ones(1),
-    ...              np.ones(1), np.zeros(1), np.full(2, -1, np.int32), np.zeros((0, 3)), 1.0, b)
-    >>> b.tolist()  # M y plus the rest-length target 1 m along the spring
-    [[-1.0, 0.0], [3.0, 0.0]]
+    >>> inertia_rhs(np.array([[0.0, 0.0], [2.0, 0.0]]), np.ones(2), np.array([-1, 0], np.int32),
+    ...             np.array([[4.0, 8.0, 0.0]]), 0.25, b)
+    >>> b.tolist()  # M y, plus h^2 S target at the held vertex
+    [[0.0, 0.0], [4.0, 0.0]]
     """
-    for i in range(x.shape[0]):
+    for i in range(y.shape[0]):
         m = vertex_mass[i]
         b[i, 0] = m * y[i, 0]
         b[i, 1] = m * y[i, 1]
@@ -133,26 +130,6 @@ def implicit_rhs(x, x_n, y, vertex_mass, spring_i, spring_j, rest, wk, wd, grab_
         if g >= 0:
             b[i, 0] += h2 * grab_pull[g, 1]
             b[i, 1] += h2 * grab_pull[g, 2]
-    for e in range(spring_i.shape[0]):
-        i = np.uint64(spring_i[e])
-        j = np.uint64(spring_j[e])
-        dx = x[j, 0] - x[i, 0]
-        dy = x[j, 1] - x[i, 1]
-        length = np.sqrt(dx * dx + dy * dy)
-        if length > 0.0:
-            nx = dx / length
-            ny = dy / length
-        else:  # coincident ends: no direction, target the current (zero) vector
-            nx = 0.0
-            ny = 0.0
-        # p_e: x_ij minus its stretch since the substep began, along d
-        s = (dx - (x_n[j, 0] - x_n[i, 0])) * nx + (dy - (x_n[j, 1] - x_n[i, 1])) * ny
-        tx = wk[e] * rest[e] * nx + wd[e] * (dx - s * nx)
-        ty = wk[e] * rest[e] * ny + wd[e] * (dy - s * ny)
-        b[i, 0] -= tx
-        b[i, 1] -= ty
-        b[j, 0] += tx
-        b[j, 1] += ty
 
 
 @njit(cache=True)
@@ -373,7 +350,7 @@ class ImplicitEuler(Integrator):
         # forces (not only gravity) balance at rest as they do without drag.
         mass = model.vertex_mass * (1.0 + h * model.air_drag)
         patch = None
-        if torn is not None and self._patchable(old, model, torn, control, h):
+        if torn is not None and model.fused and self._patchable(old, model, torn, control, h):
             # a tear: only the columns of the vertices it touched are assembled again
             source = torn[1]
             fresh = torn[2] | (mass != self._mass[source]) | (model.pinned != old[0].pinned[source])
@@ -381,12 +358,17 @@ class ImplicitEuler(Integrator):
         # a patched column is the reference's where it was before; an assembled one may differ
         self._dirty = self._dirty[patch[2]] | patch[3] if patch is not None and self._dirty is not None else None
         self._mass = mass
-        self._we = element_weights(model, h)
-        self._a, self._diag = system_matrix(model, control.grab_slot, control.grab_pull, h, mass, patch, self._we)
+        self._weights = [k.matrix_weights(h) for k in model.elements]  # in the order of model.elements
+        self._a, self._diag = system_matrix(model, control.grab_slot, control.grab_pull, h, mass, patch,
+                                            self._weights, fused=model.fused)
+        if not model.fused:  # the assembly ran no kind: each gives its entries
+            for kind, weights in zip(model.elements, self._weights):
+                rows, cols, vals = kind.matrix_entries(h, weights)
+                self._a = with_entries(self._a, rows, cols, vals, model.pinned)
+                on = rows == cols
+                self._diag = self._diag + np.bincount(rows[on], vals[on], model.n_vertices)
         self._rows = None  # its rows, for free_estimate, made when a contact first needs them
         self._key = key
-        self._wk = h * h * model.spring_stiffness
-        self._wd = h * model.spring_damping
         self._pinned = np.flatnonzero(model.pinned)
         self._touching = None  # the contact terms must be added again
 
@@ -504,11 +486,9 @@ class ImplicitEuler(Integrator):
             changed = self._matrix_if_changed(model, self._touch[:count], triples, buf.s[:n_body])
             self._listed = np.concatenate([self._touch[:count], triples.ravel()])  # the vertices the contacts read
             for it in range(iterations):
-                implicit_rhs(x, x_n, y, self._mass, model.spring_i, model.spring_j, model.spring_rest_length,
-                             self._wk, self._wd, control.grab_slot, control.grab_pull, h2, b)
-                if len(model.elem):
-                    implicit_element_rhs(x, x_n, model.elem, model.elem_b, model.elem_area, model.elem_mu,
-                                         model.elem_lambda, model.elem_damping, model.elem_kind, self._we, h, b)
+                inertia_rhs(y, self._mass, control.grab_slot, control.grab_pull, h2, b)
+                for kind, weights in zip(model.elements, self._weights):
+                    kind.rhs(x, x_n, h, weights, b)
                 # The first projection is of the prediction, where the vertex is headed; the
                 # later ones of where the contact-free system would move the iterate
                 # (free_estimate says why not of the iterate itself).
