@@ -26,6 +26,9 @@ if TYPE_CHECKING:  # the World imports this module
     from .world import World
 
 
+SPRINGS = Material("springs")  # the seed's springs, what a body without a material is (immutable: shared)
+
+
 def _material(value):
     if value is None or isinstance(value, Material):
         return value
@@ -222,7 +225,7 @@ class Body:
         m = self._overrides["material"]
         if m is None:
             m = self._check().material
-        return Material("springs") if m is None else m
+        return SPRINGS if m is None else m
 
     @material.setter
     def material(self, value):

@@ -77,7 +77,7 @@ class Model:
         where each body's start.
     body_pressure, body_pressure_area : (B,) float64
         Each body's gas pressure at rest (N/m; 0 without gas) and the enclosed area at rest
-        (m^2).
+        (m^2); ``has_pressure`` whether any body holds a gas.
     gravity : (float, float)
         Acceleration of gravity (m/s^2), and ``air_drag`` (1/s): the World's, which it sets
         in place when they change (the Model is not rebuilt for them).
@@ -243,6 +243,8 @@ class Model:
                 custom.setdefault(kind, []).append(
                     BodyElements(b, self.topologies[b], m, int(self.body_vertex_offsets[b])))
         self.elements += [kind.build(bodies) for kind, bodies in custom.items()]
+        # whether the integrators' compiled drivers run every kind (the built-in pair)
+        self.fused = all(k.fused for k in self.elements)
 
     def _torn_elements(self, body: int, old: "Model", old_body: int) -> None:
         """Fill body ``body``'s elements from body ``old_body`` of Model ``old``, which a tear
@@ -326,17 +328,12 @@ class Model:
             self.body_pressure_area[b] = enclosed_area(t.rest_positions, loops[b][:, 0], loops[b][:, 1])
             self.body_pressure[b] = p
             loops[b] = loops[b] + self.body_vertex_offsets[b]
+        self.has_pressure = bool(self.body_pressure.any())  # read every step
         self.body_pressure_offsets = np.zeros(nb + 1, np.int64)
         np.cumsum([len(lp) for lp in loops], out=self.body_pressure_offsets[1:])
         edges = np.concatenate([np.zeros((0, 2), np.int32)] + loops).astype(np.int32)
         self.pressure_a = np.ascontiguousarray(edges[:, 0])
         self.pressure_b = np.ascontiguousarray(edges[:, 1])
-
-    @property
-    def fused(self) -> bool:
-        """Whether every element kind is one the integrators' compiled drivers run themselves
-        (the built-in springs and triangles); otherwise they loop over ``elements``."""
-        return all(k.fused for k in self.elements)
 
     @property
     def n_vertices(self) -> int:

@@ -32,16 +32,17 @@ class Undo:
     the plastic rest shape (copied only when a check after plasticity can fail this step),
     the tearing bodies' topology, the moving colliders' poses and the lost-shape counts."""
 
-    def __init__(self, world, *, late_check: bool):
+    def __init__(self, world, poses, *, late_check: bool):
         self.state = world._state
         self.model = world._model
         self.model_bodies = world._model_bodies
         self.control = world._control
         self.contacts = world._contacts
         self.lost_shape = dict(world._lost_shape)
-        self.poses = [(c, c.center, c.angle) for c in world._colliders if c.moving]
-        self.bodies = [(b, b._tear_state()) for b in world._bodies if b.material.tear_strain is not None]
+        self.poses = poses  # (collider, center, angle) of the moving ones
         m = self.model
+        self.bodies = [(b, b._tear_state()) for b, mat in zip(world._bodies, m.materials)
+                       if mat is not None and mat.tear_strain is not None]
         self.rest_shape = None
         if late_check and any(mat is not None and mat.yield_strain is not None for mat in m.materials):
             self.rest_shape = (m.spring_rest_length.copy(), m.elem_b.copy(), m.elem_area.copy(), m.version)
@@ -72,7 +73,8 @@ class Undo:
 def step(world) -> None:
     """Advance ``world`` by ``world.dt`` (the stages of the module docstring)."""
     w = world
-    moving = any(c.moving for c in w._colliders)
+    poses = [(c, c.center, c.angle) for c in w._colliders if c.moving]
+    moving = bool(poses)
     moved = w._colliders_changed()
     if moved:
         w._pack_colliders()
@@ -91,15 +93,15 @@ def step(world) -> None:
         w._rebuild_grabs()
     control = w._control
     control.step = w.step_count
-    control.clear_force()
+    if control.has_force:
+        control.clear_force()
     for body, vertices, forces in w._forces:  # body-local vertices: a rebuild since kept them
         control.add_force(body.vertex_slice.start + vertices, forces)
     start = w._start
     start.assign(w._state)
-    undo = Undo(w, late_check=w.step_count % SHAPE_CHECK_EVERY == 0)
+    undo = Undo(w, poses, late_check=w.step_count % SHAPE_CHECK_EVERY == 0)
     try:
         _integrate(w, start, moving)
-        poses = undo.poses
         for c, _, _ in poses:  # the kernels moved the packed copies; now the objects
             c.advance(w.dt)
         if moved or poses:
@@ -132,7 +134,7 @@ def _integrate(w, start, moving: bool) -> None:
     integrator, contacts, state = w._integrator, w._contacts, w._state
     h = w.dt / w.substeps
     while True:
-        if w._model.body_pressure.any():
+        if w._model.has_pressure:
             behaviours.apply_pressure(w._model, state, w.dt)
         contacts.clear_needed()
         report = integrator.step(w._model, start, state, w._control, contacts, h, substeps=w.substeps,
@@ -156,8 +158,8 @@ def tear_bodies(world) -> None:
     what it built for the old one."""
     w = world
     torn = False
-    for body in w._bodies:
-        limit = body.material.tear_strain
+    for body, material in zip(w._bodies, w._model.materials):  # the Model's: body.material makes one
+        limit = None if material is None else material.tear_strain
         if limit is None:
             continue
         topo = body.topology

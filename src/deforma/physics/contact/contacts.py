@@ -1,6 +1,6 @@
 """The contact stage's data: the bodies as it reads them (:class:`ContactTopology`), its
 scratch (:class:`ContactScratch`) and the contacts it finds (:class:`ContactBuffer`), the
-counters (:class:`ContactStatus`), :class:`Contacts`, which bundles them for a step, and
+counters (``CONTACT_STATUS``), :class:`Contacts`, which bundles them for a step, and
 :class:`ContactPoints`, what ``world.contacts`` shows a user.
 
 The three are namedtuples of arrays that :class:`~deforma.physics.model.Model`, the world
@@ -32,18 +32,20 @@ SIDE_MARGIN = 1e-3       # a crossing is put back at least this fraction of the 
 PROXIMITY = 1
 CROSSING = 2
 
-ContactStatus = namedtuple("ContactStatus", [  # each a (1,) int64 array, so that kernels write it
-    "contacts",         # contacts found by the first narrow phase of the last substep
-    "needed",           # > 0: the buffer's contact arrays were too small, this many are needed
-    "pairs_needed",     # > 0: ... its candidate pair arrays
-    "failsafe",         # substeps that needed the impact-zone fail-safe (cumulative)
-    "stamp",            # substeps run through the stage (cumulative)
-    "pairs",            # candidate pairs of the last substep
-    "active",           # collision vertices tested in the last substep
-    "dirty",            # length of ContactScratch.dirty
-    "generation",       # generations of checks (cumulative)
-    "touched",          # length of ContactScratch.touched
-])
+#: The stage's counters, one int64 record (``status.needed[0]``): named fields, and one array to pass.
+STATUS_FIELDS = (
+    ("contacts", np.int64),      # contacts found by the first narrow phase of the last substep
+    ("needed", np.int64),        # > 0: the buffer's contact arrays were too small, this many are needed
+    ("pairs_needed", np.int64),  # > 0: ... its candidate pair arrays
+    ("failsafe", np.int64),      # substeps that needed the impact-zone fail-safe (cumulative)
+    ("stamp", np.int64),         # substeps run through the stage (cumulative)
+    ("pairs", np.int64),         # candidate pairs of the last substep
+    ("active", np.int64),        # collision vertices tested in the last substep
+    ("dirty", np.int64),         # length of ContactScratch.dirty
+    ("generation", np.int64),    # generations of checks (cumulative)
+    ("touched", np.int64),       # length of ContactScratch.touched
+)
+CONTACT_STATUS = np.dtype(list(STATUS_FIELDS))
 
 
 ContactTopology = namedtuple("ContactTopology", [
@@ -87,7 +89,7 @@ ContactScratch = namedtuple("ContactScratch", [
     "grid",             # (3,) float64: origin x, origin y, 1 / cell size
     "parent",           # (V,) int32: impact zones (union-find)
     "zone",             # (V, 5) float64: zone sums m vx, m vy, m, members, still
-    "status",           # ContactStatus: counters, each a (1,) int64 array
+    "status",           # (1,) CONTACT_STATUS: the counters by name
 ])
 
 ContactBuffer = namedtuple("ContactBuffer", [
@@ -127,7 +129,7 @@ def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScr
                           np.zeros((n_edges, 4)), np.zeros((n_edges, 4), np.int64), np.zeros(t + 1, np.int64),
                           np.zeros(t, np.int64), np.zeros(16 * n_edges + 64, np.int32), np.zeros(3),
                           np.zeros(v, np.int32), np.zeros((v, 5)),
-                          ContactStatus(*(np.zeros(1, np.int64) for _ in ContactStatus._fields)))
+                          np.zeros(1, CONTACT_STATUS))
 
 
 def make_buffer(contacts: int, pairs: int) -> ContactBuffer:
@@ -224,7 +226,7 @@ class Contacts:
     --------
     >>> from deforma.physics.contact.contacts import empty_topology
     >>> c = Contacts.for_topology(empty_topology(), n_vertices=3)
-    >>> c.needed, int(c.status.stamp[0])
+    >>> c.needed, int(c.status["stamp"][0])
     ((0, 0), 0)
     """
 
@@ -246,20 +248,27 @@ class Contacts:
         return cls(buffer, scratch, make_hits(n_vertices))
 
     @property
-    def status(self) -> ContactStatus:
-        """The counters (:class:`ContactStatus`)."""
+    def status(self) -> np.ndarray:
+        """The counters: a (1,) record array of ``CONTACT_STATUS`` (``status["stamp"][0]``; in a
+        compiled kernel ``status.stamp[0]``)."""
         return self.scratch.status
+
+    @property
+    def complete(self) -> bool:
+        """Whether the buffer had room for everything the last step found."""
+        st = self.scratch.status
+        return not (st["needed"][0] or st["pairs_needed"][0])
 
     @property
     def needed(self) -> tuple[int, int]:
         """``(contacts, pairs)`` the buffer lacked room for in the last step (0, 0: it had room)."""
         st = self.scratch.status
-        return int(st.needed[0]), int(st.pairs_needed[0])
+        return int(st["needed"][0]), int(st["pairs_needed"][0])
 
     def clear_needed(self) -> None:
         """Forget what the last step lacked (before a step)."""
         st = self.scratch.status
-        st.needed[0] = st.pairs_needed[0] = 0
+        st["needed"][0] = st["pairs_needed"][0] = 0
 
     def grow(self) -> None:
         """Make the buffer twice what the last step needed (and no smaller than it is)."""
@@ -272,12 +281,13 @@ class Contacts:
         indices; ``rects`` are the packed colliders (for the coefficients each collider
         contact used)."""
         scr, buf, hits = self.scratch, self.buffer, self.hits
-        n = int(scr.status.contacts[0])
+        n = int(scr.status["contacts"][0])
         k = buf.vertex[:n]
         j = buf.edge[:n]
         cv = topo.cv_vertex.astype(np.int64)
         edge = np.stack([cv[topo.ce_a[j]], cv[topo.ce_b[j]]], axis=1) if n else np.zeros((0, 2), np.int64)
-        touched = np.flatnonzero(hits.stamp == scr.status.stamp[0]) if scr.status.stamp[0] > 0 else np.zeros(0, int)
+        stamp = scr.status["stamp"][0]
+        touched = np.flatnonzero(hits.stamp == stamp) if stamp > 0 else np.zeros(0, int)
         col = hits.collider[touched].astype(np.int64)
         m = len(touched)
         return ContactPoints(

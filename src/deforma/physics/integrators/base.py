@@ -35,7 +35,7 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -143,9 +143,8 @@ def contact_epilogue(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow):
     return contact_stage(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow)
 
 
-@dataclass(frozen=True)
-class StepReport:
-    """What :meth:`Integrator.step` says of the step it ran.
+class StepReport(NamedTuple):
+    """What :meth:`Integrator.step` says of the step it ran (a named tuple: made every step).
 
     Attributes
     ----------

@@ -248,6 +248,7 @@ class SymplecticEuler(Integrator):
         self._elem_chunks = np.zeros(1, np.int64)
         self._chunk_vertices = np.zeros((0, 2), np.int64)
         self._threads = None  # numba.get_num_threads(), re-read every 1024 steps
+        self._damped = (-1, None, False)  # (Model version, Model, whether any element is damped)
         self._ticks = 0
         self._reset_timing()
 
@@ -303,6 +304,8 @@ class SymplecticEuler(Integrator):
             self._chunks, self._elem_chunks, self._chunk_vertices = merged_chunks(
                 model.spring_i, model.spring_j, model.elem, n_chunks)
             self._reset_timing()
+        if self._damped[0] != model.version or self._damped[1] is not model:  # a material may change it in place
+            self._damped = (model.version, model, bool(model.elem_damping.any()))
         if not may_parallel:
             which = "serial"
         elif mode == "parallel":
@@ -320,7 +323,7 @@ class SymplecticEuler(Integrator):
                          model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
                          model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
                          model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
-                         bool(model.elem_damping.any()), *common, control.force, control.has_force, *tail,
+                         self._damped[2], *common, control.force, control.has_force, *tail,
                          int(substeps), float(max_speed) ** 2)
         else:
             bad = self._step_kinds(kernel, model, state_out, control, contacts, substeps, max_speed, common, tail)
@@ -332,7 +335,7 @@ class SymplecticEuler(Integrator):
                 del smp[:-3]
                 self._estimate[which] = sorted(smp)[len(smp) // 2]  # median: one outlier is ignored
             self._last = which
-        return StepReport(int(bad), contacts.needed == (0, 0))
+        return StepReport(int(bad), contacts.complete)
 
     def _step_kinds(self, kernel, model, state, control, contacts, substeps, max_speed, common, tail) -> int:
         """The substeps one at a time, the forces of every element kind summed by the kinds
@@ -352,6 +355,6 @@ class SymplecticEuler(Integrator):
                 force += control.force
             bad = kernel(x, v, self._fbuf, ptr, self._chunk_vertices, *no_springs, ptr, *no_elements, *common,
                          force, True, *tail, 1, float(max_speed) ** 2)
-            if bad or contacts.needed != (0, 0):
+            if bad or not contacts.complete:
                 return bad
         return 0

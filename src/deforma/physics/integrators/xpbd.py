@@ -295,7 +295,7 @@ class XPBD(Integrator):
         gx, gy = model.gravity
         if not model.fused:
             bad = self._step_kinds(model, state_out, control, contacts, h, substeps, max_speed)
-            return StepReport(int(bad), contacts.needed == (0, 0))
+            return StepReport(int(bad), contacts.complete)
         # the colours' order is drawn from the step's index: a step repeated (after the
         # contact buffer grew) draws the same
         bad = xpbd_substeps(state_out.x, state_out.v, self._x_prev, self._lam, self._planes, self._touch,
@@ -307,7 +307,7 @@ class XPBD(Integrator):
                             control.has_force, control.grab_slot, control.grab_pull, control.colliders, contacts.hits,
                             model.contact, contacts.scratch, contacts.buffer, float(h), int(substeps),
                             int(self._options["iterations"]), float(max_speed) ** 2)
-        return StepReport(int(bad), contacts.needed == (0, 0))
+        return StepReport(int(bad), contacts.complete)
 
     def _step_kinds(self, model, state, control, contacts, h, substeps, max_speed) -> int:
         """:func:`xpbd_substeps` with the loop over the element kinds in Python: each kind
@@ -336,7 +336,8 @@ class XPBD(Integrator):
                 project_contacts(x, self._x_prev, model.vertex_inv_mass, topo, buf, n_body, stick)
                 for kind in model.elements:
                     kind.project(x, self._x_prev, model.vertex_inv_mass, h, sequence)
-            bad = finish_position_step(x, v, self._x_prev, rects, contacts.hits, scr.status.stamp[0] + 1, h, vmax2)
+            bad = finish_position_step(x, v, self._x_prev, rects, contacts.hits, scr.status["stamp"][0] + 1, h,
+                                       vmax2)
             if bad:
                 return bad
             if contact_epilogue(x, v, model.vertex_inv_mass, topo, scr, buf, rects, contacts.hits, h, True) < 0:

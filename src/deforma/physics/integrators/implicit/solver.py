@@ -508,7 +508,7 @@ class ImplicitEuler(Integrator):
                     changed = None
                 else:
                     x[...] = self._factor.solve(b)
-            bad = finish_position_step(x, v, x_n, rects, hits, scr.status.stamp[0] + 1, float(h), vmax2)
+            bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, float(h), vmax2)
             if bad:
                 return StepReport(int(bad), True)
             # scr.xp still holds x_n (detect_contacts only read it): no second gather_start; the
