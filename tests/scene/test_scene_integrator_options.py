@@ -16,29 +16,14 @@ from deforma.cli import EXIT_ERROR, main
 from deforma.physics.integrators import make_integrator
 from deforma.scene import SceneError
 from deforma.scene.schema import PhysicsSettings, Scene
-
-SCENE = """
-[physics]
-dt = 0.0166667
-stiffness = 2000.0
-integrator = "{integrator}"
-{options}
-[[body]]
-shape = "box"
-corners = [[-0.5, -0.25], [0.5, -0.25], [0.5, 0.25], [-0.5, 0.25]]
-detail = 3
-position = [0.0, 0.3]
-
-[[collider]]
-center = [0.0, -0.25]
-size = [4.0, 0.5]
-"""
+from scene_checks import write
+from test_scene_integrator import SCENE
 
 
 def scene_file(tmp_path, integrator, options="", name="s.toml"):
-    p = tmp_path / name
-    p.write_text(SCENE.format(integrator=integrator, options=options))
-    return p
+    """The small scene of test_scene_integrator.py under ``integrator``, with ``options`` (TOML,
+    a [physics.integrator_options] table) after it."""
+    return write(tmp_path, SCENE.format(name=integrator) + options, name)
 
 
 def test_a_world_built_from_a_scene_has_its_options_and_steps(tmp_path):

@@ -13,7 +13,8 @@ from deforma.viewer.session import Session
 from seed_scenes import seed
 from test_viewer import choose_from_menu, post, run
 
-ROWS = {"symplectic-euler": ["integrator_mode"], "implicit-euler": ["integrator_iterations", "integrator_contact_weight"],
+ROWS = {"symplectic-euler": ["integrator_mode"],
+        "implicit-euler": ["integrator_iterations", "integrator_contact_weight"],
         "xpbd": ["integrator_iterations"]}
 
 
@@ -21,7 +22,8 @@ def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
     rows = {p.name: p for p in integrator_params()}
     assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_contact_weight"]
     assert not set(rows) & set(PARAMS)
-    assert rows["integrator_mode"].kind == "choice" and rows["integrator_mode"].choices == ("auto", "serial", "parallel")
+    mode = rows["integrator_mode"]
+    assert mode.kind == "choice" and mode.choices == ("auto", "serial", "parallel")
     assert rows["integrator_iterations"].kind == "int" and rows["integrator_iterations"].log
     assert (rows["integrator_contact_weight"].lo, rows["integrator_contact_weight"].hi) == (0.1, 1000.0)
 
@@ -45,10 +47,13 @@ def test_the_session_sets_an_option_by_name_and_keeps_the_others(tmp_path):
 BAD = [
     ("integrator_iterations", 0, "implicit-euler option iterations must be an integer in [1, 10000], got 0"),
     ("integrator_iterations", 2.5, "implicit-euler option iterations must be an integer in [1, 10000], got 2.5"),
-    ("integrator_contact_weight", -1.0, "implicit-euler option contact_weight must be a number in (0, 1e+12), got -1.0"),
-    ("integrator_contact_weight", "x", "implicit-euler option contact_weight must be a number in (0, 1e+12), got 'x'"),
+    ("integrator_contact_weight", -1.0,
+     "implicit-euler option contact_weight must be a number in (0, 1e+12), got -1.0"),
+    ("integrator_contact_weight", "x",
+     "implicit-euler option contact_weight must be a number in (0, 1e+12), got 'x'"),
     ("integrator_mode", "serial",
-     "'mode' is an option of symplectic-euler, not of implicit-euler (implicit-euler takes iterations, contact_weight)"),
+     "'mode' is an option of symplectic-euler, not of implicit-euler "
+     "(implicit-euler takes iterations, contact_weight)"),
 ]
 
 
