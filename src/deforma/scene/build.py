@@ -107,6 +107,15 @@ def load_scene(name_or_path):
     return build(load(name_or_path))
 
 
+def _integrator_option_keys(world) -> tuple:
+    """``[physics.integrator_options]`` for the world as it is now: the options that differ
+    from the integrator's defaults (a saved scene states only what was chosen)."""
+    from ..physics.integrators import make_integrator
+
+    defaults = make_integrator(world.integrator).options
+    return tuple((k, v) for k, v in world.integrator_options.items() if v != defaults[k])
+
+
 def _material_keys(world, recorded: PhysicsSettings) -> dict:
     """``[physics]``'s material keys for the world as it is now."""
     m = world.material
@@ -183,7 +192,15 @@ def scene_of(world) -> Scene:
     whose own material equals the world's is written as following the world). A
     finite-element body has no spring mass, stiffness or damping to write. Pins: the spec's
     ``pin`` box is kept while the body's pinned vertices are exactly those inside it;
-    otherwise they are written as ``pin_vertices``.
+    otherwise they are written as ``pin_vertices``. Integrator options: those that differ from
+    the integrator's defaults (``physics.integrator_options``; none when all are defaults).
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World(integrator="implicit-euler", integrator_options={"iterations": 5})
+    >>> scene_of(w).physics.integrator_options
+    (('iterations', 5),)
     """
     rec = build_record(world)
     scene = rec.scene if rec is not None else Scene()
@@ -193,7 +210,8 @@ def scene_of(world) -> Scene:
         friction=float(world.friction), static_friction=float(world.static_friction),
         max_speed=float(world.max_speed), integrator=world.integrator,
         contact_thickness=None if world.contact_thickness is None else float(world.contact_thickness),
-        air_drag=float(world.air_drag), **_material_keys(world, scene.physics),
+        air_drag=float(world.air_drag), integrator_options=_integrator_option_keys(world),
+        **_material_keys(world, scene.physics),
     )
     interaction = InteractionSettings(explosive_force=scene.interaction.explosive_force,
                                       mouse_strength=float(world.grab_strength))
@@ -330,8 +348,10 @@ def _inline_short_arrays(text: str) -> str:
 def save_scene(world, path) -> Path:
     """Write ``world`` (or a :class:`Scene`) to a TOML scene file that :func:`load_scene` reads back.
 
-    Every key is written, defaults included. The file appears whole or not at all (it is
-    written beside the target and renamed).
+    Every key is written, defaults included, except integrator options, of which only those
+    that differ from the integrator's defaults are (``[physics.integrator_options]``, left out
+    when there are none). The file appears whole or not at all (it is written beside the target
+    and renamed).
 
     Parameters
     ----------

@@ -158,6 +158,12 @@ def build(scene: Scene):
         raise SceneError(f"{source}: physics{'' if e.key is None else '.' + e.key}: {e}") from None
     except ValueError as e:
         raise SceneError(f"{source}: physics: {e}") from None
+    if p.integrator_options:
+        # a file's options were checked when it was read; a Scene made in code is checked here
+        try:
+            world.integrator_options = dict(p.integrator_options)
+        except ValueError as e:  # the message names the option and what it allows
+            raise SceneError(f"{source}: physics.integrator_options: {e}") from None
     bodies = []
     for i, spec in enumerate(scene.body):
         try:

@@ -21,6 +21,10 @@ A file looks like::
     [physics]
     dt = 0.0016667
     stiffness = 1000.0
+    integrator = "implicit-euler"
+
+    [physics.integrator_options]    # the integrator's own settings; left out: its defaults
+    iterations = 5
 
     [[body]]
     shape = "box"
@@ -44,7 +48,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 # an image body's background: the rule of deforma.mesh.from_image itself
@@ -267,6 +271,12 @@ def _convert(value, meta, path, ctx):
         if not isinstance(value, str) or not value:
             raise _Problem(path, f"expected a built-in picture name or an image path, got {_show(value)}")
         return ctx["resolve_picture"](value, path)
+    if kind == "options":
+        # names and values are the integrator's to check (_check_integrator_options), once
+        # the table's integrator is known
+        if not isinstance(value, dict):
+            raise _Problem(path, f"expected a table of name = value ([{path}]), got {_show(value)}")
+        return tuple(value.items())
     raise AssertionError(kind)  # pragma: no cover
 
 
@@ -340,8 +350,6 @@ def with_springs(scene: Scene) -> Scene:
     >>> s.physics.material, s.body[0].material
     ('springs', None)
     """
-    from dataclasses import replace
-
     physics = replace(scene.physics, material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
                       material_damping=0.0)
     # the behaviours (tearing, plasticity, stretch limit) work for springs too: they stay
@@ -398,6 +406,27 @@ def _check_integrator(name: str, path: str) -> None:
         raise _Problem(path, f"unknown value {name!r}; {hint}allowed: {', '.join(names)}")
 
 
+def _check_integrator_options(physics: PhysicsSettings, path: str) -> PhysicsSettings:
+    """``physics`` with its integrator options checked against its integrator and kept as it
+    keeps them (an int, a float, a choice), in the order the integrator lists them."""
+    from ..physics.integrators import make_integrator
+    from ..physics.integrators.base import unknown_option
+
+    name = physics.integrator
+    options = {o.name: o for o in type(make_integrator(name)).OPTIONS}
+    given = {}
+    for key, value in physics.integrator_options:
+        if key not in options:
+            raise _Problem(f"{path}.{key}", unknown_option(key, name))
+        if options[key].kind == "int" and isinstance(value, float) and value.is_integer():
+            value = int(value)  # as for the file's other integer keys (substeps = 2.0)
+        try:
+            given[key] = options[key].check(value, name)
+        except ValueError as e:
+            raise _Problem(f"{path}.{key}", str(e)) from None
+    return replace(physics, integrator_options=tuple((k, given[k]) for k in options if k in given))
+
+
 def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
     """Validate a TOML document (as a dict) and make a :class:`Scene`.
 
@@ -449,6 +478,7 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
                 values[name] = _table(cls, data[name], name, ctx)
         if "physics" in values:
             _check_integrator(values["physics"].integrator, "physics.integrator")
+            values["physics"] = _check_integrator_options(values["physics"], "physics.integrator_options")
         for name, cls in ARRAYS.items():
             if name in data:
                 items = data[name]
@@ -491,7 +521,11 @@ def _record(obj, *, base_dir, always=()) -> dict:
             continue
         if f.name not in always and v == getattr(defaults, f.name):
             continue
-        if f.metadata["kind"] == "file":
+        if f.metadata["kind"] == "options":
+            if not v:  # no table rather than an empty one: every option has its default
+                continue
+            v = dict(v)
+        elif f.metadata["kind"] == "file":
             v = texture_reference(v, base_dir=base_dir)
         elif f.metadata["kind"] == "picture":
             v = picture_reference(v, base_dir=base_dir)

@@ -18,6 +18,11 @@ own material, each key it leaves out taken from ``[physics]``. :func:`material_s
 says what a table means and refuses the combinations that mean nothing (finite-element
 parameters on springs, spring mass on finite elements, a finite-element model without E).
 
+Integrator options: ``[physics.integrator_options]`` holds the settings of ``[physics]
+integrator`` by name (``iterations = 5``); what names and values it takes is the integrator's
+own (``deforma.physics.integrators``), so :func:`deforma.scene.schema.parse_scene` checks them
+against it, and :class:`PhysicsSettings` keeps them as ``(name, value)`` pairs.
+
 Examples
 --------
 >>> BoxBody(detail=4).corners
@@ -71,7 +76,9 @@ def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, 
     ``kind`` is one of float, int, bool, str, vec2, size2, quad, color, colors2, file, points,
     loops (a list of point lists), triangles, box2 (two corners of an axis-aligned box), indices
     (a list of integers >= 0), background (one of ``choices`` or a colour '#rrggbb'), picture
-    (an image collider's source: a built-in level or texture name, or an image path).
+    (an image collider's source: a built-in level or texture name, or an image path), options
+    (a sub-table of name = value, kept as ``(name, value)`` pairs: the integrator's options,
+    whose names and values the integrator itself checks).
     ``lo``/``hi`` bound numbers (``lo_open``/``hi_open`` make a bound exclusive).
     """
     meta = dict(kind=kind, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, choices=choices, unit=unit, doc=doc)
@@ -134,6 +141,12 @@ class PhysicsSettings:
     integrator: str = spec("str", "symplectic-euler",
                            doc="Time integrator by name: symplectic-euler (explicit, the original's), "
                                "implicit-euler or xpbd (both stable at any dt; see docs/integrators.md).")
+    integrator_options: tuple = spec("options", (),
+                                     doc="The integrator's own settings, a sub-table [physics.integrator_options] "
+                                         "of name = value: iterations and contact_weight of implicit-euler, "
+                                         "iterations of xpbd, mode of symplectic-euler (docs/integrators.md, "
+                                         "Options). Each is checked against integrator; one left out has its "
+                                         "default.")
     contact_thickness: float | None = spec("float", None, lo=0.0, lo_open=True, unit="m",
                                            doc="How far apart touching bodies stay; below every colliding body's "
                                                "shortest outline edge. Omit for 5% of each body's median outline "

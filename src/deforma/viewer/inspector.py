@@ -2,7 +2,10 @@
 
 Rows follow the original Unity inspector's groups (Square, Texture, Physics, Collision,
 Mouse), plus Material (the world's model and its finite-element parameters, the selected
-body's behaviours and gas pressure) and Contact.
+body's behaviours and gas pressure) and Contact. Under the Integrator drop-down are the
+options of the integrator in force (a drop-down for a choice, slider and text box for a
+number); the rows of the options it does not take are hidden, and the rows below move up or
+down when another integrator takes more or fewer.
 Each number has a slider (a comfortable range, log-scaled where values span decades) and a
 text box (any value the session accepts; Enter applies it). A value that may be off (a
 material behaviour, a body's gas pressure) shows "off" in its otherwise empty box: emptying
@@ -24,7 +27,7 @@ from pygame_gui.elements import (UIButton, UICheckBox, UIDropDownMenu, UIHorizon
                                  UIScrollingContainer, UITextBox, UITextEntryLine)
 
 from ..physics import available_integrators
-from .params import GROUPS, PARAMS, Param, format_value, parse_value
+from .params import GROUPS, Param, format_value, integrator_params, parse_value
 from .session import COLLIDER_FIELDS, COLLIDER_SHAPES, MATERIAL_MODELS, OBJECTS
 
 __all__ = ["PANEL_WIDTH", "Inspector"]
@@ -93,8 +96,17 @@ class _Row:
         self.slider = None
         self.entry = None
         self.check = None
+        self.menu = None           # a choice's drop-down, and the value it was made showing
+        self.menu_rect = None
+        self.menu_made_for = None
+        self.label = None
+        self.top = 0               # y of the row in the scrolling area, pixels
         self.shown = object()      # value last shown, to touch widgets only on change
         self.slider_value = None   # slider position last set by us; a different one was the user
+
+    def widgets(self) -> list:
+        """The row's widgets, its label first."""
+        return [w for w in (self.label, self.slider, self.entry, self.check, self.menu) if w is not None]
 
 
 class Inspector:
@@ -162,6 +174,14 @@ class Inspector:
                 self._integrator_rect = pygame.Rect(124, y, 188, 24)
                 self._make_integrator_menu()
                 y += ROW
+                # a row for every integrator's options (read from the registry, as the
+                # menu's names are), indented under it; _place_option_rows() then shows those
+                # of the integrator in force and closes the gap the others leave
+                self._options_top = y
+                self._option_rows = tuple(p.name for p in integrator_params())
+                for p in integrator_params():
+                    self.rows[p.name] = self._row(p, y, indent=10)
+                    y += ROW
             if group == "Material":
                 UILabel(pygame.Rect(14, y, 108, 24), "Model", m, container=c)
                 self._material_rect = pygame.Rect(124, y, 188, 24)
@@ -185,24 +205,36 @@ class Inspector:
                 self.rows[p.name] = self._row(p, y)
                 y += ROW
             y += 6
-        c.set_scrollable_area_dimensions((PANEL_WIDTH - 20, y + 4))
+        self._scroll_height = y + 4
+        c.set_scrollable_area_dimensions((PANEL_WIDTH - 20, self._scroll_height))
+        self._all_option_rows = self._option_rows
+        self._place_option_rows()
         self.message_box = UITextBox("", pygame.Rect(8, h - MESSAGE_HEIGHT + 2, PANEL_WIDTH - 16,
                                                      MESSAGE_HEIGHT - 6), m)
 
-    def _row(self, p: Param, y: int) -> _Row:
+    def _row(self, p: Param, y: int, *, indent: int = 0) -> _Row:
         m, c = self.manager, self.scroll
         row = _Row(p)
         # the unit when it fits; docs/viewer.md lists them all
         label = p.label + (f" ({p.unit})" if p.unit and len(p.label) + len(p.unit) <= 13 else "")
-        UILabel(pygame.Rect(12, y, 113, 24), label, m, container=c)
+        row.top = y
+        row.label = UILabel(pygame.Rect(12 + indent, y, 113 - indent, 24), label, m, container=c)
         if p.kind == "bool":
             row.check = UICheckBox(pygame.Rect(124, y + 3, 18, 18), "", m, container=c)
+        elif p.kind == "choice":
+            row.menu_rect = pygame.Rect(124, y, 188, 24)
+            self._make_choice_menu(row, p.choices[0])
         else:
             row.slider = UIHorizontalSlider(pygame.Rect(124, y + 3, 112, 18), 0.0, (0.0, 1.0), m, container=c,
                                             click_increment=0.02)
             row.entry = UITextEntryLine(pygame.Rect(240, y, 72, 24), m, container=c,
                                         placeholder_text=p.off_text if p.optional else None)
         return row
+
+    def _make_choice_menu(self, row: _Row, shown) -> None:
+        row.menu_made_for = shown
+        row.menu = UIDropDownMenu(list(row.param.choices), shown, row.menu_rect, self.manager, container=self.scroll,
+                                  expansion_height_limit=len(row.param.choices) * 26)
 
     def _make_menu(self) -> None:
         self._menu_made_for = self._selected_text()
@@ -268,6 +300,11 @@ class Inspector:
         elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED and event.ui_element is self.material_menu:
             self.apply_material(event.text)
             used = True
+        elif t == pygame_gui.UI_DROP_DOWN_MENU_CHANGED:
+            for name, row in self.rows.items():
+                if row.menu is event.ui_element:
+                    self.apply(name, event.text)
+                    used = True
         return bool(used)
 
     def _button(self, el) -> None:
@@ -316,14 +353,16 @@ class Inspector:
             self.rows[name].shown = object()
             return True
         ok = self._try(lambda: self.session.set_param(name, value))
-        if ok and PARAMS[name].rebuild:
+        row = self.rows[name]
+        if ok and row.param.rebuild:
             self.say(self._mesh_summary(), error=self.session.note_is_warning)
         elif ok and self.session.note:  # e.g. substeps raised for a stiffer material
             self.say(self.session.note, error=self.session.note_is_warning)
         elif ok and self.message_is_error:
             self.say("")
-        self.rows[name].shown = object()
-        self.refresh()
+        row.shown = object()
+        # a refused choice: its drop-down shows what was clicked, so it is made anew
+        self.refresh(force=not ok and row.menu is not None)
         return ok
 
     def apply_object(self, name: str) -> bool:
@@ -412,12 +451,19 @@ class Inspector:
     def refresh(self, *, force: bool = False) -> None:
         """Make the widgets show the session's current values (only widgets whose value changed)."""
         s = self.session
+        if s.integrator_params() != self._option_rows:  # switched here, by a key or in code
+            self._place_option_rows()
+            force = True
         for name, row in self.rows.items():
             value = s.get_param(name)
             if not force and value == row.shown:
                 continue
             row.shown = value
             self.dirty = True
+            if row.menu is not None:
+                if value is not None:  # None: a hidden row, an option the integrator does not take
+                    self._refresh_choice(row, value, force)
+                continue
             if row.check is not None:
                 if row.check.get_state() != bool(value):
                     row.check.set_state(bool(value))
@@ -470,6 +516,59 @@ class Inspector:
             colour = "#c0392b" if self.message_is_error else "#2b3846"
             safe = self.message.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
             self.message_box.set_text(f'<font color="{colour}">{safe}</font>')
+
+    def _place_option_rows(self) -> None:
+        """Show the option rows of the integrator in force, in order under the Integrator
+        drop-down, and hide (and disable) the others; the widgets below move up or down to
+        close or open the gap. Widgets are moved, not made anew, so that a reference to one
+        stays good across a switch."""
+        taken = self.session.integrator_params()
+        top = self._options_top
+        rows = [self.rows[name] for name in self._all_option_rows]
+        dy = (len(taken) - len(self._option_rows)) * ROW
+        if dy:
+            mine = {id(w) for row in rows for w in row.widgets()}
+            self._shift_below(top + len(self._option_rows) * ROW, dy, skip=mine)
+            self._scroll_height += dy
+            self.scroll.set_scrollable_area_dimensions((PANEL_WIDTH - 20, self._scroll_height))
+        for row in rows:
+            shown = row.param.name in taken
+            y = top + taken.index(row.param.name) * ROW if shown else top
+            for w in row.widgets():
+                w.set_relative_position((w.relative_rect.left, w.relative_rect.top + y - row.top))
+                # disabled too: a hidden widget must not take a click meant for the row shown there
+                if shown:
+                    w.show()
+                    w.enable()
+                else:
+                    w.hide()
+                    w.disable()
+            if row.menu_rect is not None:
+                row.menu_rect.move_ip(0, y - row.top)
+            row.top = y
+        self._option_rows = taken
+        self.dirty = True
+
+    def _shift_below(self, top: int, dy: int, *, skip=frozenset()) -> None:
+        """Move every widget of the scrolling area from ``top`` down by ``dy`` pixels (up if
+        negative), and the places where drop-downs are made anew, except the widgets in ``skip``."""
+        elements = self.scroll.scrollable_container.elements
+        # a slider keeps its buttons in a container beside it, which it moves itself
+        owned = {id(getattr(e, "button_container", None)) for e in elements}
+        for e in list(elements):
+            r = e.relative_rect
+            if r.top >= top and id(e) not in owned and id(e) not in skip:
+                e.set_relative_position((r.left, r.top + dy))
+        for rect in (self._menu_rect, self._integrator_rect, self._material_rect, self._shape_rect):
+            if rect.top >= top:
+                rect.move_ip(0, dy)
+
+    def _refresh_choice(self, row: _Row, shown, force: bool) -> None:
+        # as the other drop-downs (see refresh): made anew when the value changed behind it
+        if shown != row.menu_made_for or (force and row.menu.selected_option[0] != shown):
+            row.menu.kill()
+            self._make_choice_menu(row, shown)
+            self.dirty = True
 
     def set_paused(self, paused: bool) -> None:
         """Label the pause button for the current state."""

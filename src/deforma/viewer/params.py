@@ -4,6 +4,10 @@ Plain data (no GUI): :mod:`deforma.viewer.inspector` makes a row of widgets for 
 :class:`Param`, and :meth:`deforma.viewer.session.Session.set_param` applies values by name.
 Slider ranges are what is comfortable to drag; the text box beside each slider accepts any
 value the session accepts (it refuses the others with a message).
+
+The rows of the integrators' options are not fixed data but read from the integrator registry
+(:func:`integrator_params`), as the Integrator drop-down's names are, so that an integrator
+registered by the user shows its options too.
 """
 
 from __future__ import annotations
@@ -11,15 +15,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["GROUPS", "PARAMS", "Param", "format_value", "parse_value"]
+from ..physics.integrators import available_integrators, make_integrator
+
+__all__ = ["GROUPS", "INTEGRATOR_PREFIX", "PARAMS", "Param", "format_value", "integrator_params", "option_param",
+           "parse_value"]
 
 
 @dataclass(frozen=True)
 class Param:
     """One inspector row.
 
-    ``kind`` is ``float``, ``int`` or ``bool``; ``lo``/``hi`` the slider's range and ``log``
-    whether it moves in equal ratios (stiffness from 10 to 100000 N/m needs that).
+    ``kind`` is ``float``, ``int``, ``bool`` or ``choice`` (a drop-down of ``choices``);
+    ``lo``/``hi`` the slider's range and ``log`` whether it moves in equal ratios (stiffness
+    from 10 to 100000 N/m needs that).
     ``rebuild`` marks values that rebuild the body (the original's mesh settings).
     ``optional`` marks values that may be off (``None``: a material behaviour that is not
     used, a body without gas, a collider's friction that follows the world's): an empty text
@@ -37,6 +45,7 @@ class Param:
     tip: str = ""
     optional: bool = False
     off_text: str = "off"
+    choices: tuple = ()
 
     def to_slider(self, value: float) -> float:
         """Slider position in [0, 1] for ``value`` (clamped)."""
@@ -133,6 +142,54 @@ GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
 )
 
 PARAMS: dict[str, Param] = {p.name: p for _, group in GROUPS for p in group}
+
+#: The rows of integrator options are named by this prefix and the option's name:
+#: ``integrator_iterations`` is the ``iterations`` of the integrator in force.
+INTEGRATOR_PREFIX = "integrator_"
+
+
+def option_param(option) -> Param:
+    """The inspector row of an integrator option
+    (:class:`deforma.physics.integrators.base.Option`).
+
+    A choice is a drop-down of its choices; a number has a slider from a hundredth to a
+    hundred times its default (log-scaled; linear, from default - 1 to default + 1, for a
+    default <= 0), within what the option allows, and a text box that takes anything the
+    integrator accepts.
+
+    Examples
+    --------
+    >>> from deforma.physics.integrators.base import Option
+    >>> p = option_param(Option("contact_weight", 10.0, "float", low=0.0, high=1e12))
+    >>> p.name, p.label, p.lo, p.hi, p.log
+    ('integrator_contact_weight', 'Contact weight', 0.1, 1000.0, True)
+    """
+    name, label = INTEGRATOR_PREFIX + option.name, option.name.replace("_", " ").capitalize()
+    if option.kind == "choice":
+        return Param(name, label, "choice", choices=tuple(option.choices), tip=option.doc)
+    default = float(option.default)
+    if default > 0:
+        lo, hi = max(default / 100, option.low), min(default * 100, option.high)
+    else:
+        lo, hi = max(default - 1, option.low), min(default + 1, option.high)
+    return Param(name, label, option.kind, float(lo), float(hi), log=lo > 0, tip=option.doc)
+
+
+def integrator_params() -> tuple[Param, ...]:
+    """The rows of every registered integrator's options, in registry order, one per option
+    name: a name several integrators take (``iterations``) is one row, which shows and sets
+    the option of the integrator in force (its slider is the first integrator's).
+
+    Examples
+    --------
+    >>> [p.name for p in integrator_params()][:3]
+    ['integrator_mode', 'integrator_iterations', 'integrator_contact_weight']
+    """
+    rows = {}
+    for integrator in available_integrators():
+        for option in type(make_integrator(integrator)).OPTIONS:
+            rows.setdefault(option.name, option_param(option))
+    return tuple(rows.values())
 
 
 def format_value(param: Param, value) -> str:

@@ -9,6 +9,8 @@ A :class:`Session` owns the live :class:`deforma.World` and knows how it was mad
   their starting positions, every other setting is kept;
 - the world's material (springs or finite elements, with E, nu, density, damping) is
   switched on the running world, raising substeps where the explicit integrator needs it;
+- the integrator is switched, and its options (``integrator_iterations``, ...) set, on the
+  running world;
 - the selected body's material behaviours (tearing, plasticity, stretch limit) and its gas
   pressure are set on the running world;
 - vertices are pinned and unpinned where the pointer is;
@@ -29,10 +31,12 @@ import numpy as np
 
 from ..physics import Circle, Material, Polygon, Rect, Segment, available_integrators
 from ..physics.diagnostics import xpbd_advice
+from ..physics.integrators.base import unknown_option
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 from ..scene.construct import pin_mask
 from ..scene.tables import MATERIAL_MODELS, BodyPhysics
+from .params import INTEGRATOR_PREFIX, integrator_params
 
 def _builtin_texture_names() -> tuple:
     """The built-in textures the Selected menu offers, in the original's order where it has them
@@ -203,6 +207,8 @@ class Session:
         #: E, nu, density and damping of the finite-element models: the world's while it has
         #: one; kept while it is springs, so switching back restores them.
         self.material_values = self._initial_material_values(scene.physics)
+        # the option rows there are, read once: the registry is not walked for every frame's read
+        self._option_rows = tuple(p.name for p in integrator_params())
 
     def _initial_material_values(self, physics) -> dict:
         m = self.world.material
@@ -275,6 +281,8 @@ class Session:
                 return None
             value = getattr(c, attr)
             return value if part is None else value[part]
+        if name in self._option_rows:  # None: an option the integrator in force does not take
+            return w.integrator_options.get(name.removeprefix(INTEGRATOR_PREFIX))
         raise KeyError(f"unknown parameter {name!r}")
 
     def set_param(self, name: str, value) -> None:
@@ -331,6 +339,8 @@ class Session:
             self._set_mesh(scale=v)
         elif name in COLLIDER_FIELDS:
             self._edit_collider(name, value)
+        elif name in self._option_rows:
+            self.set_integrator_option(name.removeprefix(INTEGRATOR_PREFIX), value)
         else:
             raise KeyError(f"unknown parameter {name!r}")
         if name in ("substeps", "dt", "gravity_x", "gravity_y"):
@@ -499,6 +509,54 @@ class Session:
             # experiment (watch it blow up); say beforehand what will happen
             self.note = (f"dt/substeps {h:.2g} s exceeds the explicit stable estimate {stable:.2g} s: "
                          f"expect a blow-up unless you raise substeps")
+
+    @property
+    def integrator_options(self) -> dict:
+        """The running world's integrator options by name (a new dict; ``docs/integrators.md``)."""
+        return self.world.integrator_options
+
+    def integrator_params(self) -> tuple:
+        """Names of the option rows the integrator in force takes (the others are greyed out)."""
+        taken = self.world.integrator_options
+        return tuple(n for n in self._option_rows if n.removeprefix(INTEGRATOR_PREFIX) in taken)
+
+    def set_integrator_option(self, name: str, value) -> None:
+        """Set one option of the running world's integrator; its other options keep their values.
+
+        Parameters
+        ----------
+        name : str
+            The option's name (``"iterations"``, ``"contact_weight"``, ``"mode"``: the
+            integrator in force's, see ``docs/integrators.md``).
+        value : int, float or str
+            What the option takes; a whole float is taken for an integer option (a slider's 5.0).
+
+        Raises
+        ------
+        ValueError
+            A name the integrator does not take (saying which integrator does, or the nearest
+            of its own) or a value it does not allow; one line, and nothing changes.
+
+        Examples
+        --------
+        >>> s = Session("demo")
+        >>> s.set_integrator_option("iterations", 5); s.integrator_options
+        {'iterations': 5, 'contact_weight': 10.0}
+        >>> s.set_integrator_option("iterations", 0)
+        Traceback (most recent call last):
+        ...
+        ValueError: implicit-euler option iterations must be an integer in [1, 10000], got 0
+        """
+        w = self.world
+        options = w.integrator_options
+        if name not in options:
+            raise ValueError(unknown_option(name, w.integrator))
+        if isinstance(options[name], int) and isinstance(value, float) and value.is_integer():
+            value = int(value)
+        options[name] = value
+        w.integrator_options = options  # checks every value first: a bad one changes nothing
+        self.note, self.note_is_warning = "", False
+        self._xpbd_note()  # the substeps XPBD needs follow its iterations
 
     # -- mesh ---------------------------------------------------------------------------------
     def select_object(self, name: str) -> None:
