@@ -285,3 +285,15 @@ def test_the_loop_over_the_kinds_gives_what_the_compiled_drivers_give(monkeypatc
         np.testing.assert_allclose(looped, fused, rtol=0, atol=1e-9 * max(1.0, np.abs(fused).max()))
     else:
         np.testing.assert_array_equal(looped, fused)
+
+
+def test_a_registered_kind_is_a_material_of_scene_files_too(area_kind, tmp_path):
+    path = tmp_path / "area.toml"
+    path.write_text('[physics]\nmaterial = "test-area"\nyoungs_modulus = 200.0\npoisson_ratio = 0.3\ndensity = 1.0\n'
+                    'gravity = [0.0, 0.0]\n\n[[body]]\nshape = "box"\ndetail = 3\n')
+    w = deforma.load_scene(str(path))
+    assert type(w._model.elements[-1]) is AreaKind and w.bodies[0].material.model == "test-area"
+    w.step()
+    unregister_element_kind(AreaKind)
+    with pytest.raises(ValueError, match="physics.material: unknown value 'test-area'"):
+        deforma.load_scene(str(path))

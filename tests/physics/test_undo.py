@@ -109,3 +109,19 @@ def test_a_runaway_step_puts_back_the_gas_kick_and_the_collider_poses():
         if k == 2:  # the velocities: only the one set by hand differs
             continue
         np.testing.assert_array_equal(a, c)
+
+
+def test_a_step_interrupted_by_ctrl_c_after_the_integrator_leaves_no_half_made_step(monkeypatch):
+    w, grab = torn_sheet_world("implicit-euler")
+    for _ in range(5):
+        w.step()
+    before = snapshot(w)
+
+    def interrupt(*args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(stepper.behaviours, "limit_and_yield", interrupt)  # after the integrator moved everything
+    with pytest.raises(KeyboardInterrupt):
+        w.step()
+    for a, b in zip(snapshot(w), before, strict=True):
+        np.testing.assert_array_equal(a, b)

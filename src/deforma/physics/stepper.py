@@ -11,7 +11,8 @@
 
 A stage that finds the step gone wrong raises :class:`~deforma.physics.diagnostics.SimulationUnstable`;
 the World is then put back exactly as it was before the step (:class:`Undo`): positions,
-velocities, plastic rest shapes, torn topology, collider poses, grabs.
+velocities, plastic rest shapes, torn topology, collider poses, grabs. So it is after any
+other error or an interrupt (Ctrl-C) during a step: no half-made step stays.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 
 from . import behaviours
 from .behaviours import tearing
-from .diagnostics import SHAPE_CHECK_EVERY, SimulationUnstable, lost_shape, runaway, trapped
+from .diagnostics import SHAPE_CHECK_EVERY, lost_shape, runaway, trapped
 from .topology import BodyTopology
 
 REPACK_EVERY = 64  # steps: moving colliders are packed again from their objects this often
@@ -118,7 +119,7 @@ def step(world) -> None:
             error = lost_shape(w, w._model, w._state, w._lost_shape, w.step_count)
             if error is not None:
                 raise error
-    except SimulationUnstable:
+    except BaseException:  # SimulationUnstable, and any error or interrupt: no half-made step stays
         undo.restore(w, start)
         if moving:
             w._packed_colliders = None

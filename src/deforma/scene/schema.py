@@ -196,10 +196,11 @@ def _convert(value, meta, path, ctx):
     if kind == "str":
         if not isinstance(value, str):
             raise _Problem(path, f"expected a string, got {_show(value)}")
-        if meta["choices"] and value not in meta["choices"]:
-            close = difflib.get_close_matches(value, meta["choices"], n=1)
+        choices = meta["choices"]() if callable(meta["choices"]) else meta["choices"]
+        if choices and value not in choices:
+            close = difflib.get_close_matches(value, choices, n=1)
             hint = f"did you mean {close[0]!r}? " if close else ""
-            raise _Problem(path, f"unknown value {value!r}; {hint}allowed: {', '.join(meta['choices'])}")
+            raise _Problem(path, f"unknown value {value!r}; {hint}allowed: {', '.join(choices)}")
         return value
     if kind == "vec2":
         return _pair(value, path, "two numbers")

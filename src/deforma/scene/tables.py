@@ -40,6 +40,7 @@ from ..checks import MAX_DETAIL
 
 # an image body's background: the names of deforma.mesh.from_image itself
 from ..mesh.image import BACKGROUND_NAMES
+from ..physics.material import MODELS, material_models
 
 __all__ = [
     "BEHAVIOUR_KEYS", "BODY_KINDS", "COLLIDER_KINDS", "COLLIDER_SHAPES", "FEM_KEYWORD", "MATERIAL_KEYS",
@@ -51,7 +52,7 @@ __all__ = [
 
 #: Material models a scene may name (``deforma.Material``'s; kept here so that reading a file
 #: needs no physics import).
-MATERIAL_MODELS = ("springs", "corotated", "neo-hookean")
+MATERIAL_MODELS = MODELS  # built in; material_models() adds those of registered element kinds
 #: The behaviour keys of a material (``deforma.Material``'s keywords of the same names), for
 #: every model; ``plastic_rate`` matters only with ``yield_strain``.
 BEHAVIOUR_KEYS = ("tear_strain", "yield_strain", "plastic_rate", "max_stretch")
@@ -79,7 +80,9 @@ def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, 
     (an image collider's source: a built-in level or texture name, or an image path), options
     (a sub-table of name = value, kept as ``(name, value)`` pairs: the integrator's options,
     whose names and values the integrator itself checks).
-    ``lo``/``hi`` bound numbers (``lo_open``/``hi_open`` make a bound exclusive).
+    ``lo``/``hi`` bound numbers (``lo_open``/``hi_open`` make a bound exclusive). ``choices``
+    may be a function giving them when a file is read (the material models: a registered
+    element kind adds its own).
     """
     meta = dict(kind=kind, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, choices=choices, unit=unit, doc=doc)
     if default is MISSING:
@@ -154,7 +157,7 @@ class PhysicsSettings:
     air_drag: float = spec("float", 0.0, lo=0.0, unit="1/s",
                            doc="Every velocity decays as dv/dt = -air_drag v; a little lets stacks and heaps come "
                                "to rest.")
-    material: str = spec("str", "springs", choices=MATERIAL_MODELS,
+    material: str = spec("str", "springs", choices=material_models,
                          doc="What bodies are made of unless they say: springs (the original's springs on the mesh "
                              "edges, with mass, stiffness, damping), or finite elements on the triangles: corotated "
                              "or neo-hookean (need youngs_modulus, poisson_ratio, density; see deforma.Material).")
@@ -209,7 +212,7 @@ class BodyPhysics:
     mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
     stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
     damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
-    material: str | None = spec("str", None, choices=MATERIAL_MODELS,
+    material: str | None = spec("str", None, choices=material_models,
                                 doc="Overrides physics.material: any of the nine material keys (material to "
                                     "max_stretch) gives the body its own material, the others taken from [physics].")
     youngs_modulus: float | None = spec("float", None, lo=0.0, hi=1e15, lo_open=True, unit="Pa",

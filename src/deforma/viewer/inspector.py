@@ -28,7 +28,8 @@ from pygame_gui.elements import (UIButton, UICheckBox, UIDropDownMenu, UIHorizon
 
 from ..physics import available_integrators
 from .params import GROUPS, Param, format_value, integrator_params, parse_value
-from .session import COLLIDER_FIELDS, COLLIDER_SHAPES, MATERIAL_MODELS, OBJECTS
+from ..physics.material import material_models
+from .session import COLLIDER_FIELDS, COLLIDER_SHAPES, OBJECTS
 
 __all__ = ["PANEL_WIDTH", "Inspector"]
 
@@ -254,9 +255,10 @@ class Inspector:
 
     def _make_material_menu(self) -> None:
         self._material_menu_made_for = self.session.material_model
-        self.material_menu = UIDropDownMenu(list(MATERIAL_MODELS), self._material_menu_made_for,
+        models = material_models()  # a registered element kind's model too
+        self.material_menu = UIDropDownMenu(list(models), self._material_menu_made_for,
                                             self._material_rect, self.manager, container=self.scroll,
-                                            expansion_height_limit=len(MATERIAL_MODELS) * 26)
+                                            expansion_height_limit=len(models) * 26)
 
     def _selected_text(self) -> str:
         sel = self.session.mesh.selected

@@ -35,6 +35,7 @@ from ..physics.integrators.base import unknown_option
 from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 from ..scene.construct import pin_mask
+from ..physics.material import material_models
 from ..scene.tables import MATERIAL_MODELS, BodyPhysics
 from .params import INTEGRATOR_PREFIX, integrator_params
 
@@ -378,8 +379,9 @@ class Session:
             An unknown model, or a body that cannot be made of elements (a chain of springs
             without triangles); one line, and nothing changes.
         """
-        if model not in MATERIAL_MODELS:
-            raise ValueError(f"material model must be one of {', '.join(MATERIAL_MODELS)}, got {model!r}")
+        models = material_models()  # a registered element kind's model too
+        if model not in models:
+            raise ValueError(f"material model must be one of {', '.join(models)}, got {model!r}")
         self.note, self.note_is_warning = "", False
         material = self._material(model, self.material_values)
         self.world.material = material  # refuses (changing nothing) a body without triangles

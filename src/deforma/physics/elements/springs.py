@@ -209,7 +209,7 @@ class SpringKind(ElementKind):
     def __init__(self, model):
         self._model = model
         self._order = None  # XPBD's sweep order, made on first use (a Model's springs never change)
-        self._lam = np.zeros(model.n_springs)
+        self._lam = None  # XPBD's multipliers, made on first use
 
     @property
     def vertices(self) -> np.ndarray:
@@ -233,6 +233,8 @@ class SpringKind(ElementKind):
                               m.spring_damping, f)
 
     def begin_substep(self) -> None:
+        if self._lam is None:
+            self._lam = np.zeros(self._model.n_springs)
         self._lam[:] = 0.0
 
     def project(self, x, x_prev, inv_mass, h, sequence) -> None:

@@ -486,7 +486,7 @@ class TriangleKind(ElementKind):
     def __init__(self, model):
         self._model = model
         self._order = None  # XPBD's order: (elements by colour, where each colour starts)
-        self._lam = np.zeros((model.n_elements, 3))
+        self._lam = None  # XPBD's multipliers, made on first use
 
     @property
     def vertices(self) -> np.ndarray:
@@ -510,6 +510,8 @@ class TriangleKind(ElementKind):
                            m.elem_kind, bool(m.elem_damping.any()), f)
 
     def begin_substep(self) -> None:
+        if self._lam is None:
+            self._lam = np.zeros((self._model.n_elements, 3))
         self._lam[:] = 0.0
 
     def project(self, x, x_prev, inv_mass, h, sequence) -> None:
