@@ -80,11 +80,10 @@ def test_parallel_and_serial_steps_agree_exactly(material):
         fbuf = np.zeros((3, m.n_vertices, 2))  # the same 3 chunks of springs and elements for both
         chunks, elem_chunks, verts = symplectic.merged_chunks(m.spring_i, m.spring_j, m.elem, 3)
         for _ in range(50):
-            kernel(s.x, s.v, fbuf, chunks, verts, m.spring_i, m.spring_j, m.spring_rest_length,
-                   m.spring_stiffness, m.spring_damping, elem_chunks, m.elem, m.elem_b, m.elem_area, m.elem_mu,
-                   m.elem_lambda, m.elem_damping, m.elem_kind, bool(m.elem_damping.any()), m.vertex_inv_mass, 0.0, -9.81, 1.0,
-                   control.force, control.has_force, control.grab_slot, control.grab_pull, control.colliders,
-                   contacts.hits, m.contact, contacts.scratch, contacts.buffer, h, 2, 1e6)
+            kernel(s.x, s.v, fbuf, chunks, elem_chunks, verts, m.springs.arrays, m.triangles.arrays,
+                   bool(m.elem_damping.any()), m.vertex_inv_mass, 0.0, -9.81, 1.0, control.force, control.has_force,
+                   control.grab_slot, control.grab_pull, control.colliders, contacts.hits, m.contact,
+                   contacts.scratch, contacts.buffer, h, 2, 1e6)
         assert not fbuf.any()  # scratch left zeroed
         assert np.isfinite(s.x).all()
         runs.append((s.x.copy(), s.v.copy()))

@@ -48,7 +48,8 @@ def limit_and_yield(model, state_in, state_out, dt: float) -> None:
                             tolerance=LIMIT_TOLERANCE)
         if mat.yield_strain is not None:
             if s1 > s0:
-                yield_springs(state_out.x, model.spring_i[s0:s1], model.spring_j[s0:s1], model.spring_rest_length[s0:s1],
+                yield_springs(state_out.x, model.spring_i[s0:s1], model.spring_j[s0:s1],
+                              model.spring_rest_length[s0:s1],
                               model.spring_rest_length0[s0:s1], mat.yield_strain, mat.plastic_rate)
             if t1 > t0 and yield_elements(state_out.x, model.elem[t0:t1], model.elem_b[t0:t1], model.elem_area[t0:t1],
                                           model.elem_b0[t0:t1], model.elem_area0[t0:t1], mat.yield_strain,

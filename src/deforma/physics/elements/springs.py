@@ -14,10 +14,27 @@ Units: m, m/s, N.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from .kind import ElementKind, sweep_order
+
+
+class SpringArrays(NamedTuple):
+    """The springs as the compiled drivers read them (global vertex indices; m, N/m, N*s/m)."""
+
+    i: np.ndarray      # (E,) int32: one end
+    j: np.ndarray      # (E,) int32: the other
+    rest: np.ndarray   # (E,) float64: rest length
+    ks: np.ndarray     # (E,) float64: stiffness
+    kd: np.ndarray     # (E,) float64: damping along the spring
+
+    @classmethod
+    def empty(cls) -> "SpringArrays":
+        """No springs."""
+        return cls(np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0), np.zeros(0), np.zeros(0))
 
 
 @njit(cache=True)
@@ -208,6 +225,9 @@ class SpringKind(ElementKind):
 
     def __init__(self, model):
         self._model = model
+        # the Model's arrays (changed in place, never replaced) as the compiled drivers read them
+        self.arrays = SpringArrays(model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
+                                   model.spring_damping)
         self._order = None  # XPBD's sweep order, made on first use (a Model's springs never change)
         self._lam = None  # XPBD's multipliers, made on first use
 

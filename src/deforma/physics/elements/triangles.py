@@ -25,12 +25,31 @@ Units: m, s, kg, Pa (N/m per metre of thickness), J.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from ..material import KIND_COROTATED
 from .kind import ElementKind, sweep_order
 from . import corotated, neo_hookean
+
+
+class TriangleArrays(NamedTuple):
+    """The triangle elements as the compiled drivers read them (see the module docstring)."""
+
+    elem: np.ndarray   # (T, 3) int32: corners, global vertex indices, counter-clockwise at rest
+    b: np.ndarray      # (T, 4) float64: rest-shape inverses, row-major (1/m)
+    area: np.ndarray   # (T,) float64: rest areas (m^2)
+    mu: np.ndarray     # (T,) float64: Lame parameters (Pa)
+    lam: np.ndarray    # (T,) float64
+    beta: np.ndarray   # (T,) float64: damping (s)
+    kind: np.ndarray   # (T,) int32: material.KIND_*
+
+    @classmethod
+    def empty(cls) -> "TriangleArrays":
+        """No elements."""
+        return cls(np.zeros((0, 3), np.int32), np.zeros((0, 4)), *(np.zeros(0),) * 4, np.zeros(0, np.int32))
 
 
 def rest_geometry(x, tris):
@@ -485,6 +504,9 @@ class TriangleKind(ElementKind):
 
     def __init__(self, model):
         self._model = model
+        # the Model's arrays (changed in place, never replaced) as the compiled drivers read them
+        self.arrays = TriangleArrays(model.elem, model.elem_b, model.elem_area, model.elem_mu, model.elem_lambda,
+                                     model.elem_damping, model.elem_kind)
         self._order = None  # XPBD's order: (elements by colour, where each colour starts)
         self._lam = None  # XPBD's multipliers, made on first use
 

@@ -193,7 +193,8 @@ class Option:
         """``value`` as the option keeps it; ``ValueError`` saying what is allowed if it is not."""
         bad = ValueError(f"{integrator} option {self.name} must be {self.allowed()}, got {value!r}")
         if self.kind == "int":
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not self.low <= value <= self.high:
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
+                    or not self.low <= value <= self.high:
                 raise bad
             return int(value)
         if self.kind == "float":

@@ -35,8 +35,8 @@ from ..colliders.geometry import advance_colliders, jump_reach, n_colliders
 from ..colliders.response import collide_point, record_hit
 from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
 from ..contact.broad_phase import gather_start
-from ..elements.springs import scatter_spring_forces
-from ..elements.triangles import element_forces
+from ..elements.springs import SpringArrays, scatter_spring_forces
+from ..elements.triangles import TriangleArrays, element_forces
 from ..jit import serial_and_parallel
 from .base import Integrator, Option, StepReport, contact_epilogue, is_bad, register_integrator
 
@@ -62,15 +62,15 @@ def _semi_implicit_euler(x0, y0, vx, vy, fx, fy, inv_mass, gx, gy, keep, h):
 # Numba does not always prune (a helper taking a dozen arrays made the step 10x slower).
 # Scalar-only helpers are free.
 
-def _symplectic_euler(x, v, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j, rest, ks, kd,
-                      elem_ptr, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind, elem_damped,
-                      inv_mass, gx, gy, keep, force, has_force, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h,
-                      substeps, vmax2):
+def _symplectic_euler(x, v, fbuf, chunk_ptr, elem_ptr, chunk_vertices, springs, tris, elem_damped, inv_mass, gx, gy,
+                      keep, force, has_force, grab_slot, grab_pull, rects, hits, ctopo, cscr, cbuf, h, substeps, vmax2):
     """``substeps`` symplectic Euler substeps of ``h`` s with collisions.
 
-    ``fbuf`` (T, N, 2) are zeroed force buffers, one per chunk ``t`` of springs
-    (``chunk_ptr[t]:chunk_ptr[t + 1]``) and of triangle elements (``elem_ptr[t]:elem_ptr[t +
-    1]``; see :mod:`deforma.physics.elements.triangles` for ``elem*``), and are left zeroed; chunk
+    ``fbuf`` (T, N, 2) are zeroed force buffers, one per chunk ``t`` of the springs ``springs``
+    (a :class:`~deforma.physics.elements.springs.SpringArrays`; ``chunk_ptr[t]:chunk_ptr[t +
+    1]``) and of the triangle elements ``tris`` (a
+    :class:`~deforma.physics.elements.triangles.TriangleArrays`; ``elem_ptr[t]:elem_ptr[t +
+    1]``; ``elem_damped``: whether any has damping), and are left zeroed; chunk
     ``t`` touches only the vertices ``chunk_vertices[t, 0]:chunk_vertices[t, 1]`` (see
     :func:`spring_chunks`). ``force`` (N, 2) is added to every vertex's force if
     ``has_force`` (applied forces, and the forces of element kinds outside this driver). A
@@ -93,11 +93,12 @@ def _symplectic_euler(x, v, fbuf, chunk_ptr, chunk_vertices, spring_i, spring_j,
         stamp = cscr.status.stamp[0] + 1  # the contact stage counts this substep when it runs
         for t in prange(n_chunks):
             lo, hi = chunk_ptr[t], chunk_ptr[t + 1]
-            scatter_spring_forces(x, v, spring_i[lo:hi], spring_j[lo:hi], rest[lo:hi], ks[lo:hi], kd[lo:hi], fbuf[t])
+            scatter_spring_forces(x, v, springs.i[lo:hi], springs.j[lo:hi], springs.rest[lo:hi], springs.ks[lo:hi],
+                                  springs.kd[lo:hi], fbuf[t])
             lo, hi = elem_ptr[t], elem_ptr[t + 1]
             if hi > lo:
-                element_forces(x, v, elem[lo:hi], elem_b[lo:hi], elem_area[lo:hi], elem_mu[lo:hi], elem_lam[lo:hi],
-                               elem_beta[lo:hi], elem_kind[lo:hi], elem_damped, fbuf[t])
+                element_forces(x, v, tris.elem[lo:hi], tris.b[lo:hi], tris.area[lo:hi], tris.mu[lo:hi],
+                               tris.lam[lo:hi], tris.beta[lo:hi], tris.kind[lo:hi], elem_damped, fbuf[t])
         bad = 0
         for i in prange(x.shape[0]):
             x0, y0, vx, vy = x[i, 0], x[i, 1], v[i, 0], v[i, 1]
@@ -319,12 +320,9 @@ class SymplecticEuler(Integrator):
         tail = (control.grab_slot, control.grab_pull, control.colliders, contacts.hits, model.contact,
                 contacts.scratch, contacts.buffer, float(h))
         if model.fused:  # the compiled driver runs the springs and triangles itself, every substep
-            bad = kernel(state_out.x, state_out.v, self._fbuf, self._chunks, self._chunk_vertices,
-                         model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
-                         model.spring_damping, self._elem_chunks, model.elem, model.elem_b, model.elem_area,
-                         model.elem_mu, model.elem_lambda, model.elem_damping, model.elem_kind,
-                         self._damped[2], *common, control.force, control.has_force, *tail,
-                         int(substeps), float(max_speed) ** 2)
+            bad = kernel(state_out.x, state_out.v, self._fbuf, self._chunks, self._elem_chunks, self._chunk_vertices,
+                         model.springs.arrays, model.triangles.arrays, self._damped[2], *common, control.force,
+                         control.has_force, *tail, int(substeps), float(max_speed) ** 2)
         else:
             bad = self._step_kinds(kernel, model, state_out, control, contacts, substeps, max_speed, common, tail)
         if may_parallel:
@@ -343,18 +341,15 @@ class SymplecticEuler(Integrator):
         driver then runs no element. The same arithmetic as the fused driver on one chunk."""
         x, v = state.x, state.v
         force = np.zeros_like(x)
-        no_springs = (np.zeros(0, np.int32), np.zeros(0, np.int32), *(np.zeros(0),) * 3)
-        no_elements = (np.zeros((0, 3), np.int32), np.zeros((0, 4)), *(np.zeros(0),) * 4, np.zeros(0, np.int32),
-                       False)
-        ptr = np.zeros(len(self._chunks), np.int64)
+        ptr = np.zeros(len(self._chunks), np.int64)  # every chunk empty: the driver runs no element
         for _ in range(substeps):
             force[...] = 0.0
             for kind in model.elements:
                 kind.forces(x, v, force)
             if control.has_force:
                 force += control.force
-            bad = kernel(x, v, self._fbuf, ptr, self._chunk_vertices, *no_springs, ptr, *no_elements, *common,
-                         force, True, *tail, 1, float(max_speed) ** 2)
+            bad = kernel(x, v, self._fbuf, ptr, ptr, self._chunk_vertices, SpringArrays.empty(),
+                         TriangleArrays.empty(), False, *common, force, True, *tail, 1, float(max_speed) ** 2)
             if bad or not contacts.complete:
                 return bad
         return 0

@@ -134,10 +134,9 @@ def project_collider_contacts(x, x_prev, inv_mass, planes, touch, count):
 
 
 @njit(cache=True)
-def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j, rest, ks, kd,
-                  spring_order, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind,
-                  elem_order, elem_starts, seed, elem_lam_acc, gx, gy, keep, force, has_force, grab_slot, grab_pull,
-                  rects, hits, ctopo, cscr, cbuf, h, substeps, iterations, vmax2):
+def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, springs, spring_order, tris, elem_order, elem_starts,
+                  seed, elem_lam_acc, gx, gy, keep, force, has_force, grab_slot, grab_pull, rects, hits, ctopo, cscr,
+                  cbuf, h, substeps, iterations, vmax2):
     """``substeps`` XPBD substeps of ``h`` s with ``iterations`` Gauss-Seidel sweeps each,
     over the built-in element kinds (springs and triangles): the compiled driver for them.
 
@@ -154,14 +153,13 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j
         (:func:`~deforma.physics.colliders.response.contact_planes`; column 7: 1 stuck, 0 sliding).
     inv_mass : (N,) float64
         1/kg.
-    spring_i, spring_j : (E,) int32
-        Spring ends.
-    rest, ks, kd : (E,) float64
-        Rest lengths (m), stiffness (N/m), damping (N*s/m).
+    springs : SpringArrays
+        The springs (:class:`~deforma.physics.elements.springs.SpringArrays`: ends, rest
+        lengths m, stiffness N/m, damping N*s/m).
     spring_order : (E,) int64
         The springs by colour (:func:`sweep_order`), the order of every sweep.
-    elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind : arrays
-        Triangle elements (see :mod:`deforma.physics.elements.triangles`).
+    tris : TriangleArrays
+        Triangle elements (:class:`~deforma.physics.elements.triangles.TriangleArrays`).
     elem_order, elem_starts : (T,) int64, (COLOURS + 1,) int64
         The elements by colour and where each colour starts.
     seed : int
@@ -203,16 +201,17 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j
     >>> import numpy as np
     >>> from deforma.physics.contact.contacts import empty_topology, make_buffer, make_scratch
     >>> from deforma.physics.colliders.response import make_hits
+    >>> from deforma.physics.elements.springs import SpringArrays
+    >>> from deforma.physics.elements.triangles import TriangleArrays
     >>> x, v = np.array([[0.0, 0.0], [1.5, 0.0]]), np.zeros((2, 2))
-    >>> elem = np.zeros((0, 3), np.int32)
-    >>> no_elements = (elem, np.zeros((0, 4)), *[np.zeros(0)] * 4, np.zeros(0, np.int32), *sweep_order(elem, 2))
-    >>> bad = xpbd_substeps(x, v, x.copy(), np.zeros(1), np.zeros((2, 8)),
-    ...                     np.zeros(2, np.int32), np.ones(2),
-    ...                     np.array([0], np.int32), np.array([1], np.int32), np.ones(1), np.full(1, 1e9),
-    ...                     np.zeros(1), sweep_order(np.array([[0, 1]], np.int32), 2)[0], *no_elements, 0,
-    ...                     np.zeros((0, 3)), 0.0, 0.0, 1.0, np.zeros((0, 2)), False, np.full(2, -1, np.int32),
-    ...                     np.zeros((0, 3)), np.zeros((0, 19)), make_hits(2), empty_topology(), make_scratch(0, 0),
-    ...                     make_buffer(0, 0), 0.01, 1, 1, 1e6)
+    >>> ends = np.array([0], np.int32), np.array([1], np.int32)
+    >>> spring = SpringArrays(*ends, np.ones(1), np.full(1, 1e9), np.zeros(1))
+    >>> none = TriangleArrays.empty()
+    >>> bad = xpbd_substeps(x, v, x.copy(), np.zeros(1), np.zeros((2, 8)), np.zeros(2, np.int32), np.ones(2),
+    ...                     spring, sweep_order(np.array([[0, 1]], np.int32), 2)[0], none,
+    ...                     *sweep_order(none.elem, 2), 0, np.zeros((0, 3)), 0.0, 0.0, 1.0, np.zeros((0, 2)), False,
+    ...                     np.full(2, -1, np.int32), np.zeros((0, 3)), np.zeros((0, 19)), make_hits(2),
+    ...                     empty_topology(), make_scratch(0, 0), make_buffer(0, 0), 0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
     1.0
     """
@@ -220,9 +219,9 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j
     for sub in range(substeps):
         advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
         predict(x, v, x_prev, inv_mass, gx, gy, keep, force, has_force, grab_slot, grab_pull, h)
-        for e in range(spring_i.shape[0]):
+        for e in range(springs.i.shape[0]):
             lam[e] = 0.0
-        for e in range(elem.shape[0]):
+        for e in range(tris.elem.shape[0]):
             elem_lam_acc[e, 0] = 0.0
             elem_lam_acc[e, 1] = 0.0
             elem_lam_acc[e, 2] = 0.0
@@ -238,8 +237,9 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, spring_i, spring_j
             # collider contacts first, so that the springs carry their support through the sweep
             project_collider_contacts(x, x_prev, inv_mass, planes, touch, count)
             project_contacts(x, x_prev, inv_mass, ctopo, cbuf, n_body, stick)
-            project_springs(x, x_prev, inv_mass, spring_i, spring_j, rest, ks, kd, spring_order, lam, h)
-            project_elements(x, x_prev, inv_mass, elem, elem_b, elem_area, elem_mu, elem_lam, elem_beta, elem_kind,
+            project_springs(x, x_prev, inv_mass, springs.i, springs.j, springs.rest, springs.ks, springs.kd,
+                            spring_order, lam, h)
+            project_elements(x, x_prev, inv_mass, tris.elem, tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind,
                              elem_order, elem_starts, sequence, elem_lam_acc, h)
         bad = finish_position_step(x, v, x_prev, rects, hits, cscr.status.stamp[0] + 1, h, vmax2)
         if bad:
@@ -299,10 +299,8 @@ class XPBD(Integrator):
         # the colours' order is drawn from the step's index: a step repeated (after the
         # contact buffer grew) draws the same
         bad = xpbd_substeps(state_out.x, state_out.v, self._x_prev, self._lam, self._planes, self._touch,
-                            model.vertex_inv_mass, model.spring_i, model.spring_j, model.spring_rest_length,
-                            model.spring_stiffness, model.spring_damping, self._orders[1], model.elem,
-                            model.elem_b, model.elem_area, model.elem_mu, model.elem_lambda, model.elem_damping,
-                            model.elem_kind, self._orders[2], self._orders[3], int(control.step), self._elem_lam,
+                            model.vertex_inv_mass, model.springs.arrays, self._orders[1], model.triangles.arrays,
+                            self._orders[2], self._orders[3], int(control.step), self._elem_lam,
                             float(gx), float(gy), 1.0 / (1.0 + float(h) * model.air_drag), control.force,
                             control.has_force, control.grab_slot, control.grab_pull, control.colliders, contacts.hits,
                             model.contact, contacts.scratch, contacts.buffer, float(h), int(substeps),
