@@ -224,71 +224,73 @@ class SpringKind(ElementKind):
     fused = True
 
     def __init__(self, model):
-        self._model = model
-        # the Model's arrays (changed in place, never replaced) as the compiled drivers read them
+        # the Model's arrays (changed in place, never replaced) as the compiled drivers read
+        # them; no reference to the Model itself, so that a Model is freed as soon as it is
+        # dropped (a cycle would keep a torn body's old arrays until the garbage collector ran)
         self.arrays = SpringArrays(model.spring_i, model.spring_j, model.spring_rest_length, model.spring_stiffness,
                                    model.spring_damping)
+        self._n = model.n_vertices
         self._order = None  # XPBD's sweep order, made on first use (a Model's springs never change)
         self._lam = None  # XPBD's multipliers, made on first use
 
     @property
     def vertices(self) -> np.ndarray:
-        m = self._model
-        return np.stack([m.spring_i, m.spring_j], axis=1)
+        a = self.arrays
+        return np.stack([a.i, a.j], axis=1)
 
     def energy(self, x) -> np.ndarray:
-        m = self._model
-        stretch = np.linalg.norm(x[m.spring_j] - x[m.spring_i], axis=1) - m.spring_rest_length
-        return 0.5 * m.spring_stiffness * stretch * stretch
+        a = self.arrays
+        stretch = np.linalg.norm(x[a.j] - x[a.i], axis=1) - a.rest
+        return 0.5 * a.ks * stretch * stretch
 
     def gradient_hessian(self, x):
-        m = self._model
-        grad, hess = np.zeros((m.n_springs, 2, 2)), np.zeros((m.n_springs, 4, 4))
-        spring_gradient_hessian(x, m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness, grad, hess)
+        a = self.arrays
+        grad, hess = np.zeros((len(a.i), 2, 2)), np.zeros((len(a.i), 4, 4))
+        spring_gradient_hessian(x, a.i, a.j, a.rest, a.ks, grad, hess)
         return grad, hess
 
     def forces(self, x, v, f) -> None:
-        m = self._model
-        scatter_spring_forces(x, v, m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness,
-                              m.spring_damping, f)
+        a = self.arrays
+        scatter_spring_forces(x, v, a.i, a.j, a.rest, a.ks,
+                              a.kd, f)
 
     def begin_substep(self) -> None:
         if self._lam is None:
-            self._lam = np.zeros(self._model.n_springs)
+            self._lam = np.zeros(len(self.arrays.i))
         self._lam[:] = 0.0
 
     def project(self, x, x_prev, inv_mass, h, sequence) -> None:
-        m = self._model
+        a = self.arrays
         if self._order is None:
-            self._order = sweep_order(self.vertices, m.n_vertices)[0]
-        project_springs(x, x_prev, inv_mass, m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness,
-                        m.spring_damping, self._order, self._lam, h)
+            self._order = sweep_order(self.vertices, self._n)[0]
+        project_springs(x, x_prev, inv_mass, a.i, a.j, a.rest, a.ks,
+                        a.kd, self._order, self._lam, h)
 
     def matrix_weights(self, h):
         """``(h^2 ks, h kd)`` per spring (kg): the stretch's and the damping's weights."""
-        m = self._model
-        return h * h * m.spring_stiffness, h * m.spring_damping
+        a = self.arrays
+        return h * h * a.ks, h * a.kd
 
     def matrix_entries(self, h, weights=None):
         """The springs' graph Laplacian weighted by ``h^2 ks + h kd``."""
-        m = self._model
+        a = self.arrays
         wk, wd = self.matrix_weights(h) if weights is None else weights
         w = wk + wd
-        i, j = m.spring_i.astype(np.int64), m.spring_j.astype(np.int64)
+        i, j = a.i.astype(np.int64), a.j.astype(np.int64)
         return np.concatenate([i, j, i, j]), np.concatenate([i, j, j, i]), np.concatenate([w, w, -w, -w])
 
     def rhs(self, x, x_n, h, weights, b) -> None:
-        m = self._model
+        a = self.arrays
         wk, wd = weights
-        spring_rhs(x, x_n, m.spring_i, m.spring_j, m.spring_rest_length, wk, wd, b)
+        spring_rhs(x, x_n, a.i, a.j, a.rest, wk, wd, b)
 
     def stiffness_rows(self, n: int) -> np.ndarray:
-        m = self._model
+        a = self.arrays
         # (float: bincount of no springs gives integers)
-        return np.bincount(m.spring_i, m.spring_stiffness, n) + \
-            np.bincount(m.spring_j, m.spring_stiffness, n).astype(np.float64)
+        return np.bincount(a.i, a.ks, n) + \
+            np.bincount(a.j, a.ks, n).astype(np.float64)
 
     def damping_rows(self, n: int) -> np.ndarray:
-        m = self._model
-        return np.bincount(m.spring_i, m.spring_damping, n) + \
-            np.bincount(m.spring_j, m.spring_damping, n).astype(np.float64)
+        a = self.arrays
+        return np.bincount(a.i, a.kd, n) + \
+            np.bincount(a.j, a.kd, n).astype(np.float64)

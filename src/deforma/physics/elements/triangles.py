@@ -503,8 +503,10 @@ class TriangleKind(ElementKind):
     fused = True
 
     def __init__(self, model):
-        self._model = model
-        # the Model's arrays (changed in place, never replaced) as the compiled drivers read them
+        # the Model's arrays (changed in place, never replaced) as the compiled drivers read
+        # them; no reference to the Model itself, so that a Model is freed as soon as it is
+        # dropped (a cycle would keep a torn body's old arrays until the garbage collector ran)
+        self._n = model.n_vertices
         self.arrays = TriangleArrays(model.elem, model.elem_b, model.elem_area, model.elem_mu, model.elem_lambda,
                                      model.elem_damping, model.elem_kind)
         self._order = None  # XPBD's order: (elements by colour, where each colour starts)
@@ -512,67 +514,67 @@ class TriangleKind(ElementKind):
 
     @property
     def vertices(self) -> np.ndarray:
-        return self._model.elem
+        return self.arrays.elem
 
     def energy(self, x) -> np.ndarray:
-        m = self._model
-        return element_energy(x, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_kind)
+        a = self.arrays
+        return element_energy(x, a.elem, a.b, a.area, a.mu, a.lam, a.kind)
 
     def gradient_hessian(self, x):
-        m = self._model
-        grad, hess = np.zeros((m.n_elements, 3, 2)), np.zeros((m.n_elements, 6, 6))
-        triangle_gradient_hessian(x, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_kind, grad,
+        a = self.arrays
+        grad, hess = np.zeros((len(a.elem), 3, 2)), np.zeros((len(a.elem), 6, 6))
+        triangle_gradient_hessian(x, a.elem, a.b, a.area, a.mu, a.lam, a.kind, grad,
                                   hess)
         return grad, hess
 
     def forces(self, x, v, f) -> None:
-        m = self._model
-        if m.n_elements:
-            element_forces(x, v, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_damping,
-                           m.elem_kind, bool(m.elem_damping.any()), f)
+        a = self.arrays
+        if len(a.elem):
+            element_forces(x, v, a.elem, a.b, a.area, a.mu, a.lam, a.beta,
+                           a.kind, bool(a.beta.any()), f)
 
     def begin_substep(self) -> None:
         if self._lam is None:
-            self._lam = np.zeros((self._model.n_elements, 3))
+            self._lam = np.zeros((len(self.arrays.elem), 3))
         self._lam[:] = 0.0
 
     def project(self, x, x_prev, inv_mass, h, sequence) -> None:
-        m = self._model
+        a = self.arrays
         if self._order is None:
-            self._order = sweep_order(m.elem, m.n_vertices)
-        project_elements(x, x_prev, inv_mass, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda,
-                         m.elem_damping, m.elem_kind, self._order[0], self._order[1], sequence, self._lam, h)
+            self._order = sweep_order(a.elem, self._n)
+        project_elements(x, x_prev, inv_mass, a.elem, a.b, a.area, a.mu, a.lam,
+                         a.beta, a.kind, self._order[0], self._order[1], sequence, self._lam, h)
 
     def matrix_weights(self, h):
-        m = self._model
-        return triangle_weights(m.elem_area, m.elem_damping, m.elem_mu, m.elem_lambda, h)
+        a = self.arrays
+        return triangle_weights(a.area, a.beta, a.mu, a.lam, h)
 
     def matrix_entries(self, h, weights=None):
         """``sum_e w_e D D^T``: each element's weight times the dot products of its
         shape-function gradients, over its corners' pairs."""
-        m = self._model
+        a = self.arrays
         w = self.matrix_weights(h) if weights is None else weights
-        bb = m.elem_b.reshape(-1, 2, 2)
+        bb = a.b.reshape(-1, 2, 2)
         d = np.stack([-bb[:, 0] - bb[:, 1], bb[:, 0], bb[:, 1]], axis=1)  # (T, 3, 2): D_i, D_j, D_k
         dots = np.einsum("tvc,twc->tvw", d, d) * w[:, None, None]
-        t = m.elem.astype(np.int64)
+        t = a.elem.astype(np.int64)
         return np.repeat(t, 3, axis=1).ravel(), np.tile(t, (1, 3)).ravel(), dots.ravel()
 
     def rhs(self, x, x_n, h, weights, b) -> None:
-        m = self._model
-        if m.n_elements:
-            implicit_element_rhs(x, x_n, m.elem, m.elem_b, m.elem_area, m.elem_mu, m.elem_lambda, m.elem_damping,
-                                 m.elem_kind, weights, h, b)
+        a = self.arrays
+        if len(a.elem):
+            implicit_element_rhs(x, x_n, a.elem, a.b, a.area, a.mu, a.lam, a.beta,
+                                 a.kind, weights, h, b)
 
     def stiffness_rows(self, n: int) -> np.ndarray:
-        m = self._model
-        if not m.n_elements:
+        a = self.arrays
+        if not len(a.elem):
             return np.zeros(n)
-        return gradient_row_sums(m.elem, m.elem_b, m.elem_area, max_stiffness(m.elem_mu, m.elem_lambda), n)
+        return gradient_row_sums(a.elem, a.b, a.area, max_stiffness(a.mu, a.lam), n)
 
     def damping_rows(self, n: int) -> np.ndarray:
-        m = self._model
-        if not m.n_elements:
+        a = self.arrays
+        if not len(a.elem):
             return np.zeros(n)
-        k = max_stiffness(m.elem_mu, m.elem_lambda)
-        return gradient_row_sums(m.elem, m.elem_b, m.elem_area, k * m.elem_damping, n)
+        k = max_stiffness(a.mu, a.lam)
+        return gradient_row_sums(a.elem, a.b, a.area, k * a.beta, n)
