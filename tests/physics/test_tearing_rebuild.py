@@ -53,7 +53,7 @@ def reference_edges(n, t):
 def reference_tear(topo, x, limit, tips):
     """The tear as the fan search before the incremental rebuild found it (Python, per vertex),
     with the running cracks' ``tips`` (while there are any, only they advance; else one new
-    crack starts)."""
+    crack starts) and no cut that leaves a chip (``tearing._chip``, a rule of its own)."""
     n = len(topo.boundary)
     strain = np.empty(len(topo.inner))
     tearing.opening_strain(x, topo.triangles, topo.b, topo.inner_tri, topo.normal, strain)
@@ -67,6 +67,8 @@ def reference_tear(topo, x, limit, tips):
             continue
         if not len(tips) and cut:
             break
+        if tearing._chip(int(e), topo.tri_pair, topo.tri_edge):  # the rule against cutting off chips
+            continue
         used[a] = used[b] = True
         cut.append(int(e))
     if not cut:

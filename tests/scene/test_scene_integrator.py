@@ -46,6 +46,6 @@ def test_unknown_integrator_lists_every_registered_name(tmp_path):
     with pytest.raises(SceneError) as e:
         scenes.load_scene(p)
     msg = str(e.value)
-    assert "physics.integrator: unknown value 'implicit'; did you mean 'implicit-euler'?" in msg
+    assert "physics.integrator: unknown value 'implicit'; did you mean 'implicit-euler' or 'implicit-bdf2'?" in msg
     for name in available_integrators():
         assert name in msg

@@ -32,7 +32,7 @@ def test_a_world_built_from_a_scene_has_its_options_and_steps(tmp_path):
     # kept as the integrator keeps them, in the order it lists them
     assert scene.physics.integrator_options == (("iterations", 7), ("contact_weight", 25.0))
     world = scenes.load_scene(p)
-    assert world.integrator_options == {"iterations": 7, "contact_weight": 25.0}
+    assert world.integrator_options == {"iterations": 7, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 25.0}
     for _ in range(30):
         world.step()
     assert np.isfinite(world.bodies[0].positions).all()
@@ -93,11 +93,12 @@ def test_the_order_in_the_file_does_not_matter_and_whole_floats_count_as_integer
 BAD = [
     ("implicit-euler", "iteratons = 5", "iteratons",
      "unknown implicit-euler option 'iteratons' (did you mean 'iterations'?); implicit-euler takes iterations, "
-     "contact_weight"),
+     "tolerance, max_iterations, contact_weight"),
     ("xpbd", "contact_weight = 5.0", "contact_weight",
-     "'contact_weight' is an option of implicit-euler, not of xpbd (xpbd takes iterations)"),
+     "'contact_weight' is an option of implicit-euler and implicit-bdf2, not of xpbd (xpbd takes iterations)"),
     ("symplectic-euler", "iterations = 5", "iterations",
-     "'iterations' is an option of implicit-euler and xpbd, not of symplectic-euler (symplectic-euler takes mode)"),
+     "'iterations' is an option of implicit-euler, xpbd and implicit-bdf2, not of symplectic-euler "
+     "(symplectic-euler takes mode)"),
     ("implicit-euler", "iterations = 0", "iterations",
      "implicit-euler option iterations must be an integer in [1, 10000], got 0"),
     ("xpbd", "iterations = 20000", "iterations",
@@ -140,7 +141,7 @@ def test_a_table_that_is_not_a_table_is_refused(tmp_path):
 def test_a_scene_made_in_code_is_checked_when_built():
     scene = Scene(physics=PhysicsSettings(integrator="xpbd", integrator_options=(("contact_weight", 5.0),)))
     with pytest.raises(SceneError, match=r"^<scene>: physics.integrator_options: 'contact_weight' is an option of "
-                                         r"implicit-euler, not of xpbd"):
+                                         r"implicit-euler and implicit-bdf2, not of xpbd"):
         scenes.build(scene)
     good = replace(scene, physics=replace(scene.physics, integrator_options=(("iterations", 6),)))
     assert scenes.build(good).integrator_options == {"iterations": 6}
@@ -164,5 +165,5 @@ def test_the_installed_command_prints_the_key_path_and_no_traceback(tmp_path):
     lines = [line for line in r.stderr.splitlines() if not line.startswith("deforma: compiling the physics")]
     assert len(lines) == 1
     assert lines[0].startswith("deforma: error: ")
-    assert "physics.integrator_options.contact_weight: 'contact_weight' is an option of implicit-euler, " \
-           "not of xpbd" in lines[0]
+    assert "physics.integrator_options.contact_weight: 'contact_weight' is an option of implicit-euler and " \
+           "implicit-bdf2, not of xpbd" in lines[0]

@@ -14,18 +14,26 @@ from seed_scenes import seed
 from test_viewer import choose_from_menu, post, run
 
 ROWS = {"symplectic-euler": ["integrator_mode"],
-        "implicit-euler": ["integrator_iterations", "integrator_contact_weight"],
-        "xpbd": ["integrator_iterations"]}
+        "implicit-euler": ["integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
+                           "integrator_contact_weight"],
+        "xpbd": ["integrator_iterations"],
+        "implicit-bdf2": ["integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
+                          "integrator_contact_weight"]}
 
 
 def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
     rows = {p.name: p for p in integrator_params()}
-    assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_contact_weight"]
+    assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
+                          "integrator_contact_weight"]
     assert not set(rows) & set(PARAMS)
     mode = rows["integrator_mode"]
     assert mode.kind == "choice" and mode.choices == ("auto", "serial", "parallel")
     assert rows["integrator_iterations"].kind == "int" and rows["integrator_iterations"].log
     assert (rows["integrator_contact_weight"].lo, rows["integrator_contact_weight"].hi) == (0.1, 1000.0)
+    # implicit Euler's tolerance (default 0, a fixed number of iterations): a linear slider
+    # from 0 to 1 m/s; the text box takes any value the option allows
+    assert (rows["integrator_tolerance"].lo, rows["integrator_tolerance"].hi, rows["integrator_tolerance"].log) \
+        == (0.0, 1.0, False)
 
 
 def test_the_session_sets_an_option_by_name_and_keeps_the_others(tmp_path):
@@ -34,14 +42,14 @@ def test_the_session_sets_an_option_by_name_and_keeps_the_others(tmp_path):
     s.set_param("integrator_contact_weight", 20.0)
     s.set_param("integrator_iterations", 6.0)  # a whole float, as a slider gives it
     assert s.world is world  # set on the running world, no rebuild
-    assert world.integrator_options == {"iterations": 6, "contact_weight": 20.0}
+    assert world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 20.0}
     assert s.get_param("integrator_iterations") == 6 and s.get_param("integrator_mode") is None
     s.set_integrator_option("contact_weight", 15.0)
-    assert s.integrator_options == {"iterations": 6, "contact_weight": 15.0}
+    assert s.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 15.0}
     s.reset()  # starting again keeps every value, the options too
-    assert s.world.integrator_options == {"iterations": 6, "contact_weight": 15.0}
+    assert s.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 15.0}
     path = s.save(tmp_path / "options.toml")
-    assert deforma.load_scene(path).integrator_options == {"iterations": 6, "contact_weight": 15.0}
+    assert deforma.load_scene(path).integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 15.0}
 
 
 BAD = [
@@ -53,7 +61,7 @@ BAD = [
      "implicit-euler option contact_weight must be a number in (0, 1e+12), got 'x'"),
     ("integrator_mode", "serial",
      "'mode' is an option of symplectic-euler, not of implicit-euler "
-     "(implicit-euler takes iterations, contact_weight)"),
+     "(implicit-euler takes iterations, tolerance, max_iterations, contact_weight)"),
 ]
 
 
@@ -112,13 +120,15 @@ def test_the_rows_follow_an_integrator_switch_in_the_panel(demo):
     assert ins.rows["integrator_mode"].label.relative_rect.top == menu_top + ROW
     choose_from_menu(demo, ins.integrator_menu, "implicit-euler")
     assert demo.session.world.integrator == "implicit-euler"
-    assert shown_rows(ins) == ["integrator_iterations", "integrator_contact_weight"]
-    assert [ins.rows[n].label.relative_rect.top for n in shown_rows(ins)] == [menu_top + ROW, menu_top + 2 * ROW]
+    assert shown_rows(ins) == ROWS["implicit-euler"]
+    assert [ins.rows[n].label.relative_rect.top for n in shown_rows(ins)] == [menu_top + k * ROW for k in (1, 2, 3, 4)]
     assert ins.rows["integrator_iterations"].entry.get_text() == "3"
+    assert ins.rows["integrator_tolerance"].entry.get_text() == "0"
+    assert ins.rows["integrator_max_iterations"].entry.get_text() == "500"
     assert ins.rows["integrator_contact_weight"].entry.get_text() == "10"
     assert not ins.rows["integrator_mode"].menu.is_enabled  # hidden rows take no clicks
-    # what is below moved down by one row, the same widgets
-    assert dt.label.relative_rect.top == dt_top + ROW and ins.rows["stiffness"].slider is stiffness
+    # what is below moved down by three rows, the same widgets
+    assert dt.label.relative_rect.top == dt_top + 3 * ROW and ins.rows["stiffness"].slider is stiffness
     assert dt.slider.relative_rect.top == dt.label.relative_rect.top + 3
     choose_from_menu(demo, ins.integrator_menu, "xpbd")
     assert shown_rows(ins) == ["integrator_iterations"]
@@ -137,11 +147,11 @@ def test_typed_option_applies_and_a_bad_one_shows_one_line_and_changes_nothing(d
     entry.set_text("6")
     post(pygame_gui.UI_TEXT_ENTRY_FINISHED, ui_element=entry, text="6")
     run(demo, 1)
-    assert demo.session.world.integrator_options == {"iterations": 6, "contact_weight": 10.0}
+    assert demo.session.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 10.0}
     entry.set_text("0")
     post(pygame_gui.UI_TEXT_ENTRY_FINISHED, ui_element=entry, text="0")
     run(demo, 2)
-    assert demo.session.world.integrator_options == {"iterations": 6, "contact_weight": 10.0}
+    assert demo.session.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 10.0}
     assert ins.message_is_error
     assert ins.message == "implicit-euler option iterations must be an integer in [1, 10000], got 0"
     assert entry.get_text() == "6"  # the box shows the value in force again

@@ -17,6 +17,8 @@ other error or an interrupt (Ctrl-C) during a step: no half-made step stays.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from . import behaviours
@@ -147,6 +149,12 @@ def _integrate(w, start, moving: bool) -> None:
         if moving:  # the kernels moved the packed colliders: back to the start
             w._pack_colliders()
         contacts.grow()
+    if report.unconverged:
+        # the step stands (it is as good as the iterations made it), so a warning, not an
+        # error; one text, so Python shows it once where it is not filtered otherwise
+        warnings.warn("the implicit solve stopped at max_iterations short of its tolerance in some "
+                      "substeps (world.integrator_stats counts them): raise max_iterations or tolerance, "
+                      "or take more substeps", RuntimeWarning, stacklevel=3)
     if report.bad_vertices:
         raise runaway(w, w._model, state, start, w._control, w.step_count,
                       unconditionally_stable=integrator.unconditionally_stable)

@@ -331,12 +331,12 @@ class World:
         Examples
         --------
         >>> import deforma
-        >>> w = deforma.World(integrator="implicit-euler", integrator_options={"iterations": 5})
+        >>> w = deforma.World(integrator="implicit-euler", integrator_options={"tolerance": 1e-4})
         >>> w.integrator_options
-        {'iterations': 5, 'contact_weight': 10.0}
+        {'iterations': 3, 'tolerance': 0.0001, 'max_iterations': 500, 'contact_weight': 10.0}
         >>> w.integrator_options = {"contact_weight": 20.0}
         >>> w.integrator_options
-        {'iterations': 3, 'contact_weight': 20.0}
+        {'iterations': 3, 'tolerance': 0.0, 'max_iterations': 500, 'contact_weight': 20.0}
         """
         return self._integrator.options
 

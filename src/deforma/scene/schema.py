@@ -402,8 +402,10 @@ def _check_integrator(name: str, path: str) -> None:
 
     names = available_integrators()
     if name not in names:
-        close = difflib.get_close_matches(name, names, n=1)
-        hint = f"did you mean {close[0]!r}? " if close else ""
+        # every name the text begins ("implicit": both implicit integrators), else the nearest
+        close = [n for n in names if isinstance(name, str) and name and n.startswith(name)] \
+            or difflib.get_close_matches(name, names, n=1)
+        hint = f"did you mean {' or '.join(repr(n) for n in close)}? " if close else ""
         raise _Problem(path, f"unknown value {name!r}; {hint}allowed: {', '.join(names)}")
 
 

@@ -143,10 +143,12 @@ class PhysicsSettings:
                             doc="A vertex faster than this means the simulation became unstable.")
     integrator: str = spec("str", "symplectic-euler",
                            doc="Time integrator by name: symplectic-euler (explicit, the original's), "
-                               "implicit-euler or xpbd (both stable at any dt; see docs/integrators.md).")
+                               "implicit-euler, implicit-bdf2 (second order) or xpbd (all three stable at any dt; "
+                               "see docs/integrators.md).")
     integrator_options: tuple = spec("options", (),
                                      doc="The integrator's own settings, a sub-table [physics.integrator_options] "
-                                         "of name = value: iterations and contact_weight of implicit-euler, "
+                                         "of name = value: tolerance, max_iterations, iterations and contact_weight of "
+                                         "implicit-euler and implicit-bdf2, "
                                          "iterations of xpbd, mode of symplectic-euler (docs/integrators.md, "
                                          "Options). Each is checked against integrator; one left out has its "
                                          "default.")

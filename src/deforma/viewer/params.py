@@ -183,7 +183,7 @@ def integrator_params() -> tuple[Param, ...]:
     Examples
     --------
     >>> [p.name for p in integrator_params()][:3]
-    ['integrator_mode', 'integrator_iterations', 'integrator_contact_weight']
+    ['integrator_mode', 'integrator_iterations', 'integrator_tolerance']
     """
     rows = {}
     for integrator in available_integrators():

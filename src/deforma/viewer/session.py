@@ -543,7 +543,7 @@ class Session:
         --------
         >>> s = Session("demo")
         >>> s.set_integrator_option("iterations", 5); s.integrator_options
-        {'iterations': 5, 'contact_weight': 10.0}
+        {'iterations': 5, 'tolerance': 0.0, 'max_iterations': 500, 'contact_weight': 10.0}
         >>> s.set_integrator_option("iterations", 0)
         Traceback (most recent call last):
         ...

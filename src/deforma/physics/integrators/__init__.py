@@ -3,14 +3,16 @@
 - :mod:`~deforma.physics.integrators.base`: the registry, the seam every integrator
   implements, and the tail the position-based ones share;
 - :mod:`~deforma.physics.integrators.symplectic`: ``"symplectic-euler"`` (the default);
-- :mod:`~deforma.physics.integrators.implicit`: ``"implicit-euler"``;
+- :mod:`~deforma.physics.integrators.implicit`: ``"implicit-euler"`` and, second order,
+  ``"implicit-bdf2"``;
 - :mod:`~deforma.physics.integrators.xpbd`: ``"xpbd"``.
 
-Importing this package registers the three, the default first.
+Importing this package registers the four, the default first.
 """
 
 # isort: skip_file
 from .base import available_integrators, make_integrator, register_integrator
 from . import symplectic, implicit, xpbd  # noqa: F401  (each registers its integrator; the default first)
+from .implicit import bdf2  # noqa: F401  (after xpbd: the first three keep their order)
 
 __all__ = ["available_integrators", "make_integrator", "register_integrator"]

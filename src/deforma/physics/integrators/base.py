@@ -154,10 +154,14 @@ class StepReport(NamedTuple):
     complete : bool
         False when the contact buffer was too small: ``contacts.needed`` says how large it
         must be; grow it and run the step again from ``state_in``.
+    unconverged : int
+        Substeps of an iterative solve that stopped at its iteration limit short of its
+        tolerance (the step stands; the World counts them as a warning).
     """
 
     bad_vertices: int = 0
     complete: bool = True
+    unconverged: int = 0
 
 
 @dataclass(frozen=True)
@@ -165,7 +169,8 @@ class Option:
     """One setting of an integrator: its name, default and what values it takes.
 
     ``kind`` is ``"int"`` (an integer in ``[low, high]``), ``"float"`` (a number in the open
-    interval ``(low, high)``) or ``"choice"`` (one of ``choices``).
+    interval ``(low, high)``, or ``[low, high)`` with ``closed_low``) or ``"choice"`` (one of
+    ``choices``).
 
     Examples
     --------
@@ -180,13 +185,14 @@ class Option:
     high: float = math.inf
     choices: tuple = ()
     doc: str = ""
+    closed_low: bool = False
 
     def allowed(self) -> str:
         """What the option takes, in words."""
         if self.kind == "int":
             return f"an integer in [{self.low:g}, {self.high:g}]"
         if self.kind == "float":
-            return f"a number in ({self.low:g}, {self.high:g})"
+            return f"a number in {'[' if self.closed_low else '('}{self.low:g}, {self.high:g})"
         return "one of " + ", ".join(repr(c) for c in self.choices)
 
     def check(self, value, integrator: str):
@@ -199,7 +205,8 @@ class Option:
             return int(value)
         if self.kind == "float":
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-                    or not self.low < float(value) < self.high:
+                    or not (self.low <= float(value) if self.closed_low else self.low < float(value)) \
+                    or not float(value) < self.high:
                 raise bad
             return float(value)
         if value not in self.choices:
@@ -269,7 +276,8 @@ def unknown_option(key, integrator: str) -> str:
     mine = [o.name for o in _REGISTRY[integrator].OPTIONS] if integrator in _REGISTRY else []
     takes = f"{integrator} takes " + (", ".join(mine) if mine else "no options")
     if others:
-        return f"{key!r} is an option of {' and '.join(others)}, not of {integrator} ({takes})"
+        named = others[0] if len(others) == 1 else ", ".join(others[:-1]) + " and " + others[-1]
+        return f"{key!r} is an option of {named}, not of {integrator} ({takes})"
     near = difflib.get_close_matches(str(key), mine, n=1)
     hint = f" (did you mean {near[0]!r}?)" if near else ""
     return f"unknown {integrator} option {key!r}{hint}; {takes}"
