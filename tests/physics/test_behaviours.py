@@ -164,6 +164,25 @@ def test_bar_bent_below_yield_returns():
     assert abs(offset) < 0.001 * 0.3
 
 
+def test_an_element_squashed_flat_keeps_its_rest_shape():
+    # a triangle of the dent scene pressed flat onto the floor under XPBD (its three corners
+    # on one line, to rounding): its flow is singular, and the dent scene stopped there with a
+    # ZeroDivisionError traceback; now the element keeps its rest shape and the run goes on
+    from deforma.physics.behaviours.plasticity import yield_elements
+
+    def exact(*hexes):  # the recorded values, to the bit
+        return np.array([float.fromhex(h) for h in hexes])
+
+    x = exact("-0x1.c32bd3b2beb34p-1", "-0x1.999999101b27bp-5", "-0x1.82aac6985bb58p-1", "-0x1.999999101b27ap-5",
+              "-0x1.907a5690ec9d8p-1", "-0x1.999999101b27ap-5").reshape(3, 2)
+    b = exact("0x1.49da45ffa9426p+3", "-0x1.2a8ff56d9803ep+5", "-0x1.898f50f608248p+1", "0x1.ae378aa3d0975p+5")[None]
+    b0 = exact("0x1.5aaaaaaaaaaaap+3", "-0x1.5aaaaaaaaaaa2p+4", "-0x0.0p+0", "0x1.5aaaaaaaaaaa2p+4")[None]
+    area, area0 = exact("0x1.2a2cd05bd5782p-10"), exact("0x1.1734e5857bca6p-9")
+    before = b.copy()
+    assert yield_elements(x, np.array([[0, 1, 2]], np.int32), b, area, b0, area0, 0.03, 1.0) == 0
+    assert np.array_equal(b, before)
+
+
 def test_plastic_springs_keep_a_dent():
     mat = deforma.Material("springs", yield_strain=0.02)
     w = deforma.World(gravity=(0, 0), material=mat, stiffness=500.0, damping=0.5, substeps=4)

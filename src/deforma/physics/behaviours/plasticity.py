@@ -21,6 +21,8 @@ flow (its stretch has no meaning to make permanent); the elastic forces push it 
 
 from __future__ import annotations
 
+import math
+
 from numba import njit
 
 from ..elements.triangles import corners, deformation_gradient
@@ -109,6 +111,11 @@ def yield_elements(x, elem, b, area, b0, area0, yield_strain, rate):
         # the accumulated plastic deformation B0 B'^-1... its stretches must stay within the limit:
         # G = (B')^-1 B0 maps the original rest shape to the new one
         det = n00 * n11 - n01 * n10
+        if not (det > 0.0 and det < math.inf):
+            # a triangle pressed flat (its smallest stretch ~1e-17): its flow is singular to
+            # rounding and would make the rest shape so; no flow (the shape checks report a
+            # body that stays flattened)
+            continue
         g00 = (n11 * b0[e, 0] - n01 * b0[e, 2]) / det
         g01 = (n11 * b0[e, 1] - n01 * b0[e, 3]) / det
         g10 = (-n10 * b0[e, 0] + n00 * b0[e, 2]) / det
