@@ -23,7 +23,7 @@ import numpy as np
 
 from . import behaviours
 from .behaviours import tearing
-from .diagnostics import SHAPE_CHECK_EVERY, lost_shape, runaway, trapped
+from .diagnostics import SHAPE_CHECK_EVERY, SimulationUnstable, lost_shape, runaway, trapped
 from .topology import BodyTopology
 
 REPACK_EVERY = 64  # steps: moving colliders are packed again from their objects this often
@@ -94,6 +94,9 @@ def step(world) -> None:
         return
     if w._grabs_dirty:
         w._rebuild_grabs()
+    if w._auto:  # substeps = "auto": chosen again when what the stable step depends on changed
+        w._substeps = w._auto_substeps(lambda message: SimulationUnstable(
+            message, body=w._bodies[0], step=w.step_count, hint=message))
     control = w._control
     control.step = w.step_count
     if control.has_force:

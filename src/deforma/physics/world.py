@@ -16,6 +16,7 @@ Units are SI (m, kg, s, N); y points up; angles are degrees.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -53,8 +54,11 @@ class World:
         Acceleration of gravity in m/s^2.
     dt : float, optional
         Time advanced by one :meth:`step`, seconds (> 0).
-    substeps : int, optional
-        Integration substeps per step (>= 1); each is ``dt / substeps`` long.
+    substeps : int or "auto", optional
+        Integration substeps per step (>= 1); each is ``dt / substeps`` long. ``"auto"``:
+        as many as the explicit integrator's stable step asks (``ceil(dt / stable_dt())``,
+        chosen again whenever the bodies, their parameters, the grabs or ``dt`` change; 1
+        under the unconditionally stable integrators); past 1000 it is refused in one line.
     mass : float, optional
         Default total mass of a body in kg (> 0); each vertex weighs ``mass / N``.
     stiffness : float, optional
@@ -128,9 +132,11 @@ class World:
         self._material = None
         self.time = 0.0
         self.step_count = 0
+        self._auto = False  # substeps = "auto"
+        self._auto_key = None  # what the automatic substeps were chosen for
         self.gravity = gravity
         self.dt = dt
-        self.substeps = substeps
+        self.substeps = 1 if isinstance(substeps, str) and substeps == "auto" else substeps  # "auto" needs the integrator
         self.mass = mass
         self.stiffness = stiffness
         self.damping = damping
@@ -141,6 +147,8 @@ class World:
         self.integrator = integrator
         if integrator_options is not None:
             self.integrator_options = integrator_options
+        if isinstance(substeps, str) and substeps == "auto":
+            self.substeps = "auto"
         self.contact_thickness = contact_thickness
         self.air_drag = air_drag
         self.material = material
@@ -185,16 +193,65 @@ class World:
 
     @property
     def substeps(self) -> int:
-        """Substeps per step."""
+        """Substeps per step: the number in force (with ``"auto"``, the one chosen for the
+        bodies as they are now; :attr:`auto_substeps` says whether it follows them).
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(dt=1 / 60, stiffness=2000.0)
+        >>> _ = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=4))
+        >>> w.substeps = "auto"
+        >>> w.substeps, w.auto_substeps  # ceil(dt / stable_dt())
+        (11, True)
+        >>> w.integrator = "implicit-euler"; w.substeps  # stable at any step
+        1
+        """
+        if self._auto:
+            try:
+                self._substeps = self._auto_substeps(ValueError)
+            except ValueError:  # more than allowed: the next step says so
+                pass
         return self._substeps
 
     @substeps.setter
     def substeps(self, value):
+        if isinstance(value, str) and value == "auto":
+            self._auto_key = None
+            self._substeps = self._auto_substeps(ValueError)
+            self._auto = True
+            return
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SUBSTEPS:
             raise ValueError(f"substeps must be an integer in [1, {MAX_SUBSTEPS}] (one step must stay short "
-                             f"enough to interrupt), got {value!r}")
+                             f"enough to interrupt) or \"auto\", got {value!r}")
         self._check_substep(self._dt, int(value))
         self._substeps = int(value)
+        self._auto = False
+
+    @property
+    def auto_substeps(self) -> bool:
+        """Whether ``substeps`` is ``"auto"``: chosen from the stable step before every step
+        in which the bodies, their parameters, the grabs, ``dt`` or the integrator changed."""
+        return self._auto
+
+    def _auto_substeps(self, error):
+        """The substeps ``"auto"`` asks now: ``ceil(dt / stable_dt())``; ``error`` (a
+        one-line exception type, or a callable taking the message) past ``MAX_SUBSTEPS``."""
+        if self._grabs_dirty:
+            self._rebuild_grabs()
+        model, control = self._model, self._control
+        key = (model, model.version, self._dt, self._integrator.name, control.grab_slot.tobytes(),
+               control.grab_pull[:, 0].tobytes())
+        if self._auto_key is not None and self._auto_key[0] is model and self._auto_key[1:] == key[1:]:
+            return self._substeps
+        stable = self.stable_dt()
+        need = 1 if not math.isfinite(stable) else max(1, math.ceil(self._dt / stable * (1.0 + 1e-9)))
+        if need > MAX_SUBSTEPS:
+            raise error(f"substeps = \"auto\" would need {need} substeps of dt = {self._dt:g} s (stable step "
+                        f"{stable:.3g} s), more than {MAX_SUBSTEPS}: lower dt, soften the bodies, or use "
+                        f"integrator=\"implicit-euler\"")
+        self._auto_key = key
+        return need
 
     @staticmethod
     def _check_substep(dt, substeps):
@@ -450,6 +507,15 @@ class World:
         vs = [self._state.v, np.zeros_like(topo.rest_positions)]
         self._bodies.append(body)
         self._rebuild(np.concatenate(xs), np.concatenate(vs))
+        if not self._auto and not self._integrator.unconditionally_stable:
+            stable = self.stable_dt()
+            if self._dt / self._substeps > stable:
+                # say so now, not at the step that blows up
+                need = math.ceil(self._dt / stable)
+                warnings.warn(f"under {self.integrator} this world's step, dt/substeps = {self._dt / self._substeps:.3g} "
+                              f"s, exceeds the stable estimate {stable:.3g} s with this body: set substeps = "
+                              f"{need} (or \"auto\"), lower dt, or use integrator=\"implicit-euler\"",
+                              RuntimeWarning, stacklevel=2)
         return body
 
     def remove_body(self, body: Body) -> None:

@@ -189,6 +189,15 @@ def _convert(value, meta, path, ctx):
         x = _number(value, path, integer=kind == "int")
         _check_range(x, meta, path)
         return x
+    if kind == "substeps":  # an integer, or "auto" (as many as the stable step asks)
+        if value == "auto":
+            return value
+        if isinstance(value, str):
+            raise _Problem(path, f"expected an integer in [{meta['lo']:g}, {meta['hi']:g}] or \"auto\", "
+                                 f"got {_show(value)}")
+        x = _number(value, path, integer=True)
+        _check_range(x, meta, path)
+        return x
     if kind == "bool":
         if not isinstance(value, bool):
             raise _Problem(path, f"expected true or false, got {_show(value)}")

@@ -80,6 +80,7 @@ def spec(kind: str, default: Any = MISSING, *, lo=None, hi=None, lo_open=False, 
     (an image collider's source: a built-in level or texture name, or an image path), options
     (a sub-table of name = value, kept as ``(name, value)`` pairs: the integrator's options,
     whose names and values the integrator itself checks).
+    substeps (an integer or "auto").
     ``lo``/``hi`` bound numbers (``lo_open``/``hi_open`` make a bound exclusive). ``choices``
     may be a function giving them when a file is read (the material models: a registered
     element kind adds its own).
@@ -127,7 +128,9 @@ class PhysicsSettings:
 
     dt: float = spec("float", 1 / 600, lo=0.0, hi=0.1, lo_open=True, unit="s",
                      doc="Time advanced per step; smaller is more accurate and slower.")
-    substeps: int = spec("int", 1, lo=1, hi=1000, doc="Integration substeps per step, each dt/substeps long.")
+    substeps: int | str = spec("substeps", 1, lo=1, hi=1000,
+                               doc="Integration substeps per step, each dt/substeps long; \"auto\": as many as the "
+                                   "explicit integrator's stable step asks, chosen again as the bodies change.")
     gravity: tuple = spec("vec2", (0.0, -9.81), unit="m/s^2", doc="Acceleration of gravity.")
     damping: float = spec("float", 0.5, lo=0.0, unit="N*s/m", doc="Spring damping kd.")
     mass: float = spec("float", 1.0, lo=0.0, lo_open=True, unit="kg",

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import copy
 import math
+import warnings
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -620,7 +621,9 @@ class Session:
                 kept = True
             except ValueError:
                 pass
-        self._rebuild(body)
+        with warnings.catch_warnings():  # add_body's warning of a step beyond the explicit limit:
+            warnings.simplefilter("ignore", RuntimeWarning)  # _keep_stable acts on it and says so
+            self._rebuild(body)
         self.mesh = new
         self._keep_stable()
         if pinned_before and not kept:
