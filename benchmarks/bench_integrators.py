@@ -21,6 +21,12 @@ Figures are medians of timed ``world.step()`` calls after warm-up steps (which i
 Numba compilation and, for implicit Euler, the one factorization). The cost per simulated
 second is the step time divided by ``dt``. A separate row times one implicit Euler step of
 one substep at ``dt = 1/60 s`` on 1e5 vertices, the issue's goal (<= 0.1 s).
+
+The converged rows (:func:`converged_rows`) time implicit Euler solved to ``tolerance =
+1e-3`` m/s and ``implicit-bdf2`` (the same tolerance, its default) against implicit Euler's
+three fixed iterations on the same body, one step of each in turn (alternating, so that the
+shared machine's load falls on all three alike), and the spinning box of
+``tests/physics/test_converged_implicit.py`` (1e4 Pa) likewise.
 """
 
 from __future__ import annotations
@@ -100,6 +106,63 @@ def run(quick: bool) -> list[Row]:
     rows.append(Row("integrators", f"implicit-euler, {n * n:.0e} vertices, one step of 1/60 s "
                                    f"({w.integrator_options['iterations']} local/global iterations)".replace("+0", ""),
                     step, "s", "", "<= 0.1 s per step at 1e5 vertices", None if quick else step <= 0.1))
+    rows += converged_rows(quick)
+    return rows
+
+
+SOLVES = (("implicit-euler", {}, "3 iterations"), ("implicit-euler", {"tolerance": 1e-3}, "tolerance 1e-3 m/s"),
+          ("implicit-bdf2", {}, "tolerance 1e-3 m/s"))
+
+
+def spinning_box(integrator: str, options: dict):
+    """The spinning box of the converged-solve tests: 1 m, corotated 1e4 Pa, 5 rad/s, no gravity."""
+    w = deforma.World(gravity=(0.0, 0.0), dt=1 / 60, integrator=integrator, integrator_options=options)
+    m = deforma.Material("corotated", youngs_modulus=1e4, poisson_ratio=0.3, density=100.0)
+    b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=8, edges=True), position=(0, 0),
+                   material=m)
+    r = b.positions - b.center_of_mass
+    b.velocities = 5.0 * np.stack([-r[:, 1], r[:, 0]], axis=1)
+    return w, b
+
+
+def alternating(worlds, *, warmup: int, repeat: int) -> list[float]:
+    """Median seconds per step of each world, stepping them in turn."""
+    for w in worlds:
+        for _ in range(warmup):
+            w.step()
+    times = [[] for _ in worlds]
+    for _ in range(repeat):
+        for w, t in zip(worlds, times):
+            t0 = time.perf_counter()
+            w.step()
+            t.append(time.perf_counter() - t0)
+    return [statistics.median(t) for t in times]
+
+
+def converged_rows(quick: bool) -> list[Row]:
+    """Implicit Euler to a tolerance and BDF2 against three fixed iterations: the standing
+    body (1e4 vertices; 1e5 too unless quick) and the spinning box, alternating."""
+    rows = []
+    cases = [("standing body, 1e4 vertices", lambda i, o: make_world(100, i)[0], 10, 7)]
+    if not quick:
+        cases.append(("standing body, 1e5 vertices", lambda i, o: make_world(317, i)[0], 3, 3))
+    cases.append(("spinning box, 1e4 Pa, 1/60 s", lambda i, o: spinning_box(i, o)[0], 5, 25))
+    for label, make, warmup, repeat in cases:
+        worlds = []
+        for integrator, options, _ in SOLVES:
+            w = make(integrator, options)
+            w.integrator_options = options
+            worlds.append(w)
+        steps = alternating(worlds, warmup=warmup, repeat=repeat)
+        for (integrator, options, how), w, step in zip(SOLVES, worlds, steps):
+            st = w.integrator_stats
+            per = st["iterations"] / max(1, (w.step_count * w.substeps))
+            goal, met = "", None
+            if options and label.endswith("1e5 vertices") and integrator == "implicit-euler":
+                goal, met = "converged 1e5-vertex step <= 2x the fixed one", step <= 2 * steps[0]
+            rows.append(Row("integrators", f"{integrator}, {how}, {label}: one step of 1/60 s", step, "s",
+                            f"{step / steps[0]:.2g}x the 3-iteration step; {per:.0f} iterations per substep, "
+                            f"{st['unconverged']} unconverged", goal, met))
     return rows
 
 
