@@ -331,3 +331,36 @@ def test_springs_switch_runs_a_material_scene_with_the_original_springs(tmp_path
         world.step()
     assert not world.bodies[0].is_fem
     np.testing.assert_allclose(d["body0_positions"][-1], world.bodies[0].positions, atol=1e-9)
+
+
+TOPPLE = """[run]
+seconds = 1.0
+fps = 5
+[physics]
+dt = 0.016666666666666666
+integrator = "implicit-bdf2"
+material = "corotated"
+youngs_modulus = 1e7
+poisson_ratio = 0.3
+density = 100.0
+[[body]]
+shape = "box"
+corners = [[-0.123205, -0.186603], [0.223205, 0.013397], [0.123205, 0.186603], [-0.223205, -0.013397]]
+detail = 6
+position = [0.0, 1.0]
+[[collider]]
+center = [0.0, -0.25]
+size = [6.0, 0.5]
+"""
+
+
+def test_a_physics_warning_is_one_line_of_the_commands_own(tmp_path, capsys):
+    # a stiff block landing on its corner: a few substeps of the impact stop at max_iterations
+    p = tmp_path / "topple.toml"
+    p.write_text(TOPPLE)
+    code, out, err = run(capsys, "run", str(p), "--quiet", "--states", str(tmp_path / "s.npz"))
+    assert code == 0
+    lines = [line for line in err.splitlines() if not line.startswith("deforma: compiling the physics")]
+    assert lines == ["deforma: warning: the implicit solve stopped at max_iterations short of its tolerance in some "
+                     "substeps (world.integrator_stats counts them): raise max_iterations or tolerance, or take "
+                     "more substeps"]

@@ -16,6 +16,7 @@ import argparse
 import math
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -573,6 +574,11 @@ def main(argv=None) -> int:
     a.started = started
     commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view, "sweep": cmd_sweep}
     restore_signals = _stop_on_signals()
+    shown = warnings.showwarning
+    if not a.debug:  # a warning of the physics (a step beyond the explicit limit, an unconverged
+        # solve) as one line of the command's own, not Python's two with a source line
+        warnings.showwarning = lambda message, *_args, **_kw: print(f"deforma: warning: {message}",
+                                                                     file=sys.stderr)
     try:
         return commands[a.command](a)
     except KeyboardInterrupt:
@@ -600,6 +606,7 @@ def main(argv=None) -> int:
         return EXIT_ERROR
     finally:
         restore_signals()
+        warnings.showwarning = shown
 
 
 if __name__ == "__main__":  # pragma: no cover
