@@ -23,11 +23,11 @@ def column(nx):
     return deforma.mesh.Mesh(np.c_[xs.ravel(), ys.ravel()], np.r_[np.c_[a, b, c], np.c_[a, c, d]])
 
 
-def hang(model, nx, integrator, *, substeps=1):
+def hang(model, nx, integrator, *, substeps=1, plane="stress"):
     """Settled column: (elongation of the bottom edge, lateral strain at mid-height)."""
     w = deforma.World(integrator=integrator, air_drag=20.0, dt=1 / 60, substeps=substeps)
     m = column(nx)
-    mat = deforma.Material(model, youngs_modulus=E, poisson_ratio=NU, density=RHO)
+    mat = deforma.Material(model, youngs_modulus=E, poisson_ratio=NU, density=RHO, plane=plane)
     b = w.add_body(m, material=mat, position=None)
     b.pin(np.flatnonzero(np.isclose(m.vertices[:, 1], 0.0)))
     if integrator == "symplectic-euler":
@@ -51,6 +51,17 @@ def test_hanging_column_elongation_and_contraction_at_three_resolutions(model):
         assert abs(elongation / EXPECTED - 1) < 0.03, (nx, elongation, EXPECTED)
         axial = RHO * G * (L / 2) / E  # strain at mid-height
         assert abs(-lateral / axial / NU - 1) < 0.15, (nx, lateral, axial)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_hanging_column_in_plane_strain(model):
+    # the cross-section of a long body: it cannot strain along its length, so it is stiffer
+    # in the plane by 1 / (1 - nu^2) and narrows by nu / (1 - nu) of its stretch
+    for nx in (4, 8):
+        elongation, lateral = hang(model, nx, "implicit-euler", plane="strain")
+        assert abs(elongation / (EXPECTED * (1 - NU * NU)) - 1) < 0.03, (nx, elongation)
+        axial = RHO * G * (L / 2) / E * (1 - NU * NU)
+        assert abs(-lateral / axial / (NU / (1 - NU)) - 1) < 0.15, (nx, lateral, axial)
 
 
 @pytest.mark.parametrize("model", MODELS)

@@ -154,6 +154,10 @@ BAD = [
      "body[0].pin_vertices: vertex index 99 is out of range; the body has vertices 0..15"),
     ("[[body]]\npin_vertices = [-1]\n", "body[0].pin_vertices[0]: vertex indices must be >= 0, got -1"),
     ("[[body]]\npin_vertices = 3\n", "body[0].pin_vertices: expected vertex indices [i, j, ...]"),
+    (FEM + "plane = '3d'\n", "physics.plane: unknown value '3d'; allowed: stress, strain"),
+    ("[[body]]\nplane = 'strain'\n", "body[0].plane: the 'springs' material takes no plane"),
+    ("[physics]\nplane = 'strain'\n[[body]]\ndetail = 2\n",
+     "physics.plane: no body is made of finite elements to use it (physics.material is 'springs')"),
 ]
 
 
@@ -302,3 +306,22 @@ def test_pins_and_materials_of_a_world_made_in_code_round_trip(tmp_path):
     assert [x.material for x in w2.bodies] == [a.material, b.material, c.material]
     assert w2.bodies[2].mass == 2.0
     np.testing.assert_array_equal(w2.bodies[0].pinned, a.pinned)
+
+
+def test_plane_strain_from_physics_or_a_body_builds_and_round_trips(tmp_path):
+    path = write(tmp_path, FEM + """
+        plane = "strain"
+        [[body]]
+        detail = 3
+        position = [0, 2]
+        [[body]]
+        detail = 3
+        position = [3, 2]
+        plane = "stress"
+    """)
+    w = scenes.load_scene(path)
+    assert w.material.plane == "strain" and w.material.lame()[1] == pytest.approx(2e4 * 0.3 / (1.3 * 0.4))
+    assert [b.material.plane for b in w.bodies] == ["strain", "stress"]
+    scene, w2 = saved(w, tmp_path)
+    assert scene.physics.plane == "strain" and scene.body[1].plane == "stress"
+    assert [b.material for b in w2.bodies] == [b.material for b in w.bodies]

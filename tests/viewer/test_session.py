@@ -437,3 +437,15 @@ def test_pressure_on_an_open_outline_is_refused_and_changes_nothing():
         s.set_param("pressure", 100.0)
     assert "\n" not in str(e.value) and "outline" in str(e.value)
     assert s.get_param("pressure") is None and s.scene == before
+
+
+def test_a_plane_strain_world_keeps_its_plane_through_the_panel(tmp_path):
+    p = tmp_path / "strain.toml"
+    p.write_text('[physics]\nmaterial = "corotated"\nyoungs_modulus = 2e4\npoisson_ratio = 0.3\ndensity = 2.0\n'
+                 'plane = "strain"\n[[body]]\ndetail = 3\nposition = [0, 2]\n')
+    s = Session(str(p))
+    s.set_param("youngs_modulus", 3e4)
+    assert s.world.material.plane == "strain" and s.world.material.youngs_modulus == 3e4
+    s.set_material("neo-hookean")
+    assert s.world.material.plane == "strain"
+    assert deforma.load_scene(s.save(tmp_path / "again.toml")).material.plane == "strain"

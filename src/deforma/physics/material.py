@@ -7,14 +7,21 @@ elements: every triangle of the mesh is a linear (constant-strain) element of an
 sheet with Young's modulus ``E``, Poisson ratio ``nu`` and areal density ``rho``, so the
 same object meshed finer is the same object.
 
-Units. The world is 2D: a body is a slab of unit thickness seen from its face, in plane
-stress. ``youngs_modulus`` is in Pa (N/m^2, i.e. N/m per metre of thickness), ``density``
-in kg/m^2 (mass per area: a body weighs ``density * area``). Plane stress gives the Lamé
+Units. The world is 2D: a body is a slab of unit thickness seen from its face.
+``youngs_modulus`` is in Pa (N/m^2, i.e. N/m per metre of thickness), ``density`` in
+kg/m^2 (mass per area: a body weighs ``density * area``). ``plane`` says what the slab is:
+``"stress"`` (the default), a thin sheet free to thin out of its plane, with the Lamé
 parameters
 
     mu = E / (2 (1 + nu)),    lambda = E nu / (1 - nu^2),
 
-so that a strip pulled along its length contracts across by ``nu`` times its stretch.
+so that a strip pulled along its length contracts across by ``nu`` times its stretch; or
+``"strain"``, a cross-section of a long body that cannot strain along its length (a dam, a
+tunnel lining, a long rubber seal), with
+
+    mu = E / (2 (1 + nu)),    lambda = E nu / ((1 + nu) (1 - 2 nu)),
+
+stiffer the nearer ``nu`` is to 0.5 (its in-plane Poisson ratio is ``nu / (1 - nu)``).
 
 Damping (``damping``, seconds) is stiffness-proportional (Rayleigh, Kelvin-Voigt): a
 viscous stress equal to the elastic stress of the strain *rate*, times ``damping``. A
@@ -38,6 +45,8 @@ from dataclasses import KW_ONLY, dataclass
 from .elements.kind import BUILT_IN, registered_models
 
 MODELS = BUILT_IN  # more come from registered element kinds (material_models)
+#: What a finite-element body's slab is: a thin sheet or the cross-section of a long body.
+PLANES = ("stress", "strain")
 # Element kind codes stored per triangle in the Model (springs bodies have no elements).
 KIND_COROTATED = 0
 KIND_NEO_HOOKEAN = 1
@@ -104,6 +113,9 @@ class Material:
         Strain limit: no spring or element ends a step stretched beyond this ratio of its
         rest length in any direction (1.05 = at most 5% longer), however hard it is pulled
         (:mod:`deforma.physics.behaviours.strain_limit`). ``None`` (default): no limit. In (1, 100].
+    plane : {"stress", "strain"}, optional
+        Finite elements: a thin sheet (``"stress"``, default) or the cross-section of a long
+        body (``"strain"``); see the module docstring for the Lamé parameters of each.
 
     Raises
     ------
@@ -131,6 +143,7 @@ class Material:
     yield_strain: float | None = None
     plastic_rate: float = 1.0
     max_stretch: float | None = None
+    plane: str = "stress"
 
     def __post_init__(self):
         models = material_models()
@@ -139,9 +152,12 @@ class Material:
                              f"got {self.model!r}")
         self._check_behaviours()
         given = [k for k in ("youngs_modulus", "poisson_ratio", "density") if getattr(self, k) is not None]
+        if not (isinstance(self.plane, str) and self.plane in PLANES):
+            raise ValueError(f"plane must be 'stress' or 'strain', got {self.plane!r}")
         if self.model == "springs":
-            if given or self.damping != 0.0:
-                extra = ", ".join(given + (["damping"] if self.damping != 0.0 else []))
+            if given or self.damping != 0.0 or self.plane != "stress":
+                extra = ", ".join(given + (["damping"] if self.damping != 0.0 else [])
+                                  + (["plane"] if self.plane != "stress" else []))
                 raise ValueError(f"the 'springs' material takes no {extra}: its springs use the body's "
                                  f"stiffness (N/m), damping (N*s/m) and mass (kg)")
             return
@@ -204,16 +220,20 @@ class Material:
         return KIND_CODES[self.model]
 
     def lame(self) -> tuple[float, float]:
-        """Plane-stress Lamé parameters ``(mu, lambda)`` in Pa.
+        """Lamé parameters ``(mu, lambda)`` in Pa, of plane stress or plane strain (``plane``).
 
         Examples
         --------
-        >>> Material("corotated", youngs_modulus=2.6, poisson_ratio=0.3, density=1.0).lame()[0]
-        1.0
+        >>> Material("corotated", youngs_modulus=2.6, poisson_ratio=0.3, density=1.0).lame()
+        (1.0, 0.8571428571428571)
+        >>> Material("corotated", youngs_modulus=2.6, poisson_ratio=0.3, density=1.0, plane="strain").lame()
+        (1.0, 1.5)
         """
         if not self.is_fem:
             raise ValueError("the 'springs' material has no Lamé parameters")
         e, nu = self.youngs_modulus, self.poisson_ratio
+        if self.plane == "strain":
+            return e / (2.0 * (1.0 + nu)), e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
         return e / (2.0 * (1.0 + nu)), e * nu / (1.0 - nu * nu)
 
     def wave_speed(self) -> float:

@@ -122,7 +122,7 @@ def _material_keys(world, recorded: PhysicsSettings) -> dict:
     behaviours = _behaviour_keys(m)
     if m is not None and m.is_fem:
         return dict(material=m.model, youngs_modulus=m.youngs_modulus, poisson_ratio=m.poisson_ratio,
-                    density=m.density, material_damping=m.damping, **behaviours)
+                    density=m.density, material_damping=m.damping, plane=m.plane, **behaviours)
     # A springs world: finite-element keys in [physics] are defaults for bodies that choose a
     # finite-element model. The world does not hold them, so keep the scene's while some body
     # is made of elements (a file must not hold defaults that no body uses: load refuses it).
@@ -131,7 +131,8 @@ def _material_keys(world, recorded: PhysicsSettings) -> dict:
                 youngs_modulus=recorded.youngs_modulus if keep else None,
                 poisson_ratio=recorded.poisson_ratio if keep else None,
                 density=recorded.density if keep else None,
-                material_damping=recorded.material_damping if keep else 0.0, **behaviours)
+                material_damping=recorded.material_damping if keep else 0.0,
+                plane=recorded.plane if keep else "stress", **behaviours)
 
 
 def _behaviour_keys(material) -> dict:
@@ -158,10 +159,10 @@ def _body_material_keys(material) -> dict:
     behaviours = _behaviour_keys(material)
     if not material.is_fem:
         return dict(material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
-                    material_damping=None, **behaviours)
+                    material_damping=None, plane=None, **behaviours)
     return dict(material=material.model, youngs_modulus=material.youngs_modulus,
                 poisson_ratio=material.poisson_ratio, density=material.density, material_damping=material.damping,
-                **behaviours)
+                plane=material.plane, **behaviours)
 
 
 def _pin_keys(spec, body) -> dict:
@@ -188,7 +189,7 @@ def scene_of(world) -> Scene:
     the starting positions: a scene describes a setup, not a moment of a run.
 
     Materials: the world's material goes to ``[physics]``; a body whose material differs from
-    what its spec and ``[physics]`` give it gets all nine material keys of its own (so a body
+    what its spec and ``[physics]`` give it gets all ten material keys of its own (so a body
     whose own material equals the world's is written as following the world). A
     finite-element body has no spring mass, stiffness or damping to write. Pins: the spec's
     ``pin`` box is kept while the body's pinned vertices are exactly those inside it;

@@ -55,11 +55,11 @@ from pathlib import Path
 from ..mesh.image import check_background
 from .assets import picture_reference, resolve_picture, resolve_texture, texture_reference
 from .construct import build
-from .tables import (BEHAVIOUR_KEYS, BODY_KINDS, COLLIDER_KINDS, FEM_KEYWORD, MATERIAL_KEYS, MATERIAL_MODELS,
-                     BodyPhysics, BoxBody, CameraSettings, CircleCollider, ColliderCommon, ColliderSpec, Event,
-                     ImageBody, ImageCollider, InteractionSettings, MaterialKeyError, MeshBody, PhysicsSettings,
-                     PolygonCollider, Pull, RectCollider, RunSettings, SceneError, SceneInfo, SegmentCollider,
-                     material_settings)
+from .tables import (BEHAVIOUR_KEYS, BODY_KINDS, COLLIDER_KINDS, FEM_DEFAULT, FEM_KEYWORD, MATERIAL_KEYS,
+                     MATERIAL_MODELS, BodyPhysics, BoxBody, CameraSettings, CircleCollider, ColliderCommon,
+                     ColliderSpec, Event, ImageBody, ImageCollider, InteractionSettings, MaterialKeyError, MeshBody,
+                     PhysicsSettings, PolygonCollider, Pull, RectCollider, RunSettings, SceneError, SceneInfo,
+                     SegmentCollider, material_settings)
 
 # the tables are part of the file format: they are named here too (deforma.scene.schema.BoxBody)
 __all__ = [
@@ -361,7 +361,7 @@ def with_springs(scene: Scene) -> Scene:
     ('springs', None)
     """
     physics = replace(scene.physics, material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
-                      material_damping=0.0)
+                      material_damping=0.0, plane="stress")
     # the behaviours (tearing, plasticity, stretch limit) work for springs too: they stay
     model_keys = [k for k in MATERIAL_KEYS if k not in BEHAVIOUR_KEYS]
     bodies = tuple(replace(b, **dict.fromkeys(model_keys)) for b in scene.body)
@@ -384,7 +384,7 @@ def _check_materials(values: dict) -> None:
         fem_bodies += own is not None and own["model"] != "springs"
     if physics.material == "springs" and not fem_bodies:
         # finite-element defaults that no body uses are most likely a forgotten material key
-        unused = [k for k in FEM_KEYWORD if getattr(physics, k) not in (None, 0.0)]
+        unused = [k for k in FEM_KEYWORD if getattr(physics, k) not in (None, FEM_DEFAULT.get(k, 0.0))]
         if unused:
             raise _Problem(f"physics.{unused[0]}", "no body is made of finite elements to use it (physics.material "
                                                    "is 'springs'): set material = \"corotated\" or \"neo-hookean\" "

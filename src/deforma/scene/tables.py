@@ -13,7 +13,7 @@ built as one polygon per piece of its picture, and written back as those polygon
 
 Materials: ``[physics] material`` (with ``youngs_modulus``, ``poisson_ratio``, ``density``,
 ``material_damping`` and the behaviours ``tear_strain``, ``yield_strain``, ``plastic_rate``,
-``max_stretch``) is the world's default; the same nine keys on a ``[[body]]`` give it its
+``max_stretch``, and ``plane``) is the world's default; the same ten keys on a ``[[body]]`` give it its
 own material, each key it leaves out taken from ``[physics]``. :func:`material_settings`
 says what a table means and refuses the combinations that mean nothing (finite-element
 parameters on springs, spring mass on finite elements, a finite-element model without E).
@@ -40,10 +40,10 @@ from ..checks import MAX_DETAIL
 
 # an image body's background: the names of deforma.mesh.from_image itself
 from ..mesh.image import BACKGROUND_NAMES
-from ..physics.material import MODELS, material_models
+from ..physics.material import MODELS, PLANES, material_models
 
 __all__ = [
-    "BEHAVIOUR_KEYS", "BODY_KINDS", "COLLIDER_KINDS", "COLLIDER_SHAPES", "FEM_KEYWORD", "MATERIAL_KEYS",
+    "BEHAVIOUR_KEYS", "BODY_KINDS", "COLLIDER_KINDS", "COLLIDER_SHAPES", "FEM_DEFAULT", "FEM_KEYWORD", "MATERIAL_KEYS",
     "MATERIAL_MODELS", "BodyPhysics", "BoxBody", "CameraSettings", "CircleCollider", "ColliderCommon", "ColliderSpec",
     "Event", "ImageBody", "ImageCollider", "InteractionSettings", "MaterialKeyError", "MeshBody", "PhysicsSettings",
     "PolygonCollider", "Pull", "RectCollider", "RunSettings", "SceneError", "SceneInfo", "SegmentCollider",
@@ -58,10 +58,13 @@ MATERIAL_MODELS = MODELS  # built in; material_models() adds those of registered
 BEHAVIOUR_KEYS = ("tear_strain", "yield_strain", "plastic_rate", "max_stretch")
 _BEHAVIOUR_DEFAULT = {"tear_strain": None, "yield_strain": None, "plastic_rate": 1.0, "max_stretch": None}
 #: The keys that describe a material, on ``[physics]`` and on a ``[[body]]``.
-MATERIAL_KEYS = ("material", "youngs_modulus", "poisson_ratio", "density", "material_damping") + BEHAVIOUR_KEYS
+MATERIAL_KEYS = ("material", "youngs_modulus", "poisson_ratio", "density", "material_damping",
+                 "plane") + BEHAVIOUR_KEYS
 #: The finite-element keys and the :class:`deforma.Material` keyword each one sets.
 FEM_KEYWORD = {"youngs_modulus": "youngs_modulus", "poisson_ratio": "poisson_ratio", "density": "density",
-               "material_damping": "damping"}
+               "material_damping": "damping", "plane": "plane"}
+#: The finite-element keys whose default in [physics] is a value, not None.
+FEM_DEFAULT = {"material_damping": 0.0, "plane": "stress"}
 _FEM_NEEDS = ("youngs_modulus", "poisson_ratio", "density")
 _SPRING_KEYS = ("mass", "stiffness", "damping")
 
@@ -177,6 +180,9 @@ class PhysicsSettings:
     material_damping: float = spec("float", 0.0, lo=0.0, hi=1e6, unit="s",
                                    doc="Viscous damping of finite-element bodies: a vibration of angular frequency "
                                        "w gets damping ratio material_damping * w / 2.")
+    plane: str = spec("str", "stress", choices=PLANES,
+                      doc="What a finite-element body's slab is: stress (a thin sheet, free to thin out of its "
+                          "plane) or strain (the cross-section of a long body, stiffer in the plane).")
     tear_strain: float | None = spec("float", None, lo=0.0, hi=100.0, lo_open=True,
                                      doc="Tearing (any material): where a body is stretched by more than this strain "
                                          "(0.5 = 50% longer) across a mesh edge, the mesh splits there. Omit: never "
@@ -218,8 +224,9 @@ class BodyPhysics:
     stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
     damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
     material: str | None = spec("str", None, choices=material_models,
-                                doc="Overrides physics.material: any of the nine material keys (material to "
-                                    "max_stretch) gives the body its own material, the others taken from [physics].")
+                                doc="Overrides physics.material: any of the ten material keys (material to "
+                                    "max_stretch, and plane) gives the body its own material, the others taken from "
+                                    "[physics].")
     youngs_modulus: float | None = spec("float", None, lo=0.0, hi=1e15, lo_open=True, unit="Pa",
                                         doc="Overrides physics.youngs_modulus.")
     poisson_ratio: float | None = spec("float", None, lo=-1.0, hi=0.5, lo_open=True, hi_open=True,
@@ -228,6 +235,7 @@ class BodyPhysics:
                                  doc="Overrides physics.density.")
     material_damping: float | None = spec("float", None, lo=0.0, hi=1e6, unit="s",
                                           doc="Overrides physics.material_damping.")
+    plane: str | None = spec("str", None, choices=PLANES, doc="Overrides physics.plane.")
     tear_strain: float | None = spec("float", None, lo=0.0, hi=100.0, lo_open=True,
                                      doc="Overrides physics.tear_strain.")
     yield_strain: float | None = spec("float", None, lo=0.0, hi=100.0, lo_open=True,
@@ -509,7 +517,7 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
         raise MaterialKeyError(None, f"the {model!r} material needs {', '.join(missing)} (E in Pa, nu in (-1, 0.5), "
                                      f"density in kg/m^2): set {'it' if len(missing) == 1 else 'them'} {where}")
     out = {"model": model}
-    out.update((FEM_KEYWORD[k], float(v)) for k, v in values.items())
+    out.update((FEM_KEYWORD[k], v if k == "plane" else float(v)) for k, v in values.items())
     out.update(_behaviour_settings(physics, own))
     return out
 

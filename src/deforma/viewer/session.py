@@ -360,7 +360,8 @@ class Session:
         if model == "springs":
             material = Material("springs", **self._world_behaviours())
             return None if material == _SPRINGS else material  # the seed's plain springs
-        return Material(model, **{kw: values[name] for name, kw in _MATERIAL_KEYWORD.items()},
+        plane = getattr(self.world.material, "plane", "stress")  # kept, as the behaviours are
+        return Material(model, **{kw: values[name] for name, kw in _MATERIAL_KEYWORD.items()}, plane=plane,
                         **self._world_behaviours())
 
     def _world_behaviours(self) -> dict:
