@@ -113,3 +113,10 @@ def coefficient(value, name: str):
     if value is None:
         return None
     return non_negative(value, name, "(dimensionless)")
+
+
+class StepBeyondStableWarning(RuntimeWarning):
+    """``World.add_body`` under an explicit integrator: the world's step is beyond the stable
+    estimate with the new body, so a step will likely blow up (the message says what to set).
+    Here, with the other checks at the boundary, so that the command line can filter it
+    without importing the physics."""

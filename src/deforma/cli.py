@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .checks import MAX_DETAIL
+from .checks import MAX_DETAIL, StepBeyondStableWarning
 
 __all__ = ["main"]
 
@@ -574,39 +574,43 @@ def main(argv=None) -> int:
     a.started = started
     commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view, "sweep": cmd_sweep}
     restore_signals = _stop_on_signals()
-    shown = warnings.showwarning
-    if not a.debug:  # a warning of the physics (a step beyond the explicit limit, an unconverged
-        # solve) as one line of the command's own, not Python's two with a source line
-        warnings.showwarning = lambda message, *_args, **_kw: print(f"deforma: warning: {message}",
-                                                                     file=sys.stderr)
-    try:
-        return commands[a.command](a)
-    except KeyboardInterrupt:
-        if a.debug:
-            raise
-        print("deforma: interrupted; no partial output was left", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Stopped as e:
-        import signal
+    with warnings.catch_warnings():  # put back as they were when the command returns
+        # a warning of the physics (an unconverged solve) once per command, whatever came
+        # before in this process, as one line of the command's own (not Python's two)
+        warnings.simplefilter("default", RuntimeWarning)
+        if not a.debug:
+            warnings.showwarning = lambda message, *_args, **_kw: print(f"deforma: warning: {message}",
+                                                                         file=sys.stderr)
+        # a scene whose step is beyond the explicit limit: a run says so, with what to set,
+        # when a step blows up (the add_body warning would be a second line before it)
+        warnings.filterwarnings("ignore", category=StepBeyondStableWarning)
+        try:
+            return commands[a.command](a)
+        except KeyboardInterrupt:
+            if a.debug:
+                raise
+            print("deforma: interrupted; no partial output was left", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        except Stopped as e:
+            import signal
 
-        if a.debug:
-            raise
-        print(f"deforma: stopped by {signal.Signals(e.signum).name}; no partial output was left", file=sys.stderr)
-        return 128 + e.signum
-    except CliError as e:
-        if a.debug:
-            raise
-        print(f"deforma: error: {e}", file=sys.stderr)
-        return e.code
-    except (ValueError, OSError, RuntimeError) as e:
-        # a missing optional package (imageio-ffmpeg) or a file problem: one line, not a trace
-        if a.debug:
-            raise
-        print(f"deforma: error: {e}", file=sys.stderr)
-        return EXIT_ERROR
-    finally:
-        restore_signals()
-        warnings.showwarning = shown
+            if a.debug:
+                raise
+            print(f"deforma: stopped by {signal.Signals(e.signum).name}; no partial output was left", file=sys.stderr)
+            return 128 + e.signum
+        except CliError as e:
+            if a.debug:
+                raise
+            print(f"deforma: error: {e}", file=sys.stderr)
+            return e.code
+        except (ValueError, OSError, RuntimeError) as e:
+            # a missing optional package (imageio-ffmpeg) or a file problem: one line, not a trace
+            if a.debug:
+                raise
+            print(f"deforma: error: {e}", file=sys.stderr)
+            return EXIT_ERROR
+        finally:
+            restore_signals()
 
 
 if __name__ == "__main__":  # pragma: no cover

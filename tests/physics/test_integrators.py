@@ -437,3 +437,18 @@ def test_xpbd_substeps_scales_with_step_iterations_and_gravity():
     for bad in (0.0, 1.0, float("nan"), True, "0.01"):
         with pytest.raises(ValueError, match=r"strain must be a number in \(0, 1\)"):
             w.xpbd_substeps(strain=bad)
+
+
+@pytest.mark.parametrize("name", ["implicit-euler", "xpbd", "implicit-bdf2"])
+def test_air_drag_slows_motion_but_not_the_rest_state(name):
+    # 1 kg hanging on a 100 N/m spring, 1/60 s, air_drag 5: it rests at m g / k whatever the
+    # drag (XPBD rested 7.7% short, 1 / (1 + h air_drag), when its constraints weighed the
+    # plain mass against the damped prediction)
+    w = deforma.World(dt=1 / 60, integrator=name, mass=2.0, stiffness=100.0, damping=0.0, air_drag=5.0)
+    if name == "xpbd":
+        w.integrator_options = {"iterations": 20}  # one spring: the sweeps converge
+    b = w.add_body(Chain([[0, 0], [0, -1]], [[0, 1]]), position=None)
+    b.pin([0])
+    for _ in range(600):
+        w.step()
+    assert -b.positions[1, 1] - 1.0 == pytest.approx(G / 100.0, rel=1e-6)

@@ -32,6 +32,7 @@ from .colliders.shapes import SHAPES, Collider, pack_colliders
 from .contact.clearance import outlines_overlap
 from .contact.contacts import ContactPoints, Contacts
 from .control import Control
+from ..checks import StepBeyondStableWarning
 from .diagnostics import Energy, SimulationUnstable
 from .integrators import make_integrator
 from .material import Material
@@ -515,7 +516,7 @@ class World:
                 warnings.warn(f"under {self.integrator} this world's step, dt/substeps = {self._dt / self._substeps:.3g} "
                               f"s, exceeds the stable estimate {stable:.3g} s with this body: set substeps = "
                               f"{need} (or \"auto\"), lower dt, or use integrator=\"implicit-euler\"",
-                              RuntimeWarning, stacklevel=2)
+                              StepBeyondStableWarning, stacklevel=2)
         return body
 
     def remove_body(self, body: Body) -> None:
