@@ -66,9 +66,9 @@ a tear is then taken into the factor by a low-rank correction while it is small
 (:mod:`~deforma.physics.integrators.implicit.updated_factor`), and the matrix is factored again once the
 changes add up.
 
-Solved to a tolerance (``tolerance > 0``; ``implicit-bdf2``'s default). The local/global iteration is a fixed-point map whose
-fixed point is the backward Euler step; it converges linearly, and slowly where the
-constant matrix misses the motion: a stiff body's rotation is not in ``A`` (the local step
+Solved to a tolerance (``tolerance > 0``; ``implicit-bdf2``'s default). The local/global
+iteration is a fixed-point map whose fixed point is the backward Euler step; it converges
+linearly, and slowly where the constant matrix misses the motion: a stiff body's rotation is not in ``A`` (the local step
 lags one iteration), so three fixed iterations kept 6 % of a spinning box's angular momentum
 after one second at 1/60 s, where backward Euler keeps 75 %. Each substep therefore iterates
 until the objective's gradient, taken as a force on each vertex's own mass for the substep,
@@ -77,9 +77,10 @@ most ``max_iterations`` times, Anderson-accelerated
 (:mod:`~deforma.physics.integrators.implicit.anderson`); the contacts' local steps then
 project the iterate itself, so that the fixed point is the minimum of the objective with the
 contact terms. A substep that reaches ``max_iterations`` first stands as it is and is counted
-(``StepReport.unconverged``; the World warns). With ``tolerance = 0`` (implicit Euler's default
-for now: converged, the ``pile`` scene's tests took 5x longer) a fixed ``iterations`` run per
-substep, approximate where springs turn, exact along a spring after one iteration.
+(``StepReport.unconverged``; the World warns). With ``tolerance = 0`` (implicit Euler's
+default for now: converged at 1e-3 m/s, a ``pile`` test took 115 s instead of 2.3 s, since
+contacts converge slowly; ``docs/benchmarks.md``) a fixed ``iterations`` run per substep,
+approximate where springs turn, exact along a spring after one iteration.
 
 Backward Euler is unconditionally stable and dissipates: a mode of angular frequency
 ``omega`` loses the factor ``1 / (1 + (h omega)^2)`` of its energy per substep.
