@@ -822,6 +822,47 @@ class World:
         """
         stepper.step(self)
 
+    def solve_static(self, *, tolerance: float = 1e-6, max_iterations: int = 1000) -> int:
+        """Move every body to its static equilibrium under its pins, gravity, the forces
+        applied with ``body.apply_force`` and its contacts (:mod:`deforma.physics.statics`:
+        backward Euler relaxation from rest, whatever the world's integrator).
+
+        Parameters
+        ----------
+        tolerance : float, optional
+            m (> 0): done when no vertex is estimated farther than this from where it settles.
+        max_iterations : int, optional
+            Relaxation steps at most (in [1, 100000]); each is one converged implicit solve.
+
+        Returns
+        -------
+        int
+            The relaxation steps taken. ``time`` and ``step_count`` stay; velocities end at
+            zero; applied forces are used and forgotten, as by a step.
+
+        Raises
+        ------
+        ValueError
+            A bad argument; bodies nothing holds (no pinned vertex, no collider); a
+            material that tears or yields; no rest within ``max_iterations`` (the World is
+            put back as it was). One line each.
+
+        Examples
+        --------
+        >>> import deforma, numpy as np
+        >>> w = deforma.World(gravity=(0.0, -9.81), mass=2.0, stiffness=100.0)
+        >>> class Chain:  # one spring, a 1 kg mass hanging from a pinned one
+        ...     vertices, edges = np.array([[0.0, 0.0], [0.0, -1.0]]), np.array([[0, 1]])
+        >>> b = w.add_body(Chain())
+        >>> b.pin([0])
+        >>> steps = w.solve_static()
+        >>> round(float(-b.positions[1, 1] - 1.0), 5)  # m g / k, to the tolerance of 1e-6 m
+        0.0981
+        """
+        from .statics import solve_static
+
+        return solve_static(self, tolerance=tolerance, max_iterations=max_iterations)
+
     # -- diagnostics ------------------------------------------------------------------------
     def stable_dt(self, *, explicit: bool = False) -> float:
         """Estimate of the largest stable explicit (sub)step in seconds for the current bodies.

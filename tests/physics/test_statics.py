@@ -1,0 +1,93 @@
+"""world.solve_static: static equilibrium against known answers, and one line for what it
+cannot solve."""
+
+import numpy as np
+import pytest
+
+import deforma
+from physics_meshes import Chain
+from test_fem_validation import EXPECTED, RHO, E, L, NU, column
+
+
+def hanging_spring(**kw):
+    w = deforma.World(gravity=(0.0, -9.81), mass=2.0, stiffness=100.0, **kw)
+    b = w.add_body(Chain([[0, 0], [0, -1]], [[0, 1]]), position=None)
+    b.pin([0])
+    return w, b
+
+
+@pytest.mark.parametrize("model", ["corotated", "neo-hookean"])
+def test_a_hanging_column_settles_to_its_elongation_in_one_call(model):
+    w = deforma.World(dt=1 / 60, integrator="implicit-euler")
+    m = column(4)
+    b = w.add_body(m, material=deforma.Material(model, youngs_modulus=E, poisson_ratio=NU, density=RHO),
+                   position=None)
+    b.pin(np.flatnonzero(np.isclose(m.vertices[:, 1], 0.0)))
+    steps = w.solve_static()
+    bottom = np.isclose(m.vertices[:, 1], -L)
+    assert -L - b.positions[bottom, 1].mean() == pytest.approx(EXPECTED, rel=0.01)
+    assert 1 <= steps < 100
+    assert w.time == 0.0 and w.step_count == 0 and not b.velocities.any()
+    assert w.integrator == "implicit-euler" and w.dt == pytest.approx(1 / 60)  # the world's own, back
+
+
+def test_an_applied_force_acts_throughout_and_then_goes():
+    w, b = hanging_spring()
+    b.apply_force([[3.0, 0.0]], indices=[1])  # 3 N sideways on the hanging 1 kg
+    w.solve_static(tolerance=1e-9)
+    # the spring points along the resultant of gravity and the force, stretched by it / k
+    d = b.positions[1] - b.positions[0]
+    pull = np.array([3.0, -9.81])
+    np.testing.assert_allclose(d / np.linalg.norm(d), pull / np.linalg.norm(pull), atol=1e-6)
+    assert np.linalg.norm(d) - 1.0 == pytest.approx(np.linalg.norm(pull) / 100.0, rel=1e-5)
+    w.solve_static(tolerance=1e-9)  # the force is gone: straight down again
+    assert b.positions[1, 0] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_block_comes_to_rest_on_the_floor():
+    w = deforma.World(dt=1 / 60)
+    w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5)))
+    b = w.add_body(deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=3, edges=True),
+                   position=(0.0, 0.5), material=deforma.Material("corotated", youngs_modulus=1e5,
+                                                                  poisson_ratio=0.3, density=100.0))
+    w.solve_static(tolerance=1e-7)
+    assert b.positions[:, 1].min() == pytest.approx(0.0, abs=2e-3)  # on the floor's top
+    assert np.ptp(b.positions[:, 1]) == pytest.approx(0.2, rel=0.01)  # its own height, barely squeezed
+
+
+@pytest.mark.parametrize("make, kwargs, message", [
+    (lambda: deforma.World(), {}, None),  # no body: nothing to do
+    (lambda: hanging_spring()[0], {"tolerance": 0.0}, "tolerance must be a distance > 0 m, got 0.0"),
+    (lambda: hanging_spring()[0], {"tolerance": "small"}, "tolerance must be a number, got 'small'"),
+    (lambda: hanging_spring()[0], {"max_iterations": 0}, "max_iterations must be an integer in [1, 100000], got 0"),
+])
+def test_bad_arguments_are_one_line(make, kwargs, message):
+    w = make()
+    if message is None:
+        assert w.solve_static(**kwargs) == 0
+        return
+    with pytest.raises(ValueError) as e:
+        w.solve_static(**kwargs)
+    assert str(e.value) == message
+
+
+def test_what_it_cannot_solve_is_refused_and_changes_nothing():
+    free = deforma.World()
+    b = free.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2), position=(0, 3))
+    with pytest.raises(ValueError, match=r"^solve_static: nothing holds the bodies .* add a collider under them$"):
+        free.solve_static()
+    tearing = deforma.World(material=deforma.Material("springs", tear_strain=0.5))
+    tearing.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2)).pin([0])
+    with pytest.raises(ValueError, match=r"^solve_static needs elastic bodies: body 0 tears"):
+        tearing.solve_static()
+    # a soft column that one relaxation step cannot settle: refused, and put back
+    w = deforma.World(dt=1 / 60)
+    m = column(4)
+    c = w.add_body(m, material=deforma.Material("corotated", youngs_modulus=E, poisson_ratio=NU, density=RHO),
+                   position=None)
+    c.pin(np.flatnonzero(np.isclose(m.vertices[:, 1], 0.0)))
+    before = c.positions.copy()
+    with pytest.raises(ValueError, match=r"^solve_static did not settle within max_iterations = 1 relaxation steps"):
+        w.solve_static(max_iterations=1)
+    assert np.array_equal(c.positions, before) and w.integrator == "symplectic-euler" and w.step_count == 0
+    assert np.array_equal(b.positions, free.bodies[0].positions)
