@@ -32,7 +32,8 @@ def test_a_world_built_from_a_scene_has_its_options_and_steps(tmp_path):
     # kept as the integrator keeps them, in the order it lists them
     assert scene.physics.integrator_options == (("iterations", 7), ("contact_weight", 25.0))
     world = scenes.load_scene(p)
-    assert world.integrator_options == {"iterations": 7, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 25.0}
+    assert world.integrator_options == {"iterations": 7, "tolerance": 0.0, "max_iterations": 500,
+                                       "contact_weight": 25.0}
     for _ in range(30):
         world.step()
     assert np.isfinite(world.bodies[0].positions).all()

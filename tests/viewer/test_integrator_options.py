@@ -23,8 +23,8 @@ ROWS = {"symplectic-euler": ["integrator_mode"],
 
 def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
     rows = {p.name: p for p in integrator_params()}
-    assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
-                          "integrator_contact_weight"]
+    assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_tolerance",
+                          "integrator_max_iterations", "integrator_contact_weight"]
     assert not set(rows) & set(PARAMS)
     mode = rows["integrator_mode"]
     assert mode.kind == "choice" and mode.choices == ("auto", "serial", "parallel")
@@ -42,14 +42,17 @@ def test_the_session_sets_an_option_by_name_and_keeps_the_others(tmp_path):
     s.set_param("integrator_contact_weight", 20.0)
     s.set_param("integrator_iterations", 6.0)  # a whole float, as a slider gives it
     assert s.world is world  # set on the running world, no rebuild
-    assert world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 20.0}
+    assert world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500,
+                                       "contact_weight": 20.0}
     assert s.get_param("integrator_iterations") == 6 and s.get_param("integrator_mode") is None
     s.set_integrator_option("contact_weight", 15.0)
     assert s.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 15.0}
     s.reset()  # starting again keeps every value, the options too
-    assert s.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 15.0}
+    assert s.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500,
+                                         "contact_weight": 15.0}
     path = s.save(tmp_path / "options.toml")
-    assert deforma.load_scene(path).integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 15.0}
+    assert deforma.load_scene(path).integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500,
+                                                          "contact_weight": 15.0}
 
 
 BAD = [
@@ -147,11 +150,13 @@ def test_typed_option_applies_and_a_bad_one_shows_one_line_and_changes_nothing(d
     entry.set_text("6")
     post(pygame_gui.UI_TEXT_ENTRY_FINISHED, ui_element=entry, text="6")
     run(demo, 1)
-    assert demo.session.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 10.0}
+    assert demo.session.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500,
+                                                    "contact_weight": 10.0}
     entry.set_text("0")
     post(pygame_gui.UI_TEXT_ENTRY_FINISHED, ui_element=entry, text="0")
     run(demo, 2)
-    assert demo.session.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500, "contact_weight": 10.0}
+    assert demo.session.world.integrator_options == {"iterations": 6, "tolerance": 0.0, "max_iterations": 500,
+                                                    "contact_weight": 10.0}
     assert ins.message_is_error
     assert ins.message == "implicit-euler option iterations must be an integer in [1, 10000], got 0"
     assert entry.get_text() == "6"  # the box shows the value in force again

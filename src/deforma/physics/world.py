@@ -137,7 +137,8 @@ class World:
         self._auto_key = None  # what the automatic substeps were chosen for
         self.gravity = gravity
         self.dt = dt
-        self.substeps = 1 if isinstance(substeps, str) and substeps == "auto" else substeps  # "auto" needs the integrator
+        # "auto" asks the integrator, set below: until then one substep
+        self.substeps = 1 if isinstance(substeps, str) and substeps == "auto" else substeps
         self.mass = mass
         self.stiffness = stiffness
         self.damping = damping
@@ -513,9 +514,10 @@ class World:
             if self._dt / self._substeps > stable:
                 # say so now, not at the step that blows up
                 need = math.ceil(self._dt / stable)
-                warnings.warn(f"under {self.integrator} this world's step, dt/substeps = {self._dt / self._substeps:.3g} "
-                              f"s, exceeds the stable estimate {stable:.3g} s with this body: set substeps = "
-                              f"{need} (or \"auto\"), lower dt, or use integrator=\"implicit-euler\"",
+                h = self._dt / self._substeps
+                warnings.warn(f"under {self.integrator} this world's step, dt/substeps = {h:.3g} s, exceeds the "
+                              f"stable estimate {stable:.3g} s with this body: set substeps = {need} (or "
+                              f"\"auto\"), lower dt, or use integrator=\"implicit-euler\"",
                               StepBeyondStableWarning, stacklevel=2)
         return body
 

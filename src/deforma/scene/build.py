@@ -206,7 +206,8 @@ def scene_of(world) -> Scene:
     rec = build_record(world)
     scene = rec.scene if rec is not None else Scene()
     physics = PhysicsSettings(
-        dt=float(world.dt), substeps="auto" if world.auto_substeps else int(world.substeps), gravity=tuple(float(g) for g in world.gravity),
+        dt=float(world.dt), substeps="auto" if world.auto_substeps else int(world.substeps),
+        gravity=tuple(float(g) for g in world.gravity),
         damping=float(world.damping), mass=float(world.mass), stiffness=float(world.stiffness),
         friction=float(world.friction), static_friction=float(world.static_friction),
         max_speed=float(world.max_speed), integrator=world.integrator,

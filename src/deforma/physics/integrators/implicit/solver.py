@@ -68,10 +68,10 @@ changes add up.
 
 Solved to a tolerance (``tolerance > 0``; ``implicit-bdf2``'s default). The local/global
 iteration is a fixed-point map whose fixed point is the backward Euler step; it converges
-linearly, and slowly where the constant matrix misses the motion: a stiff body's rotation is not in ``A`` (the local step
-lags one iteration), so three fixed iterations kept 6 % of a spinning box's angular momentum
-after one second at 1/60 s, where backward Euler keeps 75 %. Each substep therefore iterates
-until the objective's gradient, taken as a force on each vertex's own mass for the substep,
+linearly, and slowly where the constant matrix misses the motion: a stiff body's rotation
+is not in ``A`` (the local step lags one iteration), so three fixed iterations kept 6 % of a
+spinning box's angular momentum after one second at 1/60 s, where backward Euler keeps 75 %.
+Each substep therefore iterates until the objective's gradient, taken as a force on each vertex's own mass for the substep,
 would change no velocity by more than ``tolerance`` (m/s), at least ``iterations`` and at
 most ``max_iterations`` times, Anderson-accelerated
 (:mod:`~deforma.physics.integrators.implicit.anderson`); the contacts' local steps then
