@@ -18,8 +18,8 @@ angular frequency ``omega`` keeps ``|z|^2`` of its energy per step, ``z`` the la
 The earlier state is kept as the increments of the last substep, ``(x_n - x_{n-1}, v_n -
 v_{n-1})``: whatever changes the state between steps (an impulse, an explosion, positions
 set by hand) moves the earlier state with it. The first step, and the first after a new body
-joins, starts from a past of constant velocity, ``(h v_n, 0)``; a tear carries each vertex's
-increments to its copies. Contacts are held inside the solve as under backward Euler, from
+joins, starts from a past under gravity and the applied forces alone, ``(h v_n - h^2 a / 2,
+h a)`` (exact in free fall); a tear carries each vertex's increments to its copies. Contacts are held inside the solve as under backward Euler, from
 the true start of the substep; a vertex the collider response moves takes the response's
 velocity.
 
@@ -37,7 +37,8 @@ from .solver import ImplicitEuler
 @register_integrator("implicit-bdf2")
 class ImplicitBDF2(ImplicitEuler):
     """Implicit BDF2: second order, unconditionally stable, and a body's own vibration
-    survives at a display step (its decay is then the material's ``damping``).
+    survives at a display step (its decay is then mostly the material's ``damping``; the
+    scheme's own share per frequency and step is in ``docs/integrators.md``).
 
     The options and stats are implicit Euler's (:class:`ImplicitEuler`), but for the
     default ``tolerance``, 1e-3 m/s: BDF2 is solved to a tolerance unless told otherwise (0
