@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..checks import number
 from .integrators import make_integrator
 
 if TYPE_CHECKING:
@@ -43,8 +44,8 @@ def solve_static(world: "World", *, tolerance: float = 1e-6, max_iterations: int
     relaxation steps it took. ``world.time`` and ``world.step_count`` stay; velocities end at
     zero; the forces applied with ``body.apply_force`` act throughout and are then forgotten,
     as after a step."""
-    tol = _number(tolerance, "tolerance")
-    if not (math.isfinite(tol) and tol > 0.0):
+    tol = number(tolerance, "tolerance")
+    if not tol > 0.0:
         raise ValueError(f"tolerance must be a distance > 0 m, got {tolerance!r}")
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
             or not 1 <= max_iterations <= 100_000:
@@ -104,8 +105,3 @@ def solve_static(world: "World", *, tolerance: float = 1e-6, max_iterations: int
     world._forces.clear()
     return done
 
-
-def _number(value, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    return float(value)

@@ -138,12 +138,12 @@ def _integrate(w, start, moving: bool) -> None:
     """Stages 2 and 3: the gas kick and the integrator, again from ``start`` with a larger
     contact buffer while it runs out of room."""
     integrator, contacts, state = w._integrator, w._contacts, w._state
-    h = w.dt / w.substeps
+    h = w.dt / w._substeps  # the count in force (the public getter would check "auto" again)
     while True:
         if w._model.has_pressure:
             behaviours.apply_pressure(w._model, state, w.dt)
         contacts.clear_needed()
-        report = integrator.step(w._model, start, state, w._control, contacts, h, substeps=w.substeps,
+        report = integrator.step(w._model, start, state, w._control, contacts, h, substeps=w._substeps,
                                  max_speed=w.max_speed)
         if report.complete:
             break
