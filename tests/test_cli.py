@@ -172,6 +172,7 @@ def test_unwritable_output_folder(tmp_path, capsys, monkeypatch):
 UNSTABLE = """
 [physics]
 dt = 0.02
+substeps = 1
 stiffness = 50000.0
 [[body]]
 detail = 4

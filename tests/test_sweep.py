@@ -23,6 +23,7 @@ fps = 10
 
 [physics]
 dt = 0.002
+substeps = 1
 integrator = "symplectic-euler"
 material = "springs"
 stiffness = 1000.0

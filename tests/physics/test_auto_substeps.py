@@ -1,5 +1,6 @@
 """substeps = "auto" under symplectic Euler, and the warning add_body gives when the step is
-beyond the explicit limit: the README's bunny, which the default World blew up at step 9."""
+beyond the explicit limit: the README's bunny, which the default World (then one substep) blew up at
+step 9."""
 
 import math
 import warnings
@@ -15,20 +16,33 @@ def bunny():
     return deforma.mesh.from_image("bunny", resolution=4, detect_edges=True, edge_step=2, scale=0.01)
 
 
-def test_the_readme_bunny_warns_at_add_body_and_runs_with_auto_substeps():
-    w = deforma.World()
+def test_the_readme_bunny_runs_under_the_default_world():
+    w = deforma.World()  # substeps = "auto" by default
     w.add_collider(deforma.Rect((0.0, -0.25), (6.0, 0.5), 0.0))
     m = bunny()
-    with pytest.warns(RuntimeWarning, match=r"exceeds the stable estimate .* set substeps = 40 \(or \"auto\"\)"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing to warn about
         b = w.add_body(m, position=(0.0, np.ptp(m.vertices[:, 1]) / 2 + 0.2))  # 20 cm above the floor
-    w.substeps = "auto"
-    assert w.auto_substeps and w.substeps == math.ceil(w.dt / w.stable_dt())
+    assert w.auto_substeps and w.substeps == math.ceil(w.dt / w.stable_dt()) == 40
     for _ in range(1200):  # 2 s: landed
         w.step()
     landed = w.energy().total
     for _ in range(4800):  # 8 s more: the soft bunny sways on (its springs barely damp), and no
         w.step()           # energy comes from nowhere
     assert np.isfinite(b.positions).all() and w.energy().total <= landed * 1.001
+
+
+def test_one_substep_beyond_the_limit_warns_at_add_body():
+    w = deforma.World(substeps=1)
+    with pytest.warns(RuntimeWarning, match=r"exceeds the stable estimate .* set substeps = 40 \(or \"auto\"\)"):
+        w.add_body(bunny())
+    w = deforma.World(dt=0.1)  # "auto" would need 2380 substeps: said at once, in one line
+    with pytest.warns(RuntimeWarning, match=r"would need 2375 substeps .* more than 1000") as caught:
+        w.add_body(bunny())
+    assert "\n" not in str(caught[0].message)
+    with pytest.raises(SimulationUnstable, match="more than 1000"):
+        w.step()
+    assert w.step_count == 0
 
 
 def test_auto_follows_the_bodies_and_the_integrator():
@@ -49,7 +63,7 @@ def test_auto_follows_the_bodies_and_the_integrator():
 
 
 def test_auto_past_1000_substeps_is_refused_in_one_line_and_changes_nothing():
-    w = deforma.World(dt=0.1)  # the bunny needs 2380 substeps of it
+    w = deforma.World(dt=0.1, substeps=1)  # the bunny needs 2375 substeps of it
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         w.add_body(bunny())

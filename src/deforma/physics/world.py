@@ -56,10 +56,11 @@ class World:
     dt : float, optional
         Time advanced by one :meth:`step`, seconds (> 0).
     substeps : int or "auto", optional
-        Integration substeps per step (>= 1); each is ``dt / substeps`` long. ``"auto"``:
-        as many as the explicit integrator's stable step asks (``ceil(dt / stable_dt())``,
-        chosen again whenever the bodies, their parameters, the grabs or ``dt`` change; 1
-        under the unconditionally stable integrators); past 1000 it is refused in one line.
+        Integration substeps per step (>= 1); each is ``dt / substeps`` long. ``"auto"`` (the
+        default): as many as the explicit integrator's stable step asks (``ceil(dt /
+        stable_dt())``, chosen again whenever the bodies, their parameters, the grabs or ``dt``
+        change; 1 under the unconditionally stable integrators); past 1000 ``add_body`` warns
+        and the step is refused in one line.
     mass : float, optional
         Default total mass of a body in kg (> 0); each vertex weighs ``mass / N``.
     stiffness : float, optional
@@ -111,7 +112,7 @@ class World:
     True
     """
 
-    def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps=1, mass=1.0, stiffness=1000.0,
+    def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps="auto", mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
                  integrator="symplectic-euler", contact_thickness=None, air_drag=0.0, material=None,
                  integrator_options=None):
@@ -509,7 +510,12 @@ class World:
         vs = [self._state.v, np.zeros_like(topo.rest_positions)]
         self._bodies.append(body)
         self._rebuild(np.concatenate(xs), np.concatenate(vs))
-        if not self._auto and not self._integrator.unconditionally_stable:
+        if self._auto and not self._integrator.unconditionally_stable:
+            try:  # say so now, not at the first step
+                self._substeps = self._auto_substeps(ValueError)
+            except ValueError as e:
+                warnings.warn(str(e), StepBeyondStableWarning, stacklevel=2)
+        elif not self._integrator.unconditionally_stable:
             stable = self.stable_dt()
             if self._dt / self._substeps > stable:
                 # say so now, not at the step that blows up

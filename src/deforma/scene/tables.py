@@ -131,7 +131,7 @@ class PhysicsSettings:
 
     dt: float = spec("float", 1 / 600, lo=0.0, hi=0.1, lo_open=True, unit="s",
                      doc="Time advanced per step; smaller is more accurate and slower.")
-    substeps: int | str = spec("substeps", 1, lo=1, hi=1000,
+    substeps: int | str = spec("substeps", "auto", lo=1, hi=1000,
                                doc="Integration substeps per step, each dt/substeps long; \"auto\": as many as the "
                                    "explicit integrator's stable step asks, chosen again as the bodies change.")
     gravity: tuple = spec("vec2", (0.0, -9.81), unit="m/s^2", doc="Acceleration of gravity.")
