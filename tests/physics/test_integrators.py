@@ -427,6 +427,35 @@ def test_xpbd_substeps_tells_holding_from_sinking():
         assert lo < 1 - np.ptp(body.positions[:, 1]) / rest < hi, substeps
 
 
+def _cantilever(substeps, integrator="xpbd"):
+    """A horizontal 1 m x 0.1 m corotated beam (E = 1e5 Pa) pinned at its left end, 1/60 s."""
+    mat = deforma.Material("corotated", youngs_modulus=1e5, poisson_ratio=0.3, density=100.0)
+    w = deforma.World(dt=1 / 60, substeps=substeps, integrator=integrator, material=mat, air_drag=3.0)
+    b = w.add_body(grid_mesh(1.0, 0.1, 41, 5), position=(0.5, 2.0))
+    b.pin(np.flatnonzero(b.positions[:, 0] < b.positions[:, 0].min() + 1e-9))
+    return w, b
+
+
+def test_xpbd_substeps_follow_the_pins_not_only_the_height():
+    # Pins carry a cantilever's load along its length: the advice counts the distance from
+    # the pins (1 m), not the height along gravity (0.1 m, which asked for 3 substeps, under
+    # which the tip hung 69% below its equilibrium)
+    w, b = _cantilever(1, "implicit-euler")
+    tip = np.flatnonzero(b.positions[:, 0] > b.positions[:, 0].max() - 1e-9)
+    start = b.positions[tip, 1].mean()
+    w.solve_static()
+    sag = start - b.positions[tip, 1].mean()  # 0.703 m: a soft beam
+    w, _ = _cantilever(1)
+    need = w.xpbd_substeps()
+    assert need == 30  # dt / (l sqrt(0.01 / (2 g L))), l = 0.025 m, L = 1.005 m
+    for substeps, lo, hi in ((need, 0.0, 0.15), (3, 0.5, 1.0)):
+        w, b = _cantilever(substeps)
+        for _ in range(600):  # 10 s: settled (air drag 3/s)
+            w.step()
+        error = (start - b.positions[tip, 1].mean()) / sag - 1.0
+        assert lo < error < hi, (substeps, error)
+
+
 def test_xpbd_substeps_scales_with_step_iterations_and_gravity():
     w, _ = _standing_grid(30, 1)
     assert w.xpbd_substeps(strain=0.04) == 11  # half of 22 (rounded up): h grows as sqrt(strain)

@@ -123,6 +123,28 @@ def damping_note(model, control, stable: float) -> str:
     return f" (set by the damping: {undamped:.3g} s without it; lower material_damping or damping)"
 
 
+def support_reach(x, pinned, down) -> float:
+    """How far (m) the support of a body at rest positions ``x`` (N, 2) must travel through
+    it: from its pinned vertices to the farthest vertex, in any direction (a cantilever held
+    at one end bends under a load that its pins carry along its length); without pins, its
+    height along ``down`` (a floor holds it from below).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 0.1]])
+    >>> support_reach(x, np.array([True, False, False, False]), np.array([0.0, -1.0]))  # along its length
+    2.0024984394500787
+    >>> support_reach(x, np.zeros(4, bool), np.array([0.0, -1.0]))  # standing: its height
+    0.1
+    """
+    if not pinned.any():
+        return float(np.ptp(x @ down))
+    from scipy.spatial import cKDTree
+
+    return float(cKDTree(x[pinned]).query(x)[0].max())
+
+
 def xpbd_substeps(bodies, gravity, dt: float, sweeps: int, strain: float) -> int:
     """Substeps per ``dt`` at which XPBD with ``sweeps`` sweeps per substep holds ``bodies``
     up under ``gravity`` to ``strain`` (see :meth:`deforma.World.xpbd_substeps`)."""
@@ -137,10 +159,10 @@ def xpbd_substeps(bodies, gravity, dt: float, sweeps: int, strain: float) -> int
         if len(e) == 0:
             continue
         spacing = float(np.median(np.hypot(*(x[e[:, 1]] - x[e[:, 0]]).T)))
-        height = float(np.ptp(x @ down))
-        if spacing <= 0.0 or height <= 0.0:
+        reach = support_reach(x, body.pinned, down)
+        if spacing <= 0.0 or reach <= 0.0:
             continue
-        h = spacing * math.sqrt(strain * sweeps / (2.0 * g * height))
+        h = spacing * math.sqrt(strain * sweeps / (2.0 * g * reach))
         need = max(need, math.ceil(dt / h - 1e-9))
     return need
 
