@@ -53,6 +53,27 @@ KIND_NEO_HOOKEAN = 1
 KIND_CODES = {"corotated": KIND_COROTATED, "neo-hookean": KIND_NEO_HOOKEAN}
 
 
+#: Named materials (:meth:`Material.preset`, ``material = "jelly"`` in scene files): real-world
+#: values in SI for a slab of unit thickness (density in kg/m^2 is then the 3D density in
+#: kg/m^3). ``damping`` (s) sets how fast a body stops ringing: a mode of angular frequency
+#: ``omega`` gets damping ratio ``damping * omega / 2``.
+PRESETS: dict[str, dict] = {
+    # gelatin dessert: E of a few 10 kPa, nearly incompressible, rings for about a second
+    "jelly": dict(model="neo-hookean", youngs_modulus=3e4, poisson_ratio=0.45, density=1050.0, damping=0.005),
+    # gummy candy: ten times stiffer than jelly and lossy, so it lands with a thud
+    "gummy": dict(model="neo-hookean", youngs_modulus=3e5, poisson_ratio=0.45, density=1200.0, damping=0.02),
+    # natural rubber: a few MPa, little loss, bounces
+    "rubber": dict(model="neo-hookean", youngs_modulus=2e6, poisson_ratio=0.45, density=1100.0, damping=0.0005),
+    # open-cell foam: light, compressible (small Poisson ratio) and strongly damped
+    "foam": dict(model="corotated", youngs_modulus=2e4, poisson_ratio=0.1, density=30.0, damping=0.05),
+    # softwood across the grain: stiff for its weight; at display steps take an implicit integrator
+    "wood": dict(model="corotated", youngs_modulus=1e9, poisson_ratio=0.3, density=600.0, damping=1e-5),
+    # a fabric-like sheet: light and soft, its stretch limited to 5%, so a strip hangs and folds
+    "cloth": dict(model="corotated", youngs_modulus=100.0, poisson_ratio=0.3, density=0.3, damping=0.02,
+                  max_stretch=1.05),
+}
+
+
 def material_models() -> tuple[str, ...]:
     """The material models ``Material`` takes: the built-in ones, then those of the element
     kinds registered with :func:`~deforma.physics.elements.kind.register_element_kind`.
@@ -181,6 +202,56 @@ class Material:
         object.__setattr__(self, "poisson_ratio", nu)
         object.__setattr__(self, "density", rho)
         object.__setattr__(self, "damping", d)
+
+    @classmethod
+    def preset(cls, name: str, **overrides) -> "Material":
+        """A named material with real-world parameters (SI; see :data:`PRESETS`), any of them
+        replaced by ``overrides`` (the keywords of :class:`Material`).
+
+        The look of a body under gravity depends on its size as well as its material: a
+        block of height ``H`` sags by about ``density * g * H / (2 E)`` and rings at about
+        ``wave_speed() / (2 H)``. ``docs/physics.md`` ("Material presets") gives each
+        preset's sag, bounce and wobble measured on a 0.5 m block.
+
+        Parameters
+        ----------
+        name : str
+            One of ``jelly``, ``gummy``, ``rubber``, ``foam``, ``wood``, ``cloth``.
+        **overrides
+            Keywords of :class:`Material` that replace the preset's (``model`` too).
+
+        Raises
+        ------
+        ValueError
+            An unknown name (with the closest one), an unknown keyword, or a value the
+            Material refuses; one line.
+
+        Examples
+        --------
+        >>> Material.preset("rubber").youngs_modulus
+        2000000.0
+        >>> Material.preset("jelly", density=500.0).density
+        500.0
+        >>> Material.preset("jely")
+        Traceback (most recent call last):
+        ...
+        ValueError: unknown material preset 'jely': did you mean 'jelly'? (presets: jelly, gummy, rubber, foam, wood, cloth)
+        """
+        import difflib
+        from dataclasses import fields
+
+        if not isinstance(name, str) or name not in PRESETS:
+            close = difflib.get_close_matches(name, list(PRESETS), n=1) if isinstance(name, str) else []
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise ValueError(f"unknown material preset {name!r}: {hint}(presets: {', '.join(PRESETS)})")
+        allowed = [f.name for f in fields(cls) if f.name != "_"]
+        unknown = [k for k in overrides if k not in allowed]
+        if unknown:
+            close = difflib.get_close_matches(unknown[0], allowed, n=1)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise ValueError(f"Material.preset({name!r}) takes no {unknown[0]!r}: {hint}(keywords: "
+                             f"{', '.join(allowed)})")
+        return cls(**{**PRESETS[name], **overrides})
 
     def _check_behaviours(self) -> None:
         for name in ("tear_strain", "yield_strain"):

@@ -40,7 +40,7 @@ from ..checks import MAX_DETAIL
 
 # an image body's background: the names of deforma.mesh.from_image itself
 from ..mesh.image import BACKGROUND_NAMES
-from ..physics.material import MODELS, PLANES, material_models
+from ..physics.material import MODELS, PLANES, PRESETS, material_models
 
 __all__ = [
     "BEHAVIOUR_KEYS", "BODY_KINDS", "COLLIDER_KINDS", "COLLIDER_SHAPES", "FEM_DEFAULT", "FEM_KEYWORD", "MATERIAL_KEYS",
@@ -53,6 +53,18 @@ __all__ = [
 #: Material models a scene may name (``deforma.Material``'s; kept here so that reading a file
 #: needs no physics import).
 MATERIAL_MODELS = MODELS  # built in; material_models() adds those of registered element kinds
+
+
+def material_names() -> tuple[str, ...]:
+    """What a ``material`` key takes: a model (:func:`~deforma.physics.material.material_models`)
+    or a preset (:data:`~deforma.physics.material.PRESETS`).
+
+    Examples
+    --------
+    >>> material_names()[-6:]
+    ('jelly', 'gummy', 'rubber', 'foam', 'wood', 'cloth')
+    """
+    return material_models() + tuple(PRESETS)
 #: The behaviour keys of a material (``deforma.Material``'s keywords of the same names), for
 #: every model; ``plastic_rate`` matters only with ``yield_strain``.
 BEHAVIOUR_KEYS = ("tear_strain", "yield_strain", "plastic_rate", "max_stretch")
@@ -165,10 +177,12 @@ class PhysicsSettings:
     air_drag: float = spec("float", 0.0, lo=0.0, unit="1/s",
                            doc="Every velocity decays as dv/dt = -air_drag v; a little lets stacks and heaps come "
                                "to rest.")
-    material: str = spec("str", "springs", choices=material_models,
+    material: str = spec("str", "springs", choices=material_names,
                          doc="What bodies are made of unless they say: springs (the original's springs on the mesh "
                              "edges, with mass, stiffness, damping), or finite elements on the triangles: corotated "
-                             "or neo-hookean (need youngs_modulus, poisson_ratio, density; see deforma.Material).")
+                             "or neo-hookean (need youngs_modulus, poisson_ratio, density; see deforma.Material), "
+                             "or a preset (jelly, gummy, rubber, foam, wood, cloth: deforma.Material.preset), whose "
+                             "values the material keys set beside it replace.")
     youngs_modulus: float | None = spec("float", None, lo=0.0, hi=1e15, lo_open=True, unit="Pa",
                                         doc="Young's modulus E of finite-element bodies: rubber ~1e6, a soft gel "
                                             "~1e4.")
@@ -223,7 +237,7 @@ class BodyPhysics:
     mass: float | None = spec("float", None, lo=0.0, lo_open=True, unit="kg", doc="Overrides physics.mass.")
     stiffness: float | None = spec("float", None, lo=0.0, unit="N/m", doc="Overrides physics.stiffness.")
     damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="Overrides physics.damping.")
-    material: str | None = spec("str", None, choices=material_models,
+    material: str | None = spec("str", None, choices=material_names,
                                 doc="Overrides physics.material: any of the ten material keys (material to "
                                     "max_stretch, and plane) gives the body its own material, the others taken from "
                                     "[physics].")
@@ -495,6 +509,9 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
     else:
         own = {k: getattr(body, k) for k in MATERIAL_KEYS if getattr(body, k) is not None}
         model = own.get("material", physics.material)
+    preset = PRESETS.get(model)
+    if preset is not None:
+        model = preset["model"]
     springs = [k for k in _SPRING_KEYS if body is not None and getattr(body, k) is not None]
     if model != "springs" and springs:
         where = "" if "material" in own else " (physics.material)"
@@ -510,7 +527,7 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
                                            f"stiffness and damping): set material = \"corotated\" or "
                                            f"\"neo-hookean\" too, or remove {fem[0]}")
         return {"model": "springs", **_behaviour_settings(physics, own)}
-    values = {k: own.get(k, getattr(physics, k)) for k in FEM_KEYWORD}
+    values = {k: _with_preset(k, own, physics, preset, FEM_DEFAULT.get(k)) for k in FEM_KEYWORD}
     missing = [k for k in _FEM_NEEDS if values[k] is None]
     if missing:
         where = "on the body or in [physics]" if body is not None else "in [physics]"
@@ -518,15 +535,29 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
                                      f"density in kg/m^2): set {'it' if len(missing) == 1 else 'them'} {where}")
     out = {"model": model}
     out.update((FEM_KEYWORD[k], v if k == "plane" else float(v)) for k, v in values.items())
-    out.update(_behaviour_settings(physics, own))
+    out.update(_behaviour_settings(physics, own, preset))
     return out
 
 
-def _behaviour_settings(physics: PhysicsSettings, own: dict) -> dict:
-    """The behaviour keywords that are set (the body's, else ``[physics]``'s), defaults left out."""
+def _with_preset(key: str, own: dict, physics: PhysicsSettings, preset: dict | None, default):
+    """A material key's value: the body's own; then, for a preset the body names, the preset's
+    before ``[physics]``'s, and for the world's preset ``[physics]``'s before the preset's (a
+    value equal to the key's default counts as unset)."""
+    if key in own:
+        return own[key]
+    name = FEM_KEYWORD.get(key, key)
+    if preset is None or name not in preset:
+        return getattr(physics, key)
+    v = None if "material" in own else getattr(physics, key)
+    return preset[name] if v is None or v == default else v
+
+
+def _behaviour_settings(physics: PhysicsSettings, own: dict, preset: dict | None = None) -> dict:
+    """The behaviour keywords that are set (the body's, else ``[physics]``'s, else the preset's),
+    defaults left out."""
     out = {}
     for k in BEHAVIOUR_KEYS:
-        v = own.get(k, getattr(physics, k))
+        v = _with_preset(k, own, physics, preset, _BEHAVIOUR_DEFAULT[k])
         if v is not None and v != _BEHAVIOUR_DEFAULT[k]:
             out[k] = float(v)
     return out
