@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import shutil
 import sys
 import time
 import warnings
@@ -136,6 +138,9 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="picture size (default 1280x720)")
     r.add_argument("-o", "--output", metavar="OUT", help="out.mp4, out.gif, or a folder/ for PNG frames")
     r.add_argument("--states", metavar="OUT.npz", help="save positions per frame, meshes and parameters")
+    r.add_argument("--export", metavar="DIR", help="write every body's deformed mesh per frame into the new folder DIR")
+    r.add_argument("--format", choices=("obj", "json", "svg"), help="--export's format (default obj: with uv and "
+                   "a material library naming each body's picture)")
     r.add_argument("--wireframe", action="store_true", help="draw the springs over the bodies")
     r.add_argument("--overlay", action="store_true",
                    help="write the simulated time (top left) and a scale bar (bottom left) on every frame")
@@ -237,6 +242,59 @@ def _progress(total: int, enabled: bool, label: str):
                 dynamic_ncols=True)
 
 
+def _check_export_path(path: str) -> None:
+    """``--export DIR``: a new folder, or an empty one, in a folder that exists and is writable."""
+    from .files import check_folder
+
+    target = Path(path)
+    if target.exists() and not (target.is_dir() and not any(target.iterdir())):
+        what = "a file" if not target.is_dir() else "a folder that is not empty"
+        raise CliError(f"{path}: --export writes a new folder, and this is {what}: give a new or empty folder")
+    try:
+        check_folder(path, target.resolve().parent)
+    except ValueError as e:
+        raise CliError(str(e)) from None
+
+
+class _MeshExport:
+    """``--export DIR``: each frame's meshes written into a hidden temporary folder beside DIR,
+    which becomes DIR when the run ends well (:meth:`publish`) and is removed otherwise."""
+
+    def __init__(self, path: str, fmt: str, scene):
+        from .files import temp_folder_in
+
+        self.target = Path(path)
+        self.fmt = fmt
+        self.colors = [getattr(b, "color", None) for b in scene.body]
+        self.tmp = temp_folder_in(self.target.resolve().parent)
+        self.materials = None
+        self._first = True
+
+    def write(self, world, frame: int) -> None:
+        from .mesh.export import write_materials, write_meshes
+
+        bodies = [b for b in world.bodies if len(b.triangles)]
+        meshes = [b.to_mesh() for b in bodies]
+        names = [f"body{b.index}" for b in bodies]
+        if self._first and self.fmt == "obj":  # the pictures do not change: once
+            self.materials = write_materials(meshes, self.tmp, names=names)
+        self._first = False
+        colors = [self.colors[b.index] if b.index < len(self.colors) else None for b in bodies]
+        write_meshes(meshes, self.tmp / f"frame_{frame:05d}.{self.fmt}", names=names, colors=colors,
+                     materials=self.materials, frame=frame, time=world.time)
+
+    def publish(self) -> None:
+        if self.target.is_dir():  # an empty folder (checked before the run): replaced
+            self.target.rmdir()
+        os.replace(self.tmp, self.target)
+        self.tmp = None
+
+    def abort(self) -> None:
+        if self.tmp is not None:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            self.tmp = None
+
+
 def cmd_run(a) -> int:
     from .startup import COMPILE_MESSAGE, CompileWatch, warn
 
@@ -275,6 +333,10 @@ def _run_scene(a, watch, shown: dict) -> int:
         check_output(a.output)
     if a.states:
         _check_states_path(a.states)
+    if a.format and not a.export:
+        raise CliError("--format says how --export writes the meshes: give --export DIR too")
+    if a.export:
+        _check_export_path(a.export)
     world = scene.build()
     n_frames = frame_count(seconds, fps)
     from .physics.diagnostics import xpbd_advice
@@ -302,19 +364,26 @@ def _run_scene(a, watch, shown: dict) -> int:
     bar = shown["bar"] = _progress(n_frames, True, label) if on_terminal else None
     t_wall = time.perf_counter()
     compile_before = watch.seconds
+    export = None
     try:
         if a.output:
             # inside the try: from here on an interrupt removes the temporary file
             writer = open_writer(a.output, fps=fps)
+        if a.export:
+            export = _MeshExport(a.export, a.format or "obj", scene)
         # the scene's [[event]] explosions and [[pull]] grabs, frame by frame
         playback = Playback(scene, world, fps=fps, view=view, writer=writer, record=bool(a.states))
-        for _ in playback.frames(n_frames):
+        for k in playback.frames(n_frames):
+            if export is not None:
+                export.write(world, k)
             if bar is not None:
                 bar.update(1)
         if writer is not None:
             writer.close()
         if a.states:
             playback.recording.save(a.states)
+        if export is not None:
+            export.publish()
     except SimulationUnstable as e:
         raise CliError(f"{a.scene}: simulation became unstable at t = {world.time:.3f} s: {e}; "
                        f"nothing was written", EXIT_UNSTABLE) from None
@@ -323,6 +392,8 @@ def _run_scene(a, watch, shown: dict) -> int:
             bar.close()
         if writer is not None:
             writer.abort()  # no-op after close(); discards the temporary file otherwise
+        if export is not None:
+            export.abort()  # no-op after publish(); removes the temporary folder otherwise
         if view is not None:
             view.renderer.release()
     # honest figures: the whole command's wall time, start-up and compiling included, and the
@@ -331,7 +402,7 @@ def _run_scene(a, watch, shown: dict) -> int:
     frames_wall = time.perf_counter() - t_wall - (watch.seconds - compile_before)
     compiling = watch.seconds if watch.compiled else 0.0  # else a helper without cache: start-up
     startup = max(0.0, total - frames_wall - compiling)
-    outputs = [o for o in (a.output, a.states) if o]
+    outputs = [o for o in (a.output, a.states, a.export) if o]
     sim = world.time
     print(f"{label}: {n_frames} frames, {sim:.2f} s simulated in {total:.2f} s wall ("
           + (f"{compiling:.2f} s compiling kernels, first run only; " if watch.compiled else "")

@@ -2,8 +2,9 @@
 
 from .box import box
 from .delaunay import delaunay
+from .export import read_meshes, write_meshes
 from .image import from_image
 from .mesh import Mesh
 from .outline import outline
 
-__all__ = ["Mesh", "box", "delaunay", "from_image", "outline"]
+__all__ = ["Mesh", "box", "delaunay", "from_image", "outline", "read_meshes", "write_meshes"]

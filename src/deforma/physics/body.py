@@ -203,6 +203,41 @@ class Body:
         """(E, 2) int32 spring vertex pairs in body-local indices."""
         return self.topology.springs
 
+    def to_mesh(self):
+        """The body's current shape as a :class:`~deforma.mesh.Mesh`: its positions (m), its
+        triangles (a torn body's as torn), its texture coordinates and picture.
+
+        A triangle the motion has turned over stays as it is (it is not re-ordered), so the
+        mesh shows the body exactly; ``deforma.mesh.write_meshes`` writes it as OBJ, JSON or
+        SVG.
+
+        Raises
+        ------
+        ValueError
+            A body without triangles (a chain of springs): no mesh to give.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2), position=(0, 2))
+        >>> w.step()
+        >>> m = b.to_mesh()
+        >>> bool((m.vertices == b.positions).all()), bool((m.triangles == b.triangles).all()), m.uv.shape
+        (True, True, (16, 2))
+        """
+        from ..mesh import Mesh
+
+        if len(self.triangles) == 0:
+            raise ValueError(f"body {self._index} has no triangles (a chain of springs): it has no mesh to give")
+        uv = getattr(self.mesh, "uv", None)
+        if uv is None or len(uv) != self.n_vertices:
+            x = self.topology.rest_positions
+            lo, hi = x.min(axis=0), x.max(axis=0)
+            uv = (x - lo) / np.where(hi > lo, hi - lo, 1.0)
+        return Mesh._trusted(self.positions.copy(), self.triangles.copy(), np.array(uv, dtype=np.float64, copy=True),
+                             getattr(self.mesh, "texture", None))
+
     @property
     def vertex_masses(self) -> np.ndarray:
         """(N,) mass of each vertex in kg (a copy): equal for springs, ``density`` times the
