@@ -183,6 +183,22 @@ size = [5.0, 0.5]
 """
 
 
+def test_states_on_a_full_disk_keep_the_earlier_video_and_name_the_file(tmp_path, capsys, monkeypatch):
+    import errno
+
+    video, states = tmp_path / "v.mp4", tmp_path / "s.npz"
+    video.write_bytes(b"earlier video")
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(np, "savez_compressed", full)
+    code, _, err = run(capsys, "run", "sample", "--seconds", "0.2", "-o", str(video), "--states", str(states), *SMALL)
+    assert code == EXIT_ERROR and err.count("\n") == 1
+    assert f"{states}: could not be written: no space left on the device; nothing was written" in err
+    assert video.read_bytes() == b"earlier video" and sorted(os.listdir(tmp_path)) == ["v.mp4"]
+
+
 def test_unstable_simulation_fails_cleanly_and_writes_nothing(tmp_path, capsys):
     p = tmp_path / "boom.toml"
     p.write_text(UNSTABLE)

@@ -378,12 +378,16 @@ def _run_scene(a, watch, shown: dict) -> int:
                 export.write(world, k)
             if bar is not None:
                 bar.update(1)
+        # every output complete before any is put in place: a disk too full for the states
+        # (or a video that could not be finished) keeps the earlier files as they were
         if writer is not None:
-            writer.close()
+            writer.finish()
         if a.states:
             playback.recording.save(a.states)
         if export is not None:
             export.publish()
+        if writer is not None:
+            writer.close()
     except SimulationUnstable as e:
         raise CliError(f"{a.scene}: simulation became unstable at t = {world.time:.3f} s: {e}; "
                        f"nothing was written", EXIT_UNSTABLE) from None

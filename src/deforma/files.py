@@ -24,6 +24,7 @@ Examples
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import shutil
@@ -32,7 +33,7 @@ import time
 from pathlib import Path
 from typing import BinaryIO, Callable
 
-__all__ = ["check_folder", "publish", "remove_stale_partials", "temp_beside", "temp_folder_in", "write_atomic"]
+__all__ = ["check_folder", "failed_write", "publish", "remove_stale_partials", "temp_beside", "temp_folder_in", "write_atomic"]
 
 
 def check_folder(path, folder: Path) -> None:
@@ -165,6 +166,28 @@ def write_atomic(path, write: Callable[[BinaryIO], object]) -> None:
         with open(tmp, "wb") as f:
             write(f)
         publish(tmp, path)
+    except OSError as e:
+        tmp.unlink(missing_ok=True)
+        raise failed_write(path, e) from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+def failed_write(path, error: OSError) -> OSError:
+    """A one-line error for a file that could not be written, naming it (an OSError such as a
+    full disk's ``[Errno 28]`` names only the temporary file, or nothing); ``errno`` is kept.
+
+    Examples
+    --------
+    >>> import errno
+    >>> str(failed_write("out/s.npz", OSError(errno.ENOSPC, "No space left on device")))
+    'out/s.npz: could not be written: no space left on the device; nothing was written'
+    """
+    if getattr(error, "errno", None) in (errno.ENOSPC, errno.EDQUOT):
+        why = "no space left on the device"
+    else:
+        why = (error.strerror or str(error) or type(error).__name__).strip().splitlines()[0]
+    out = OSError(f"{path}: could not be written: {why}; nothing was written")
+    out.errno = getattr(error, "errno", None)
+    return out

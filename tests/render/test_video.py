@@ -152,3 +152,55 @@ def test_outputs_get_normal_file_permissions(tmp_path, name):
     files = [target] if target.is_file() else sorted(target.iterdir())
     for f in files:
         assert f.stat().st_mode & 0o777 == 0o644, f
+
+
+def test_a_real_mp4_is_complete_and_a_cut_one_is_not(tmp_path):
+    from deforma.render.video import mp4_complete
+
+    out = tmp_path / "a.mp4"
+    with open_writer(out, fps=24) as w:
+        for f in moving_frames(17):
+            w.write(f)
+    assert mp4_complete(out)
+    data = out.read_bytes()
+    for keep in (0.3, 0.6, 0.99):  # what ffmpeg leaves when the disk fills while it finishes
+        out.write_bytes(data[: int(len(data) * keep)])
+        assert not mp4_complete(out), keep
+
+
+def _full_disk(*args, **kwargs):
+    import errno
+
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+@pytest.mark.parametrize("name", ["v.mp4", "v.gif", "frames"])
+def test_a_full_disk_keeps_the_earlier_output_and_says_which_file(tmp_path, monkeypatch, name):
+    from deforma.render import video
+
+    target = tmp_path / name
+    if name == "frames":
+        target.mkdir()
+        (target / "frame_00000.png").write_bytes(b"earlier")
+        monkeypatch.setattr(Image.Image, "save", _full_disk)  # the first frame fails
+        earlier = target / "frame_00000.png"
+    else:
+        target.write_bytes(b"earlier")
+        earlier = target
+        if name.endswith(".mp4"):
+            # ffmpeg out of disk while it finishes the file exits as if all were well: the file is
+            # found cut short (test_a_real_mp4_is_complete_and_a_cut_one_is_not)
+            monkeypatch.setattr(video, "mp4_complete", lambda path: False)
+        else:
+            monkeypatch.setattr(Image.Image, "save", _full_disk)
+    w = open_writer(target, fps=10)
+    with pytest.raises(OSError) as e:
+        for f in moving_frames(5):
+            w.write(f)
+        w.close()
+    text = str(e.value)
+    why = "ffmpeg stopped (the finished file is cut short)" if name.endswith(".mp4") else "no space left on the device"
+    assert text.startswith(f"{target}: ") and why in text and "nothing was written" in text
+    assert "\n" not in text and earlier.read_bytes() == b"earlier"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == sorted([name] + (["frame_00000.png"] if name == "frames"
+                                                                            else []))

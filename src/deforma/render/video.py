@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..files import check_folder, publish, temp_beside, temp_folder_in
+from ..files import check_folder, failed_write, publish, temp_beside, temp_folder_in
 
 __all__ = ["FrameWriter", "GifWriter", "Mp4Writer", "PngFolderWriter", "check_output", "open_writer", "output_kind"]
 
@@ -88,6 +88,7 @@ class FrameWriter:
         self.frames_written = 0
         self.size: tuple[int, int] | None = None
         self._closed = False
+        self._finished = False
 
     def _check(self, frame) -> np.ndarray:
         f = np.asarray(frame)
@@ -105,14 +106,49 @@ class FrameWriter:
         """Append one frame."""
         if self._closed:
             raise ValueError(f"{self.path}: writer is closed")
-        self._write(self._check(frame))
+        try:
+            self._write(self._check(frame))
+        except OSError as e:  # a full disk while frames are written (PNG folders, MP4's pipe)
+            if not self._closed:
+                self._closed = True
+                self._discard()
+            if str(self.path) in str(e):
+                raise
+            raise failed_write(self.path, e) from None
         self.frames_written += 1
+
+    def finish(self) -> None:
+        """Complete the file in its temporary place, not yet moved onto the target: a caller
+        with more outputs finishes them all before it puts any in place (``deforma run -o
+        out.mp4 --states s.npz`` on a disk too full for the states keeps the earlier video)."""
+        if not self._closed and not self._finished:
+            self._finished = True
+            try:
+                self._finish()
+            except OSError as e:
+                self._closed = True
+                self._discard()
+                if str(self.path) in str(e):  # already says which file (the MP4 writer's own)
+                    raise
+                raise failed_write(self.path, e) from None
+            except BaseException:
+                self._closed = True
+                self._discard()
+                raise
 
     def close(self) -> None:
         """Finish the file and move it into place."""
         if not self._closed:
+            self.finish()
             self._closed = True
-            self._commit()
+            try:
+                self._publish()
+            except OSError as e:
+                self._discard()
+                raise failed_write(self.path, e) from None
+            except BaseException:
+                self._discard()
+                raise
 
     def abort(self) -> None:
         """Throw away everything written so far; the target is left as it was."""
@@ -133,11 +169,60 @@ class FrameWriter:
     def _write(self, frame):  # pragma: no cover - abstract
         raise NotImplementedError
 
-    def _commit(self):  # pragma: no cover - abstract
+    def _finish(self):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _publish(self):  # pragma: no cover - abstract
         raise NotImplementedError
 
     def _discard(self):  # pragma: no cover - abstract
         raise NotImplementedError
+
+
+def mp4_complete(path) -> bool:
+    """Whether ``path`` is a whole MP4 file: its top-level boxes (4-byte size, 4-byte type; a
+    size of 1 is followed by an 8-byte one, 0 runs to the end) tile it exactly, and it has
+    its ``ftyp``, ``moov`` and ``mdat``. ffmpeg that runs out of disk while it finishes the
+    file (the ``+faststart`` rewrite copies it once more) prints "Error writing trailer" and
+    leaves a truncated file, exiting as if all were well: this is how it is caught.
+
+    Examples
+    --------
+    >>> import struct, tempfile
+    >>> from pathlib import Path
+    >>> box = lambda kind, body=b"": struct.pack(">I", 8 + len(body)) + kind + body
+    >>> p = Path(tempfile.mkdtemp()) / "v.mp4"
+    >>> _ = p.write_bytes(box(b"ftyp", b"isom") + box(b"moov") + box(b"mdat", b"x" * 9))
+    >>> mp4_complete(p)
+    True
+    >>> _ = p.write_bytes(p.read_bytes()[:-3])  # cut short
+    >>> mp4_complete(p)
+    False
+    """
+    try:
+        with open(path, "rb") as f:
+            end = os.fstat(f.fileno()).st_size
+            at, kinds = 0, set()
+            while at < end:
+                f.seek(at)
+                head = f.read(8)
+                if len(head) < 8:
+                    return False
+                size, kind = int.from_bytes(head[:4], "big"), head[4:]
+                if size == 1:
+                    big = f.read(8)
+                    if len(big) < 8:
+                        return False
+                    size = int.from_bytes(big, "big")
+                elif size == 0:
+                    size = end - at
+                if size < 8:
+                    return False
+                kinds.add(kind)
+                at += size
+    except OSError:
+        return False
+    return at == end and {b"ftyp", b"moov", b"mdat"} <= kinds
 
 
 class Mp4Writer(FrameWriter):
@@ -164,7 +249,7 @@ class Mp4Writer(FrameWriter):
             self._padded = (w + w % 2, h + h % 2)
             self._gen = imageio_ffmpeg.write_frames(
                 str(self._tmp), self._padded, fps=self.fps, codec="libx264", pix_fmt_in="rgb24",
-                pix_fmt_out="yuv420p", quality=self.quality, macro_block_size=1, ffmpeg_log_level="error",
+                pix_fmt_out="yuv420p", quality=self.quality, macro_block_size=1, ffmpeg_log_level="quiet",
                 # veryfast: half the encoding time of the default preset, and no bigger here
                 output_params=["-preset", "veryfast", "-movflags", "+faststart"],
             )
@@ -192,22 +277,18 @@ class Mp4Writer(FrameWriter):
         return OSError(f"{self.path}: writing the video failed after {self.frames_written} frames: {why}; "
                        f"nothing was written")
 
-    def _commit(self):
+    def _finish(self):
         if self._gen is None:
-            self._tmp.unlink(missing_ok=True)
             raise ValueError(f"{self.path}: no frames were written")
         try:
             self._gen.close()
         except OSError as e:
             raise self._failed(e) from None
-        except BaseException:
-            self._tmp.unlink(missing_ok=True)
-            raise
-        try:
-            publish(self._tmp, self.path)
-        except BaseException:
-            self._tmp.unlink(missing_ok=True)
-            raise
+        if not mp4_complete(self._tmp):  # ffmpeg could not finish it, and did not say so
+            raise self._failed(OSError("the finished file is cut short"))
+
+    def _publish(self):
+        publish(self._tmp, self.path)
 
     def _discard(self):
         if self._gen is not None:
@@ -266,23 +347,20 @@ class GifWriter(FrameWriter):
         cs = np.round(np.arange(n + 1) * 100.0 / self.fps).astype(int)
         return [int(max(d, 1)) * 10 for d in np.diff(cs)]
 
-    def _commit(self):
+    def _finish(self):
         if self._palette is None and self._pending:
             self._build_palette()
-        tmp = self._tmp
         if not self._frames:
-            tmp.unlink(missing_ok=True)
             raise ValueError(f"{self.path}: no frames were written")
         try:
             first, rest = self._frames[0], self._frames[1:]
-            first.save(tmp, format="GIF", save_all=True, append_images=rest, loop=0,
+            first.save(self._tmp, format="GIF", save_all=True, append_images=rest, loop=0,
                        duration=self.durations_ms(len(self._frames)), disposal=1, optimize=False)
-            publish(tmp, self.path)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
         finally:
             self._frames = []
+
+    def _publish(self):
+        publish(self._tmp, self.path)
 
     def _discard(self):
         self._frames = []
@@ -324,9 +402,11 @@ class PngFolderWriter(FrameWriter):
             target.unlink(missing_ok=True)
             raise
 
-    def _commit(self):
+    def _finish(self):
         if self.frames_written == 0:
             raise ValueError(f"{self.path}: no frames were written")
+
+    def _publish(self):
         try:
             mask = os.umask(0)
             os.umask(mask)

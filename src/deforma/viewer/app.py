@@ -822,7 +822,8 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
     finally:
         v.close()
     if screenshot is not None and str(screenshot) in v.screenshot_errors:
-        raise OSError(f"{screenshot}: cannot save the screenshot: {v.screenshot_errors[str(screenshot)]}")
+        why = v.screenshot_errors[str(screenshot)].removeprefix(f"{screenshot}: ")  # said once
+        raise OSError(f"{screenshot}: cannot save the screenshot: {why}")
     return None
 
 
