@@ -381,3 +381,32 @@ def test_a_physics_warning_is_one_line_of_the_commands_own(tmp_path, capsys):
     assert lines == ["deforma: warning: the implicit solve stopped at max_iterations short of its tolerance in some "
                      "substeps (world.integrator_stats counts them): raise max_iterations or tolerance, or take "
                      "more substeps"]
+
+
+@pytest.mark.parametrize("signame, code, said", [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "stopped by SIGTERM")])
+def test_a_signal_while_the_package_loads_exits_with_the_shell_code_and_one_line(signame, code, said):
+    # the console script starts in deforma_entry, which sets its handlers before importing the
+    # package (half a second of NumPy, Numba and SciPy); the signal is sent from inside that import
+    script = (
+        "import builtins, os, signal, sys, time\n"
+        "import deforma_entry\n"
+        "real = builtins.__import__\n"
+        "def importing(name, *args, **kwargs):\n"
+        "    if name == 'deforma.cli':\n"
+        f"        os.kill(os.getpid(), signal.{signame})\n"
+        "        time.sleep(5)\n"
+        "    return real(name, *args, **kwargs)\n"
+        "builtins.__import__ = importing\n"
+        "sys.argv = ['deforma', 'scenes']\n"
+        "sys.exit(deforma_entry.main())\n"
+    )
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert p.returncode == code, p.stderr
+    assert p.stderr == f"deforma: {said} while starting; nothing was written\n" and p.stdout == ""
+
+
+def test_the_console_script_starts_in_deforma_entry():
+    from importlib.metadata import entry_points
+
+    (script,) = [e for e in entry_points(group="console_scripts") if e.name == "deforma"]
+    assert script.value == "deforma_entry:main"
