@@ -38,6 +38,8 @@ def test_plane_stress_lame_parameters():
     (dict(model="corotated", youngs_modulus=1e5, poisson_ratio=0.3, density=float("inf")), "density"),
     (dict(model="corotated", youngs_modulus=1e5, poisson_ratio=0.3, density=1.0, damping=-1.0), "damping"),
     (dict(model="corotated", youngs_modulus="stiff", poisson_ratio=0.3, density=1.0), "must be a number"),
+    (dict(model="corotated", youngs_modulus=10**400, poisson_ratio=0.3, density=1.0),
+     "youngs_modulus must be a finite number, got an integer of 401 digits"),
     (dict(model="springs", youngs_modulus=1e5), "takes no youngs_modulus"),
 ])
 def test_bad_materials_are_refused_with_the_value_and_the_range(kwargs, needle):

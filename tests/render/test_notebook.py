@@ -173,6 +173,7 @@ def test_show_a_world_keeps_its_scene_camera_and_fires_its_events():
     ({"size": "640x360"}, r"size must be a width"),
     ({"size": 320.5}, r"size must be a width"),
     ({"format": "webm"}, r"format must be one of 'mp4', 'gif' or None, got 'webm'"),
+    ({"overlay": "no"}, r"overlay must be True or False, got 'no'"),
     ({"seconds": 600, "fps": 60}, r"gives 36000 frames; at most 1800"),
 ])
 def test_bad_input_is_one_clear_value_error_line(kwargs, message):

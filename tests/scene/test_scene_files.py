@@ -156,6 +156,32 @@ def test_save_scene_writes_atomically_and_checks_the_target(tmp_path):
         scenes.save_scene(w, tmp_path / "nope" / "x.toml")
     scenes.save_scene(w, tmp_path / "x.toml")
     assert sorted(os.listdir(tmp_path)) == ["x.toml"]
+    (tmp_path / "d.toml").mkdir()
+    with pytest.raises(ValueError, match=r"d.toml: is a folder; give the scene file's name, ending in .toml"):
+        scenes.save_scene(w, tmp_path / "d.toml")
+    with pytest.raises(TypeError, match="save_scene saves a deforma.World or a deforma.scene.Scene, got int"):
+        scenes.save_scene(42, tmp_path / "y.toml")
+
+
+def test_save_scene_on_a_full_disk_keeps_the_earlier_file_and_names_it(tmp_path, monkeypatch):
+    import errno
+
+    w = scenes.load_scene("sample")
+    target = tmp_path / "x.toml"
+    target.write_text("# earlier")
+    real = open
+
+    def full_disk_open(file, mode="r", *args, **kwargs):
+        if "w" in mode and ".partial" in str(file):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(file, mode, *args, **kwargs)
+
+    monkeypatch.setattr("builtins.open", full_disk_open)
+    with pytest.raises(OSError) as e:
+        scenes.save_scene(w, target)
+    monkeypatch.undo()
+    assert str(e.value) == f"{target}: could not be written: no space left on the device; nothing was written"
+    assert target.read_text() == "# earlier" and sorted(os.listdir(tmp_path)) == ["x.toml"]
 
 
 BAD = [

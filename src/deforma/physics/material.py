@@ -91,6 +91,8 @@ def _number(value, name: str) -> float:
         v = float(value)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number, got {value!r}") from None
+    except OverflowError:  # an integer beyond any float (10**400)
+        raise ValueError(f"{name} must be a finite number, got an integer of {len(str(abs(value)))} digits") from None
     if isinstance(value, bool):
         raise ValueError(f"{name} must be a number, got {value!r}")
     return v

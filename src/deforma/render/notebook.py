@@ -319,6 +319,8 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
     fps = _number(fps, "fps", FPS_MAX, "frames/s")
     width, height = _check_size(size)
     format = _check_format(format)
+    if not isinstance(overlay, (bool, np.bool_)):  # overlay="no" is truthy: refuse it rather than draw it
+        raise ValueError(f"overlay must be True or False, got {overlay!r}")
     world, scene = _world_and_scene(scene_or_world)
     seconds = seconds if seconds is not None else scene.run.seconds
     fps = fps if fps is not None else scene.run.fps

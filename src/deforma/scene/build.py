@@ -8,9 +8,7 @@ remembers what each world was built from; :func:`scene_of` reads that record.
 from __future__ import annotations
 
 import math
-import os
 import re
-import tempfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -377,23 +375,25 @@ def save_scene(world, path) -> Path:
     """
     import tomli_w
 
+    from ..files import failed_write, write_atomic
+    from ..physics import World
+
+    if not isinstance(world, (Scene, World)):
+        raise TypeError(f"save_scene saves a deforma.World or a deforma.scene.Scene, got {type(world).__name__}")
     scene = world if isinstance(world, Scene) else scene_of(world)
     target = Path(path)
     if target.suffix.lower() != ".toml":
         raise ValueError(f"{path}: a scene file must end in .toml")
     if not target.parent.is_dir():
         raise ValueError(f"{path}: the folder {str(target.parent)!r} does not exist")
+    if target.is_dir():
+        raise ValueError(f"{path}: is a folder; give the scene file's name, ending in .toml")
     doc = scene_to_dict(scene, base_dir=target.parent.resolve())
     text = "# deforma scene: see docs/scenes.md for every key\n" + _inline_short_arrays(tomli_w.dumps(doc))
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".partial.toml", dir=target.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)  # mkstemp files are private; a scene file is not
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    try:  # whole or not at all: a full or read-only disk keeps the earlier file, and says which
+        write_atomic(target, lambda f: f.write(text.encode("utf-8")))
+    except OSError as e:
+        if str(path) in str(e):
+            raise
+        raise failed_write(path, e) from None
     return target
