@@ -410,3 +410,13 @@ def test_the_console_script_starts_in_deforma_entry():
 
     (script,) = [e for e in entry_points(group="console_scripts") if e.name == "deforma"]
     assert script.value == "deforma_entry:main"
+
+
+def test_states_onto_a_folder_are_refused_before_the_run(tmp_path, capsys, monkeypatch):
+    from deforma.scene import playback
+
+    (tmp_path / "s.npz").mkdir()
+    monkeypatch.setattr(playback.Playback, "frames", lambda *a, **k: pytest.fail("the run started"))
+    code, _, err = run(capsys, "run", "sample", "--states", str(tmp_path / "s.npz"), *SMALL)
+    assert code == EXIT_ERROR and err == f"deforma: error: {tmp_path / 's.npz'}: is a folder; give the states file's " \
+                                         f"name, ending in .npz\n"

@@ -219,6 +219,8 @@ def _check_states_path(path: str) -> None:
     p = Path(path)
     if p.suffix.lower() != ".npz":
         raise CliError(f"{path}: states are written as .npz; give a name ending in .npz")
+    if p.is_dir():  # said now, not after the whole simulation
+        raise CliError(f"{path}: is a folder; give the states file's name, ending in .npz")
     _check_folder(path)
 
 

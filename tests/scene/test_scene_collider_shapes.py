@@ -160,6 +160,12 @@ def test_bad_collider_keys_are_one_line_errors_with_the_key_path(table, message)
 
 @pytest.mark.parametrize("table, message", [
     ({"shape": "polygon", "points": [[0, 0], [2, 2], [2, 0], [0, 1]]}, "collider[1]: a polygon must be simple"),
+    # a bow-tie whose two halves cancel has no area, but its fault is the crossing
+    ({"shape": "polygon", "points": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "collider[1]: a polygon must be simple: edge 0 "
+                                                                        "crosses edge 2"),
+    ({"shape": "polygon", "points": [[0, 0], [1, 0], [2, 0]]}, "collider[1]: a polygon's points must enclose an area"),
+    ({"shape": "image", "source": "ramp", "min_area": 1e308}, "collider[1]: min_area = 1e+308 square px drops every "
+                                                              "piece of the picture"),
     ({"shape": "polygon", "points": [[0, 0], [1, 0], [0, 1]], "holes": [[[5, 5], [6, 5], [5, 6]]]},
      "collider[1]: holes[0] must lie inside the polygon"),
     ({"shape": "segment", "a": [1, 1], "b": [1, 1]}, "collider[1]: a segment of radius 0 needs two different ends"),

@@ -283,3 +283,27 @@ def test_saved_vectors_are_written_on_one_line(tmp_path):
     compact = _inline_short_arrays(tomli_w.dumps(doc))
     assert tomllib.loads(compact) == doc
     assert "    [0.123456789, -2.5],\n" in compact and "t = [[0, 1, 2], [2, 3, 0]]\n" in compact
+
+
+@pytest.mark.parametrize("content, why", [
+    (b"not a picture", "cannot identify image file"),
+    (b"", "cannot identify image file"),
+    ("liar", "image file is truncated"),  # a PNG whose header says 100 x 100 and holds 10 x 10
+])
+def test_an_unreadable_texture_file_is_refused_naming_its_key(tmp_path, content, why):
+    import struct
+    import zlib
+
+    if content == "liar":
+        def chunk(kind, data):
+            return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+        raw = b"".join(b"\x00" + b"\xff\x00\x00" * 10 for _ in range(10))
+        content = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 100, 100, 8, 2, 0, 0, 0))
+                   + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+    (tmp_path / "t.png").write_bytes(content)
+    p = tmp_path / "s.toml"
+    p.write_text('[[body]]\ndetail = 2\ntexture = "t.png"\n')
+    with pytest.raises(scenes.SceneError) as e:
+        scenes.load(p)
+    text = str(e.value)
+    assert "\n" not in text and text.startswith(f"{p}: body[0].texture: cannot read image") and why in text

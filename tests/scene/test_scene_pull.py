@@ -26,6 +26,11 @@ HANG = """
     ("[[pull]]\nat = [0, 0]\nend = 1.0\n", "pull[0].to: missing: where the target moves by end"),
     ("[[pull]]\nat = [0, 0]\nradius = 0\n", "pull[0].radius: must be > 0 m, got 0"),
     ("[[pull]]\nat = [0, 0]\nstrength = -5\n", "pull[0].strength: must be > 0 N/m, got -5"),
+    # what World.grab refuses is said at load time with the key's path
+    ("[[pull]]\nat = [1e308, 0]\n", "pull[0].at: must lie within +-1e+09 m, got [1e+308, 0]"),
+    ("[[pull]]\nat = [0, 0]\nto = [0, -1e308]\n", "pull[0].to: must lie within +-1e+09 m"),
+    ("[[pull]]\nat = [0, 0]\nradius = 1e308\n", "pull[0].radius: must be in [1e-09, 1e+06] m, got 1e+308"),
+    ("[[pull]]\nat = [0, 0]\nstrength = 1e308\n", "pull[0].strength: must be in [1e-09, 1e+12] N/m, got 1e+308"),
     ("[[pull]]\nat = [0]\n", "pull[0].at: expected two numbers [x, y]"),
     ("[[pull]]\nat = [0, 0]\nstop = 1\n", "pull[0].stop: unknown key; "),
     ("[pull]\nat = [0, 0]\n", "pull: expected an array of tables ([[pull]])"),

@@ -583,6 +583,20 @@ def _from_path(source):
     return _open(name, name)
 
 
+def check_picture(path) -> None:
+    """Read the picture at ``path`` as :func:`from_image` would, to refuse at once what it
+    would refuse later (not a picture, truncated or corrupt data, a header that lies about its
+    size, no pixels, more than ``MAX_PIXELS``): a scene file's texture is checked when the
+    file is read, so that the error names its key, not only when a frame is drawn.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file and what is wrong with it.
+    """
+    _open(path, str(path))
+
+
 def _open(path, label):
     try:
         with Image.open(path) as im:

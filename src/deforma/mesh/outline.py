@@ -140,6 +140,9 @@ def outline(
         elif not dropped and size[k] >= min_area:
             regions[-1][1].append(loops[k])
 
+    if not regions:
+        raise ValueError(f"min_area = {min_area:g} square px drops every piece of the picture (the largest is "
+                         f"{float(size.max()):.0f} square px): lower it")
     out = []
     for outer, holes in _simplify_regions(regions, tolerance):
         out.append((_to_metres(outer, cx, cy, scale, True), [_to_metres(h, cx, cy, scale, False) for h in holes]))

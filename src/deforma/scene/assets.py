@@ -104,6 +104,9 @@ def _resolve(value: str, names: dict, what: str, base_dir) -> str:
     if not p.is_absolute():
         p = Path(base_dir) / p
     if p.is_file():
+        from ..mesh.image import check_picture
+
+        check_picture(p)  # an unreadable picture is refused here, where the error can name its key
         return str(p.resolve())
     allowed = f"a built-in {what} ({', '.join(names) or 'none installed'}) or an image file"
     if "/" not in value and "." not in value:

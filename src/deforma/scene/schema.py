@@ -52,6 +52,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 # an image body's background: the rule of deforma.mesh.from_image itself
+from ..checks import LIMITS, MAX_COORDINATE
 from ..mesh.image import check_background
 from .assets import picture_reference, resolve_picture, resolve_texture, texture_reference
 from .construct import build
@@ -403,6 +404,16 @@ def _check_pull(pull: Pull, path: str) -> None:
     if pull.release is not None and pull.release < end:
         raise _Problem(f"{path}.release", f"must be >= {'end' if pull.end is not None else 'start'} ({end:g} s), "
                                           f"got {pull.release:g}")
+    # what World.grab refuses, said here with the key's path, before the run
+    for key in ("at", "to"):
+        value = getattr(pull, key)
+        if value is not None and max(abs(value[0]), abs(value[1])) > MAX_COORDINATE:
+            raise _Problem(f"{path}.{key}", f"must lie within +-{MAX_COORDINATE:g} m, got [{value[0]:g}, {value[1]:g}]")
+    for key in ("radius", "strength"):
+        value, (lo, hi) = getattr(pull, key), LIMITS[key]
+        if value is not None and not lo <= value <= hi:
+            raise _Problem(f"{path}.{key}", f"must be in [{lo:g}, {hi:g}] {'m' if key == 'radius' else 'N/m'}, "
+                                            f"got {value:g}")
 
 
 def _check_integrator(name: str, path: str) -> None:

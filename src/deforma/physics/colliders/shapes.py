@@ -486,6 +486,9 @@ class Polygon(Collider):
                  angular_velocity=0.0):
         outer = _points(points, "points", minimum=3)
         if abs(signed_area(outer)) <= 1e-12 * max(1.0, float(np.ptp(outer, axis=0).max()) ** 2):
+            spread = np.linalg.svd(outer - outer.mean(axis=0), compute_uv=False)
+            if spread[1] > 1e-9 * max(spread[0], 1e-300):  # not on one line: a bow-tie whose halves cancel
+                _check_simple([outer], "a polygon")
             raise ValueError("a polygon's points must enclose an area (they are collinear or repeated)")
         if signed_area(outer) < 0:
             outer = outer[::-1]
