@@ -115,6 +115,12 @@ def coefficient(value, name: str):
     return non_negative(value, name, "(dimensionless)")
 
 
+class IgnoredSettingWarning(UserWarning):
+    """A world parameter set that some bodies do not read: ``world.stiffness`` (``mass``,
+    ``damping``) on bodies made of finite elements, whose stiffness is their material's. Said
+    once per world and parameter, naming the bodies and their model."""
+
+
 class StepBeyondStableWarning(RuntimeWarning):
     """``World.add_body`` under an explicit integrator: the world's step is beyond the stable
     estimate with the new body, so a step will likely blow up (the message says what to set).

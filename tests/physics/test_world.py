@@ -248,3 +248,27 @@ def test_other_arguments_are_validated():
 def test_integrator_registry_names_the_choices():
     assert "symplectic-euler" in available_integrators()
     assert deforma.World(integrator="symplectic-euler").integrator == "symplectic-euler"
+
+
+def test_spring_parameters_set_on_the_world_say_once_which_bodies_ignore_them():
+    import warnings
+
+    from deforma.checks import IgnoredSettingWarning
+
+    box = deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2)
+    w = deforma.World(material=deforma.Material("corotated", youngs_modulus=1e4, poisson_ratio=0.3, density=1.0))
+    w.add_body(box)
+    with pytest.warns(IgnoredSettingWarning, match=r"world.stiffness changes no body: body 0 \(corotated\) is made of "
+                                                   r"finite elements, whose stiffness is set by youngs_modulus"):
+        w.stiffness = 3000.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        w.stiffness = 4000.0  # said once
+    w.add_body(box, position=(3, 0), material=deforma.Material("springs"))
+    with pytest.warns(IgnoredSettingWarning, match=r"world.damping changes only the bodies made of springs: body 0"):
+        w.damping = 2.0
+    springs = deforma.World()
+    springs.add_body(box)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        springs.stiffness = 3000.0  # every body reads it

@@ -449,3 +449,9 @@ def test_a_plane_strain_world_keeps_its_plane_through_the_panel(tmp_path):
     s.set_material("neo-hookean")
     assert s.world.material.plane == "strain"
     assert deforma.load_scene(s.save(tmp_path / "again.toml")).material.plane == "strain"
+
+
+def test_a_spring_value_set_on_a_finite_element_scene_is_noted_in_the_panel():
+    s = Session("demo")
+    s.set_param("stiffness", 3000.0)
+    assert s.note_is_warning and s.note.startswith("world.stiffness changes no body: body 0 (neo-hookean)")

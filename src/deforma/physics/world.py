@@ -32,7 +32,7 @@ from .colliders.shapes import SHAPES, Collider, pack_colliders
 from .contact.clearance import outlines_overlap
 from .contact.contacts import ContactPoints, Contacts
 from .control import Control
-from ..checks import StepBeyondStableWarning
+from ..checks import IgnoredSettingWarning, StepBeyondStableWarning
 from .diagnostics import Energy, SimulationUnstable
 from .integrators import make_integrator
 from .material import Material
@@ -134,6 +134,7 @@ class World:
         self._material = None
         self.time = 0.0
         self.step_count = 0
+        self._said_ignored = set()  # the spring parameters already said to reach no FEM body
         self._auto = False  # substeps = "auto"
         self._auto_key = None  # what the automatic substeps were chosen for
         self.gravity = gravity
@@ -270,9 +271,24 @@ class World:
             setattr(self, "_" + name, check(value, name, unit))
             for b in range(len(self._bodies)):  # bodies that follow the world (friction: body contacts)
                 self._apply_body_parameters(b)
+            if name in ("mass", "stiffness", "damping"):
+                self._say_ignored(name)
             if name in ("friction", "static_friction"):
                 self._packed_colliders = None  # colliders that follow the world's
         return property(get, set_, doc=f"World default {name} ({unit}).")
+
+    def _say_ignored(self, name: str) -> None:
+        """Warn once per parameter when the spring ``name`` just set reaches no finite-element body."""
+        fem = [b for b in self._bodies if b.is_fem]
+        if not fem or name in self._said_ignored:
+            return
+        self._said_ignored.add(name)
+        which = ", ".join(f"body {b.index} ({b.material.model})" for b in fem[:3]) + (" ..." if len(fem) > 3 else "")
+        share = "no body" if len(fem) == len(self._bodies) else "only the bodies made of springs"
+        instead = {"mass": "density", "stiffness": "youngs_modulus", "damping": "the material's damping"}[name]
+        warnings.warn(f"world.{name} changes {share}: {which} {'is' if len(fem) == 1 else 'are'} made of finite "
+                      f"elements, whose {name} is set by {instead} (world.material or body.material)",
+                      IgnoredSettingWarning, stacklevel=3)
 
     mass = _world_param("mass", "kg", _positive)
     stiffness = _world_param("stiffness", "N/m", _non_negative)

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import IgnoredSettingWarning
 from ..physics import Circle, Material, Polygon, Rect, Segment, available_integrators
 from ..physics.diagnostics import xpbd_advice
 from ..physics.integrators.base import unknown_option
@@ -307,7 +308,14 @@ class Session:
             w.substeps = value
         elif name in ("dt", "damping", "mass", "stiffness", "friction", "static_friction", "air_drag",
                       "contact_thickness"):
-            setattr(w, name, value)
+            with warnings.catch_warnings(record=True) as said:  # a spring value finite elements ignore:
+                warnings.simplefilter("always", IgnoredSettingWarning)  # the panel says so
+                setattr(w, name, value)
+            for warning in said:
+                if issubclass(warning.category, IgnoredSettingWarning):
+                    self.note, self.note_is_warning = str(warning.message), True
+                else:
+                    warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
         elif name in ("collide", "self_collision"):
             if w.bodies:
                 setattr(w.bodies[self.body_index], name, bool(value))
