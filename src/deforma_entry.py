@@ -26,12 +26,16 @@ def _stop_while_starting(signum, frame):  # pragma: no cover - runs only in a ki
 
 def main() -> int:
     """Entry point of the ``deforma`` console script: see the module docstring."""
-    for signum in _SIGNALS:
-        signal.signal(signum, _stop_while_starting)
+    before = {signum: signal.getsignal(signum) for signum in _SIGNALS}
+    for signum, handler in before.items():
+        if handler is not signal.SIG_IGN:  # a signal the parent ignores (nohup, a background job) stays so
+            signal.signal(signum, _stop_while_starting)
     from deforma.cli import main as run
 
-    # from here on Ctrl-C is a KeyboardInterrupt again, which the command cleans up after
-    signal.signal(signal.SIGINT, signal.default_int_handler)
+    # from here on Ctrl-C is a KeyboardInterrupt again, which the command cleans up after, and
+    # SIGTERM / SIGHUP are the command's to handle
+    for signum, handler in before.items():
+        signal.signal(signum, handler)
     return run()
 
 
