@@ -254,6 +254,8 @@ def test_bad_pins_are_refused_and_change_nothing():
         b.pin([0, 9])
     with pytest.raises(ValueError, match="must be integers"):
         b.pin([0.5])
+    with pytest.raises(ValueError, match=f"vertex index {2**70} is out of range; body 0 has vertices 0..8"):
+        b.pin([0, 2**70])  # beyond int64
     assert not b.pinned.any()
 
 

@@ -319,6 +319,11 @@ class Body:
         if a.dtype == bool and a.shape == (self.n_vertices,):
             return np.flatnonzero(a)
         a = a.reshape(-1)
+        if a.size and a.dtype == object and all(isinstance(v, int) for v in a.tolist()):
+            # Python integers too large for int64: certainly out of range, said as such
+            bad = next(v for v in a.tolist() if not 0 <= v < self.n_vertices)
+            raise ValueError(f"{name}: vertex index {bad} is out of range; body {self._index} has vertices "
+                             f"0..{self.n_vertices - 1}")
         if a.size and not np.issubdtype(a.dtype, np.integer):
             raise ValueError(f"{name} must be integers (or a bool mask of {self.n_vertices}), got dtype {a.dtype}")
         if a.size and (a.min() < 0 or a.max() >= self.n_vertices):
