@@ -139,7 +139,7 @@ BAD = [
     ("[physics]\nyoungs_modulus = 1e4\n[[body]]\ndetail = 2\n",
      "physics.youngs_modulus: no body is made of finite elements to use it (physics.material is 'springs')"),
     ("[physics]\nmaterial = 'steel'\n", "physics.material: unknown value 'steel'; allowed: springs, corotated, "
-                                        "neo-hookean, jelly, gummy, rubber, foam, wood, cloth"),
+                                        "neo-hookean, rigid, jelly, gummy, rubber, foam, wood, cloth"),
     ("[[body]]\nmaterial = 'neohookean'\n", "body[0].material: unknown value 'neohookean'; did you mean "
                                             "'neo-hookean'?"),
     ("[physics]\npoisson_ratio = 0.5\n", "physics.poisson_ratio: must be in (-1, 0.5), got 0.5"),

@@ -235,6 +235,22 @@ def test_material_model_switches_on_the_running_world_with_the_defaults():
     assert (world.material.model, world.material.youngs_modulus, world.material.density) == ("corotated", 5e4, 3.0)
 
 
+def test_the_rigid_model_makes_the_bodies_rigid_and_keeps_the_elastic_values():
+    s = Session(seed("sample"))
+    world = s.world
+    s.set_param("youngs_modulus", 5e4)
+    s.set_material("rigid")
+    assert world.material == deforma.Material("rigid", density=1.0) and world.bodies[0].material.is_rigid
+    s.set_param("youngs_modulus", 6e4)  # kept for an elastic model, the bodies stay rigid
+    assert world.material.is_rigid and "kept for when" in s.note
+    s.set_param("density", 2.0)
+    assert world.material == deforma.Material("rigid", density=2.0)
+    for _ in range(30):
+        world.step()
+    s.set_material("corotated")
+    assert (world.material.youngs_modulus, world.material.density) == (6e4, 2.0)
+
+
 def test_a_fem_scene_shows_its_material():
     scene = deforma.scene.load("sample")
     physics = dataclasses.replace(scene.physics, material="corotated", youngs_modulus=2e5, poisson_ratio=0.25,

@@ -9,17 +9,22 @@ pulled toward a target while held.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..checks import MAX_LOAD
+from ..checks import number as _number
+from ..checks import pair as _pair
 from ..checks import non_negative as _non_negative
 from ..checks import positive as _positive
 from ..checks import switch as _switch
 from .behaviours import tearing as _tearing
+from . import rigid_motion
 from .behaviours.pressure import outline_loops
 from .material import Material
+from .rigid.stage import rigid_set
 from .topology import BodyTopology, element_geometry
 
 if TYPE_CHECKING:  # the World imports this module
@@ -82,6 +87,7 @@ class Body:
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
         self._tear_fresh = np.zeros(0, np.int64)  # and the vertices whose springs, elements or mass it changed
         self._cracks = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
+        self._angle0 = 0.0  # rad: the angle it was placed at (its rest shape is turned so)
 
     def _tear_view(self):
         """The tear check's view (:class:`~deforma.physics.behaviours.tearing.TearTopology`) of the current
@@ -251,6 +257,85 @@ class Body:
         return (m @ self.positions) / m.sum()
 
     @property
+    def velocity(self) -> np.ndarray:
+        """(2,) velocity of the centre of mass, m/s (a copy).
+
+        Setting it shifts every vertex's velocity by the same amount: the body's spin and
+        wobble stay as they are.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(gravity=(0, 0))
+        >>> b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2))
+        >>> b.velocity = (1.0, 2.0)
+        >>> b.velocity.tolist(), b.velocities[0].tolist()
+        ([1.0, 2.0], [1.0, 2.0])
+        """
+        m = self._check()._model.vertex_mass[self.vertex_slice]
+        return (m @ self.velocities) / m.sum()
+
+    @velocity.setter
+    def velocity(self, value):
+        world = self._check()
+        vel = _pair(value, "velocity", limit=world.max_speed)
+        self.velocities[...] += np.asarray(vel) - self.velocity
+
+    @property
+    def angular_velocity(self) -> float:
+        """Spin about the centre of mass, deg/s, counter-clockwise: the vertices' angular
+        momentum about it over their moment of inertia (exact for a rigid motion).
+
+        Setting it replaces that spin and keeps the rest of the motion.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(gravity=(0, 0))
+        >>> b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2))
+        >>> b.angular_velocity = 90.0
+        >>> round(b.angular_velocity, 9), bool(abs(b.velocity).max() < 1e-12)
+        (90.0, True)
+        """
+        m = self._check()._model.vertex_mass[self.vertex_slice]
+        _, omega = rigid_motion.linear_and_angular_velocity(self.positions, self.velocities, m)
+        return math.degrees(omega)
+
+    @angular_velocity.setter
+    def angular_velocity(self, value):
+        world = self._check()
+        spin = math.radians(_number(value, "angular_velocity"))
+        if not abs(spin) <= world.max_speed:
+            raise ValueError(f"angular_velocity must be within +-{math.degrees(world.max_speed):g} deg/s "
+                             f"(world.max_speed in rad/s), got {value!r}")
+        m = world._model.vertex_mass[self.vertex_slice]
+        x = self.positions
+        _, omega = rigid_motion.linear_and_angular_velocity(x, self.velocities, m)
+        self.velocities[...] += rigid_motion.rigid_velocities(x, m, (0.0, 0.0), spin - omega)
+
+    @property
+    def angle(self) -> float:
+        """How far the body has turned, degrees counter-clockwise: the angle it was placed at
+        (``add_body(angle=...)``) plus the rotation of the rigid motion that best carries its
+        rest shape onto its vertices (mass-weighted least squares). Within +-180 of the
+        placement angle: a body that spins through half a turn wraps around.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(gravity=(0, 0))
+        >>> b = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=2), angle=10)
+        >>> b.angular_velocity = 90.0
+        >>> for _ in range(60):  # a tenth of a second at 90 deg/s
+        ...     w.step()
+        >>> round(b.angle, 1)
+        19.0
+        """
+        m = self._check()._model.vertex_mass[self.vertex_slice]
+        turn = rigid_motion.fit_angle(self.topology.rest_positions, self.positions, m)
+        return math.degrees(self._angle0 + turn)
+
+    @property
     def material(self) -> Material:
         """The body's material (its own, or the world's; ``Material("springs")`` if neither is set).
 
@@ -399,13 +484,24 @@ class Body:
         """
         idx, j = self._loads(impulse, indices, "impulse", "N*s")
         world = self._check()
+        if self.material.is_rigid:  # the whole body takes it: its centre and its spin
+            x, m = self.positions, self.vertex_masses
+            r = x[idx] - rigid_motion.center_of_mass(x, m)
+            rs = rigid_set(world._model)
+            k = int(np.flatnonzero(rs.bodies == self._index)[0])
+            total = j.sum(axis=0)
+            turn = float((r[:, 0] * j[:, 1] - r[:, 1] * j[:, 0]).sum())
+            inv_mass, inv_inertia = rs.inverse_masses(world._model)
+            self.velocities[...] += rigid_motion.rigid_velocities(x, m, total * inv_mass[k], turn * inv_inertia[k])
+            return
         rows = self.vertex_slice.start + idx
         free = ~self._pinned[idx]
         np.add.at(world._state.v, rows[free], j[free] * world._model.vertex_inv_mass[rows[free], None])
 
     def pin(self, indices) -> None:
         """Hold vertices ``indices`` (body-local, or a bool mask) where they are: infinite mass,
-        zero velocity, under every integrator, until :meth:`unpin`.
+        zero velocity, under every integrator, until :meth:`unpin`. A rigid body held at any
+        vertex is held whole: it stops and stands as a collider would.
 
         Examples
         --------
@@ -421,7 +517,7 @@ class Body:
         world = self._check()
         idx = self._indices(indices, "pin indices")
         self._pinned[idx] = True
-        self.velocities[idx] = 0.0
+        self.velocities[slice(None) if self.material.is_rigid and idx.size else idx] = 0.0
         world._model.set_pinned(self._index, self._pinned)
 
     def unpin(self, indices=None) -> None:

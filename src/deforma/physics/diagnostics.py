@@ -280,7 +280,8 @@ def trapped(world, model, state, step: int) -> SimulationUnstable | None:
     x = state.x
     for c, collider in enumerate(world.colliders):
         x0, y0, x1, y1 = collider.bounds()
-        near = np.flatnonzero((x[:, 0] > x0) & (x[:, 0] < x1) & (x[:, 1] > y0) & (x[:, 1] < y1))
+        # a rigid body's vertices are the rigid stage's (it may rest a hair inside a collider)
+        near = np.flatnonzero((x[:, 0] > x0) & (x[:, 0] < x1) & (x[:, 1] > y0) & (x[:, 1] < y1) & ~model.rigid)
         inside = near[collider.contains(x[near])] if len(near) else near
         if len(inside):
             b = int(np.searchsorted(model.body_vertex_offsets, inside[0], side="right") - 1)

@@ -80,8 +80,8 @@ def material_models() -> tuple[str, ...]:
 
     Examples
     --------
-    >>> material_models()[:3]
-    ('springs', 'corotated', 'neo-hookean')
+    >>> material_models()[:4]
+    ('springs', 'corotated', 'neo-hookean', 'rigid')
     """
     return MODELS + tuple(m for m in registered_models() if m not in MODELS)
 
@@ -104,13 +104,15 @@ class Material:
 
     Parameters
     ----------
-    model : {"springs", "corotated", "neo-hookean"}
+    model : {"springs", "corotated", "neo-hookean", "rigid"}
         ``"springs"``: the original's mass-spring model (takes none of the keywords below;
         the body's ``stiffness``, ``damping`` and ``mass`` apply). ``"corotated"``: linear
         elasticity in each triangle's rotated frame (cheapest element, exact for small
         strains at any rotation). ``"neo-hookean"``: stable Neo-Hookean (Smith et al.
         2018), stiffer than corotated in large compression and defined for inverted
-        triangles, which it pushes back out.
+        triangles, which it pushes back out. ``"rigid"``: a rigid body of the mesh's shape
+        (three degrees of freedom: position and angle, :mod:`deforma.physics.rigid`); it
+        takes ``density`` only.
     youngs_modulus : float
         E in Pa (> 0, finite). Rubber ~1e6, a soft gel ~1e4.
     poisson_ratio : float
@@ -183,6 +185,20 @@ class Material:
                                   + (["plane"] if self.plane != "stress" else []))
                 raise ValueError(f"the 'springs' material takes no {extra}: its springs use the body's "
                                  f"stiffness (N/m), damping (N*s/m) and mass (kg)")
+            return
+        if self.model == "rigid":
+            extra = [k for k in ("youngs_modulus", "poisson_ratio") if getattr(self, k) is not None]
+            extra += [k for k in ("tear_strain", "yield_strain", "max_stretch") if getattr(self, k) is not None]
+            extra += (["damping"] if self.damping != 0.0 else []) + (["plane"] if self.plane != "stress" else [])
+            if extra:
+                raise ValueError(f"the 'rigid' material takes density only, not {', '.join(extra)}: a rigid body "
+                                 f"does not deform")
+            if self.density is None:
+                raise ValueError("the 'rigid' material needs density (kg/m^2): the body weighs density * area")
+            rho = _number(self.density, "density")
+            if not (math.isfinite(rho) and 0.0 < rho <= 1e12):
+                raise ValueError(f"density must be in (0, 1e12] kg/m^2, got {self.density!r}")
+            object.__setattr__(self, "density", rho)
             return
         missing = [k for k in ("youngs_modulus", "poisson_ratio", "density") if getattr(self, k) is None]
         if missing:
@@ -282,8 +298,13 @@ class Material:
     @property
     def is_fem(self) -> bool:
         """True for the finite-element models (``"corotated"``, ``"neo-hookean"``, and those of
-        registered element kinds): the body weighs ``density * area``."""
+        registered element kinds) and ``"rigid"``: the body weighs ``density * area``."""
         return self.model != "springs"
+
+    @property
+    def is_rigid(self) -> bool:
+        """True for ``"rigid"``: the body keeps its shape and moves as one."""
+        return self.model == "rigid"
 
     @property
     def kind(self) -> int:
@@ -302,8 +323,8 @@ class Material:
         >>> Material("corotated", youngs_modulus=2.6, poisson_ratio=0.3, density=1.0, plane="strain").lame()
         (1.0, 1.5)
         """
-        if not self.is_fem:
-            raise ValueError("the 'springs' material has no Lamé parameters")
+        if not self.is_fem or self.is_rigid:
+            raise ValueError(f"the {self.model!r} material has no Lamé parameters")
         e, nu = self.youngs_modulus, self.poisson_ratio
         if self.plane == "strain":
             return e / (2.0 * (1.0 + nu)), e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))

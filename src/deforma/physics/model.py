@@ -176,6 +176,12 @@ class Model:
         if pinned is not None:
             for b, mask in enumerate(pinned):
                 self.pinned[self.body_vertex_offsets[b]:self.body_vertex_offsets[b + 1]] = mask
+        # a rigid body's vertices: the soft integrators hold them (infinite mass there) and
+        # the rigid stage moves them (deforma.physics.rigid)
+        self.rigid = np.zeros(n, bool)
+        for b, m in enumerate(materials):
+            if m is not None and m.is_rigid:
+                self.rigid[self.body_vertex_offsets[b]:self.body_vertex_offsets[b + 1]] = True
         self.spring_stiffness = np.empty(e, np.float64)
         self.spring_damping = np.empty(e, np.float64)
         self.materials = materials
@@ -411,7 +417,9 @@ class Model:
     def _inverse_masses(self, v0, v1):
         self.version += 1  # every set_* that changes masses, springs or elements comes here
         # a pinned vertex has infinite mass: no force, impulse or projection moves it
-        self.vertex_inv_mass[v0:v1] = np.where(self.pinned[v0:v1], 0.0, 1.0 / self.vertex_mass[v0:v1])
+        # (so has a rigid body's, as the soft integrators see it: the rigid stage moves it)
+        self.vertex_inv_mass[v0:v1] = np.where(self.pinned[v0:v1] | self.rigid[v0:v1], 0.0,
+                                               1.0 / self.vertex_mass[v0:v1])
 
     def set_contact_parameters(self, body: int, *, collide: bool, self_collision: bool, friction: float,
                                static_friction: float, thickness: float) -> None:

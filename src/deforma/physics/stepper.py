@@ -23,6 +23,8 @@ import numpy as np
 
 from . import behaviours
 from .behaviours import tearing
+from .colliders.response import clear_impulses
+from .rigid.stage import step_rigid_bodies
 from .diagnostics import SHAPE_CHECK_EVERY, SimulationUnstable, lost_shape, runaway, trapped
 from .topology import BodyTopology
 
@@ -77,8 +79,9 @@ def step(world) -> None:
     """Advance ``world`` by ``world.dt`` (the stages of the module docstring)."""
     w = world
     poses = [(c, c.center, c.angle) for c in w._colliders if c.moving]
-    moving = bool(poses)
-    moved = w._colliders_changed()
+    rigid = bool(w._model.n_vertices) and w._model.rigid.any()
+    moving = bool(poses) or rigid  # the rigid bodies' outlines move as colliders
+    moved = w._colliders_changed() or rigid
     if moved:
         w._pack_colliders()
     if moving:
@@ -107,14 +110,26 @@ def step(world) -> None:
     start.assign(w._state)
     undo = Undo(w, poses, late_check=w.step_count % SHAPE_CHECK_EVERY == 0)
     try:
-        _integrate(w, start, moving)
+        if rigid:
+            # the rigid bodies take the soft bodies' impulses after every soft substep, not
+            # once a step: a soft body held by an outline that stands still for a whole step
+            # stores the push as elastic energy and the rigid body gets the momentum besides
+            # (measured: a jelly ball into a crate at 1/60 s gained 11 % energy, 1 % per substep)
+            sub, h = w._sub_start, w.dt / w._substeps
+            for _ in range(w._substeps):
+                sub.assign(w._state)
+                _integrate(w, sub, moving, 1)
+                step_rigid_bodies(w, sub, w._state, control, w._contacts.hits, w._control.colliders,
+                                  len(w._colliders), h)
+        else:
+            _integrate(w, start, moving, w._substeps)
         for c, _, _ in poses:  # the kernels moved the packed copies; now the objects
             c.advance(w.dt)
         if moved or poses:
             error = trapped(w, w._model, w._state, w.step_count)
             if error is not None:
                 raise error
-        if poses and w.step_count % REPACK_EVERY:
+        if poses and not rigid and w.step_count % REPACK_EVERY:
             # the packed copies are where the objects now are (up to rounding, which a
             # repack every REPACK_EVERY steps clears): no repack next step
             w._packed_colliders = w._collider_key()
@@ -134,23 +149,26 @@ def step(world) -> None:
     w.step_count += 1
 
 
-def _integrate(w, start, moving: bool) -> None:
-    """Stages 2 and 3: the gas kick and the integrator, again from ``start`` with a larger
-    contact buffer while it runs out of room."""
+def _integrate(w, start, moving: bool, substeps: int) -> None:
+    """Stages 2 and 3 over ``substeps`` of the step's substeps: the gas kick and the
+    integrator, again from ``start`` with a larger contact buffer while it runs out of room."""
     integrator, contacts, state = w._integrator, w._contacts, w._state
     h = w.dt / w._substeps  # the count in force (the public getter would check "auto" again)
+    rects = w._control.colliders.copy() if moving else None  # where the packed colliders start
     while True:
         if w._model.has_pressure:
-            behaviours.apply_pressure(w._model, state, w.dt)
+            behaviours.apply_pressure(w._model, state, h * substeps)
         contacts.clear_needed()
-        report = integrator.step(w._model, start, state, w._control, contacts, h, substeps=w._substeps,
+        if w._model.rigid.any():  # the impulses the rigid bodies take are this run's alone
+            clear_impulses(contacts.hits)
+        report = integrator.step(w._model, start, state, w._control, contacts, h, substeps=substeps,
                                  max_speed=w.max_speed)
         if report.complete:
             break
         # the contact buffer was too small: grow it and run the step again from its start
         state.assign(start)
         if moving:  # the kernels moved the packed colliders: back to the start
-            w._pack_colliders()
+            w._control.colliders[...] = rects
         contacts.grow()
     if report.unconverged:
         # the step stands (it is as good as the iterations made it), so a warning, not an

@@ -172,7 +172,8 @@ def build(scene: Scene):
             b = world.add_body(m, position=spec.position, material=material, mass=spec.mass,
                                stiffness=spec.stiffness, damping=spec.damping, collide=spec.collide,
                                self_collision=spec.self_collision, friction=spec.friction,
-                               static_friction=spec.static_friction)
+                               static_friction=spec.static_friction, angle=spec.angle, velocity=spec.velocity,
+                               angular_velocity=spec.angular_velocity)
         except MaterialKeyError as e:
             raise SceneError(f"{source}: body[{i}]{'' if e.key is None else '.' + e.key}: {e}") from None
         except ValueError as e:

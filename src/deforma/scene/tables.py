@@ -268,6 +268,12 @@ class BodyPhysics:
                                       "use sqrt(a * b) of theirs.")
     static_friction: float | None = spec("float", None, lo=0.0,
                                          doc="Overrides physics.static_friction against other bodies and itself.")
+    angle: float = spec("float", 0.0, lo=-1e6, hi=1e6, unit="deg",
+                        doc="Turn the mesh by this many degrees (counter-clockwise) about its bounding-box centre "
+                            "before placing it.")
+    velocity: tuple = spec("vec2", (0.0, 0.0), unit="m/s", doc="Initial velocity of its centre of mass.")
+    angular_velocity: float = spec("float", 0.0, lo=-1e9, hi=1e9, unit="deg/s",
+                                   doc="Initial spin about its centre of mass, counter-clockwise.")
     pin: tuple | None = spec("box2", None, unit="m",
                              doc="Pin every vertex inside this box, [[x0, y0], [x1, y1]] in world coordinates after "
                                  "the body is placed: they stay where they are.")
@@ -527,6 +533,8 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
                                            f"stiffness and damping): set material = \"corotated\" or "
                                            f"\"neo-hookean\" too, or remove {fem[0]}")
         return {"model": "springs", **_behaviour_settings(physics, own)}
+    if model == "rigid":
+        return _rigid_settings(physics, own)
     values = {k: _with_preset(k, own, physics, preset, FEM_DEFAULT.get(k)) for k in FEM_KEYWORD}
     missing = [k for k in _FEM_NEEDS if values[k] is None]
     if missing:
@@ -537,6 +545,21 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
     out.update((FEM_KEYWORD[k], v if k == "plane" else float(v)) for k, v in values.items())
     out.update(_behaviour_settings(physics, own, preset))
     return out
+
+
+def _rigid_settings(physics: PhysicsSettings, own: dict) -> dict:
+    """A rigid body's material: its density (the body's, else ``[physics]``'s) and nothing
+    else; a deformation key on the body itself is refused (``[physics]``'s are the other
+    bodies' and stay theirs)."""
+    extra = [k for k in (*FEM_KEYWORD, *BEHAVIOUR_KEYS) if k in own and k != "density"]
+    if extra:
+        raise MaterialKeyError(extra[0], f"the 'rigid' material takes density only, not {extra[0]}: a rigid "
+                                         f"body does not deform; remove {extra[0]}")
+    density = own.get("density", physics.density)
+    if density is None:
+        raise MaterialKeyError(None, "the 'rigid' material needs density (kg/m^2): set it on the body or in "
+                                     "[physics]")
+    return {"model": "rigid", "density": float(density)}
 
 
 def _with_preset(key: str, own: dict, physics: PhysicsSettings, preset: dict | None, default):

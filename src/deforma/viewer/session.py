@@ -368,6 +368,8 @@ class Session:
         if model == "springs":
             material = Material("springs", **self._world_behaviours())
             return None if material == _SPRINGS else material  # the seed's plain springs
+        if model == "rigid":  # density alone: a rigid body does not deform, tear or yield
+            return Material("rigid", density=values["density"])
         plane = getattr(self.world.material, "plane", "stress")  # kept, as the behaviours are
         return Material(model, **{kw: values[name] for name, kw in _MATERIAL_KEYWORD.items()}, plane=plane,
                         **self._world_behaviours())
@@ -407,8 +409,9 @@ class Session:
             raise ValueError(f"{name} must be a number, got {value!r}") from None
         model = self.material_model
         # checked by the Material itself (ranges and units in its message), also while springs
-        material = self._material("corotated" if model == "springs" else model, values)
-        if model == "springs":
+        kept = model == "springs" or (model == "rigid" and name != "density")
+        material = self._material("corotated" if kept else model, values)
+        if kept:
             self.note = f"{name} is kept for when the model is corotated or neo-hookean"
         else:
             self.world.material = material

@@ -35,6 +35,12 @@ With this, the total friction on a block is exactly ``friction * sum(N)`` while 
 satisfy the static test does not move at all. A point that moved further in a substep than
 a collider's half-thickness gets a swept test of its path (it may have jumped a thin one).
 
+A rigid body's outline (a row with ``INV_MASS`` > 0, :mod:`deforma.physics.rigid`) is not a
+collider here: :func:`collide_point` and :func:`contact_planes` pass it by, and
+:func:`collide_dynamic` resolves the points in it, one at a time, with the impulse between two
+masses (the point's and the body's, which takes the opposite at once), so a light crate hit by
+a heavy jelly moves off as the jelly arrives rather than stopping it as a wall would.
+
 Units: m, m/s; the packed array holds angles in radians.
 """
 
@@ -50,6 +56,8 @@ from .geometry import exit_face, point_inside, n_colliders, relative_start, swep
 from .shapes import (
     EDGE_AX,
     EDGE_AY,
+    INV_INERTIA,
+    INV_MASS,
     KIND,
     OMEGA,
     POLYGON,
@@ -78,13 +86,27 @@ ColliderHits = namedtuple("ColliderHits", [
     "collider",         # (N,) int32: which collider
     "normal",           # (N, 2) float64: the face's outward normal
     "depth",            # (N,) float64: how deep inside it the vertex was (m)
+    "dv",               # (N, 2) float64: the velocity changes the collider response made (m/s), summed
+                        #   until cleared: times the vertex's mass, the impulse it took (a rigid body
+                        #   takes the opposite, deforma.physics.rigid)
+    "dm",               # (N,) float64: the change of x cross v each made, about the origin (m^2/s): times
+                        #   the mass, the angular momentum the vertex took
+    "dv_collider",      # (N,) int32: the collider of the last of them
 ])
 
 
 def make_hits(n_vertices: int) -> ColliderHits:
     """An empty record for ``n_vertices`` vertices (no substep has stamp -1)."""
     return ColliderHits(np.full(n_vertices, -1, np.int64), np.zeros(n_vertices, np.int32),
-                        np.zeros((n_vertices, 2)), np.zeros(n_vertices))
+                        np.zeros((n_vertices, 2)), np.zeros(n_vertices), np.zeros((n_vertices, 2)),
+                        np.zeros(n_vertices), np.full(n_vertices, -1, np.int32))
+
+
+def clear_impulses(hits: ColliderHits) -> None:
+    """Forget the velocity changes ``hits`` summed (``dv``, ``dm``, ``dv_collider``)."""
+    hits.dv[...] = 0.0
+    hits.dm[...] = 0.0
+    hits.dv_collider[...] = -1
 
 
 # Pushing a point out of one collider can push it into a touching one; a few passes settle
@@ -146,7 +168,7 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
     if jumpy:
         inside = False
         for r in range(n_colliders(rects)):
-            if point_inside(rects, r, px, py):
+            if rects[r, INV_MASS] == 0.0 and point_inside(rects, r, px, py):
                 inside = True
         if not inside:
             px, py = swept_entry(x0, y0, px, py, rects)
@@ -158,8 +180,8 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
     for _ in range(MAX_PASSES):
         hit = False
         for r in range(n_colliders(rects)):
-            if not point_inside(rects, r, px, py):
-                continue
+            if rects[r, INV_MASS] != 0.0 or not point_inside(rects, r, px, py):
+                continue  # outside, or a rigid body's outline (collide_dynamic's)
             hit = True
             rx0, ry0 = relative_start(rects, r, x0, y0, h)
             nx, ny, qx, qy, best = exit_face(rects, r, rx0, ry0, px, py)
@@ -188,7 +210,7 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
             break
     if hit:
         for r in range(n_colliders(rects)):
-            if point_inside(rects, r, px, py):
+            if rects[r, INV_MASS] == 0.0 and point_inside(rects, r, px, py):
                 # trapped between colliders: the original's answer, back to where it was
                 return x0, y0, 0.0, 0.0, last, hx_n, hy_n, last_depth
     return px, py, vx, vy, last, hx_n, hy_n, last_depth
@@ -243,7 +265,9 @@ def contact_planes(x0, y, rects, planes, index, h):
         px, py = y[i, 0], y[i, 1]
         best_depth = -np.inf
         for r in range(n_colliders(rects)):
-            if not point_inside(rects, r, px, py):
+            # a rigid body's outline is met after the solve (collide_point), where the
+            # velocity change it makes is the impulse the rigid body takes back
+            if rects[r, INV_MASS] != 0.0 or not point_inside(rects, r, px, py):
                 continue
             rx0, ry0 = relative_start(rects, r, x0[i, 0], x0[i, 1], h)
             nx, ny, qx, qy, depth = exit_face(rects, r, rx0, ry0, px, py)
@@ -264,17 +288,139 @@ def contact_planes(x0, y, rects, planes, index, h):
 
 
 @njit(cache=True, inline="always")
-def record_hit(hits, i, stamp, r, nx, ny, depth):
-    """Note in ``hits`` (a :class:`ColliderHits`) that vertex ``i`` touched collider ``r`` in substep ``stamp``."""
+def note_impulse(hits, i, r, qx, qy, ux, uy, px, py, vx, vy):
+    """Add to ``hits.dv`` and ``hits.dm`` what a collider ``r`` did to vertex ``i``'s velocity
+    and angular momentum (from ``(qx, qy)`` at ``(ux, uy)`` to ``(px, py)`` at ``(vx, vy)``).
+    The moment counts the move too (``p x v - q x u``, not ``p x (v - u)``): what a rigid
+    outline takes back is then exactly what the vertex gained, angular momentum included."""
+    hits.dv[i, 0] += vx - ux
+    hits.dv[i, 1] += vy - uy
+    hits.dm[i] += (px * vy - py * vx) - (qx * uy - qy * ux)
+    hits.dv_collider[i] = r
+    hits.dv_collider[i] = r
+
+
+@njit(cache=True, inline="always")
+def record_hit(hits, i, stamp, r, nx, ny, depth, qx, qy, ux, uy, px, py, vx, vy):
+    """Note in ``hits`` (a :class:`ColliderHits`) that vertex ``i`` touched collider ``r`` in
+    substep ``stamp``, and that the response took it from ``(qx, qy)`` m moving at ``(ux, uy)``
+    m/s to ``(px, py)`` moving at ``(vx, vy)``."""
     hits.stamp[i] = stamp
     hits.collider[i] = r
     hits.normal[i, 0] = nx
     hits.normal[i, 1] = ny
     hits.depth[i] = depth
+    note_impulse(hits, i, r, qx, qy, ux, uy, px, py, vx, vy)
 
 
 @njit(cache=True)
-def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
+def collide_dynamic(x, v, inv_mass, vertex, n, xp, rects, hits, stamp, h):
+    """Points against rigid bodies' outlines (rows with ``INV_MASS`` > 0), in turn: each point
+    inside one leaves it as from a collider (the exit of :func:`collide_point`'s step 2, from
+    where it started, seen from the body), and the two take equal and opposite impulses at the
+    surface point ``q``: along the normal, what stops their approach (``jn = -vn / kn``, with
+    ``kn = w + W + I^-1 (r x n)^2``, ``w`` the point's 1/mass, ``W`` the body's, ``r = q - c``),
+    along the surface Coulomb's rule on the pair (sticking takes ``-vt / kt``; more than
+    ``static_friction * jn`` slides with ``friction * jn``). The body's velocity in its row
+    changes at once, so the next point meets it moving: a pile of points arriving together
+    pushes a light body off instead of each stopping as against a wall. Each point's change
+    goes to ``hits`` as any collider hit's (the rigid stage gives the body its total).
+
+    Parameters
+    ----------
+    x, v : (N, 2) float64
+        Positions (m) and velocities (m/s) at the end of the substep, updated in place.
+    inv_mass : (N,) float64
+        1/kg (0: pinned or a rigid body's own vertex, not moved).
+    vertex : (V,) int32
+        Collision vertex -> row of ``x``; the first ``n`` (the outlines) are tested.
+    xp : (V, 2) float64
+        Where each was at the start of the substep (m).
+    rects : (R, RECT_COLUMNS) float64
+        Packed colliders, rigid outlines among them (their velocity columns updated).
+    hits : ColliderHits
+    stamp : int
+        This substep's number (see :func:`record_hit`).
+    h : float
+        Substep (s).
+
+    Returns
+    -------
+    int
+        How many points it moved.
+
+    Examples
+    --------
+    A 1 kg point at 2 m/s into the left face of a resting 1 kg square: both end at 1 m/s
+    (a perfectly inelastic collision along the normal through the centre).
+
+    >>> import numpy as np
+    >>> from deforma.physics.colliders.shapes import INV_INERTIA, INV_MASS, Rect, pack_colliders
+    >>> r = pack_colliders([Rect((0, 0), (1, 1), 0.0)], friction=0.0, static_friction=0.0)
+    >>> r[0, INV_MASS], r[0, INV_INERTIA] = 1.0, 6.0
+    >>> x, v = np.array([[-0.49, 0.0]]), np.array([[2.0, 0.0]])
+    >>> collide_dynamic(x, v, np.ones(1), np.zeros(1, np.int32), 1, np.array([[-0.51, 0.0]]), r,
+    ...                 make_hits(1), 1, 0.01)
+    1
+    >>> v.tolist(), r[0, 15:18].tolist(), round(float(x[0, 0]), 6)
+    ([[1.0, 0.0]], [1.0, 0.0, 0.0], -0.5)
+    """
+    moved = 0
+    n_rects = n_colliders(rects)
+    dynamic = False
+    for r in range(n_rects):
+        if rects[r, INV_MASS] != 0.0:
+            dynamic = True
+    if not dynamic:
+        return 0
+    for k in range(n):
+        i = vertex[k]
+        w = inv_mass[i]
+        if w == 0.0:
+            continue
+        px, py = x[i, 0], x[i, 1]
+        for r in range(n_rects):
+            big_w = rects[r, INV_MASS]
+            if big_w == 0.0 or not (rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX]
+                                    and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]):
+                continue
+            if not point_inside(rects, r, px, py):
+                continue
+            rx0, ry0 = relative_start(rects, r, xp[k, 0], xp[k, 1], h)
+            nx, ny, qx, qy, depth = exit_face(rects, r, rx0, ry0, px, py)
+            tx, ty = -ny, nx
+            cx, cy = rects[r, RECT_CX], rects[r, RECT_CY]
+            ax, ay = qx - cx, qy - cy
+            om = rects[r, OMEGA]
+            ux, uy = v[i, 0], v[i, 1]
+            vn = (ux - rects[r, VEL_X] + om * ay) * nx + (uy - rects[r, VEL_Y] - om * ax) * ny
+            vt = (ux - rects[r, VEL_X] + om * ay) * tx + (uy - rects[r, VEL_Y] - om * ax) * ty
+            big_i = rects[r, INV_INERTIA]
+            an = ax * ny - ay * nx
+            at = ax * ty - ay * tx
+            kn = w + big_w + big_i * an * an
+            kt = w + big_w + big_i * at * at
+            jn = -vn / kn if vn < 0.0 else 0.0
+            # Coulomb's rule on the relative motion: sticking changes vt by -vt, i.e. takes
+            # -vt / kt; the cone's bound on that change is static_friction * kt * jn
+            jt = (coulomb(vt, jn * kt, rects[r, RECT_STATIC_FRICTION], rects[r, RECT_FRICTION]) - vt) / kt
+            jx, jy = jn * nx + jt * tx, jn * ny + jt * ty
+            vx, vy = ux + w * jx, uy + w * jy
+            rects[r, VEL_X] -= big_w * jx
+            rects[r, VEL_Y] -= big_w * jy
+            rects[r, OMEGA] -= big_i * (ax * jy - ay * jx)
+            skin = rects[r, RECT_SKIN]
+            shift = h * w * jt  # the position the corrected velocity would have reached
+            qx2, qy2 = qx + skin * nx + shift * tx, qy + skin * ny + shift * ty
+            record_hit(hits, i, stamp, r, nx, ny, depth, px, py, ux, uy, qx2, qy2, vx, vy)
+            x[i, 0], x[i, 1], v[i, 0], v[i, 1] = qx2, qy2, vx, vy
+            px, py = qx2, qy2
+            moved += 1
+    return moved
+
+
+@njit(cache=True)
+def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects, hits):
     """Collider corners against body outlines: push every outline edge a corner pokes through
     back off it; returns how many edges moved.
 
@@ -305,16 +451,20 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
         Collision vertex -> row of ``x`` (``ContactTopology.cv_vertex``).
     rects : (R, RECT_COLUMNS) float64
         From :func:`~deforma.physics.colliders.shapes.pack_colliders`.
+    hits : ColliderHits
+        Each end's velocity change is added to ``dv`` with the collider in ``dv_collider``
+        (a rigid body's outline takes the opposite impulse: :mod:`deforma.physics.rigid`).
 
     Examples
     --------
     >>> import numpy as np
+    >>> from deforma.physics.colliders.response import make_hits
     >>> from deforma.physics.colliders.shapes import Rect, pack_colliders
     >>> r = pack_colliders([Rect((0, 0), (2, 2), 45.0)], friction=0.3, static_friction=0.5)
     >>> x = np.array([[-1.0, 1.3], [1.0, 1.3]])  # an edge running right: the body is above it
     >>> v = np.array([[0.0, -1.0], [0.0, -1.0]])
     >>> push_edges_off_corners(x, v, np.ones(2), np.array([0], np.int32), np.array([1], np.int32),
-    ...                        np.arange(2, dtype=np.int32), r)
+    ...                        np.arange(2, dtype=np.int32), r, make_hits(2))
     1
     >>> x.round(6).tolist(), v.tolist()  # the top corner is at y = sqrt 2: the edge moved up past it
     ([[-1.0, 1.414214], [1.0, 1.414214]], [[0.0, 0.0], [0.0, 0.0]])
@@ -391,18 +541,21 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects):
                     blocked = True
             if blocked:
                 continue
-            ax, ay, bx, by = qax, qay, qbx, qby
-            x[ia, 0], x[ia, 1], x[ib, 0], x[ib, 1] = ax, ay, bx, by
+            uax, uay, ubx, uby = v[ia, 0], v[ia, 1], v[ib, 0], v[ib, 1]
+            x[ia, 0], x[ia, 1], x[ib, 0], x[ib, 1] = qax, qay, qbx, qby
             # the edge point on the corner stops moving into it: the impulse acts there,
             # split as the push is, so the end far from the corner keeps most of its motion
             # (zeroing both ends' motion into the corner held a block overhanging a ledge
             # level on the corner instead of letting it tip off)
-            vn = (sa * v[ia, 0] + sb * v[ib, 0]) * nx + (sa * v[ia, 1] + sb * v[ib, 1]) * ny
+            vn = (sa * uax + sb * ubx) * nx + (sa * uay + sb * uby) * ny
             if vn < 0.0:  # into the corner
                 dv = -vn / den
                 v[ia, 0] += sa * wa * dv * nx
                 v[ia, 1] += sa * wa * dv * ny
                 v[ib, 0] += sb * wb * dv * nx
                 v[ib, 1] += sb * wb * dv * ny
+            note_impulse(hits, ia, r, ax, ay, uax, uay, qax, qay, v[ia, 0], v[ia, 1])
+            note_impulse(hits, ib, r, bx, by, ubx, uby, qbx, qby, v[ib, 0], v[ib, 1])
+            ax, ay, bx, by = qax, qay, qbx, qby
             moved += 1
     return moved

@@ -38,7 +38,10 @@ RECT_REACH = 13   # squared half-thickness: a vertex moving further per substep 
 KIND = 14
 VEL_X, VEL_Y, OMEGA = 15, 16, 17   # m/s, m/s, rad/s
 COUNT = 18        # the number of collider rows (the edge rows follow them), in every row
-RECT_COLUMNS = 19
+# a rigid body's outline (deforma.physics.rigid): its 1/mass (1/kg) and 1/moment of inertia
+# (1/(kg m^2)); 0 on a collider, which nothing a body does moves
+INV_MASS, INV_INERTIA = 19, 20
+RECT_COLUMNS = 21
 # Edge rows (KIND = EDGE): ends a, b in columns 0-3, outward unit normal in 4-5.
 EDGE_AX, EDGE_AY, EDGE_BX, EDGE_BY, EDGE_NX, EDGE_NY = 0, 1, 2, 3, 4, 5
 
@@ -566,10 +569,10 @@ def pack_colliders(colliders, *, friction: float, static_friction: float) -> np.
     Examples
     --------
     >>> pack_colliders([Rect((0, 0), (2, 1), 0.0)], friction=0.3, static_friction=0.5).shape
-    (1, 19)
+    (1, 21)
     >>> a = pack_colliders([Polygon([[0, 0], [1, 0], [0, 1]])], friction=0.3, static_friction=0.5)
     >>> a.shape, int(a[0, KIND]), int(a[0, RECT_HX]), int(a[0, RECT_HY])  # 3 edge rows from row 1
-    ((4, 19), 2, 1, 3)
+    ((4, 21), 2, 1, 3)
     """
     rows = []
     edges = []

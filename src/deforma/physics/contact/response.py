@@ -250,9 +250,12 @@ def collider_pass(x, v, topo, scr, rects, hits, h):
             if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                 near = True
         if near and path_hits(xp[k, 0], xp[k, 1], px, py, rects):
+            ux, uy = v[i, 0], v[i, 1]
             x[i, 0], x[i, 1], v[i, 0], v[i, 1], hit, nx, ny, depth = collide_point(
                 xp[k, 0], xp[k, 1], px, py, v[i, 0], v[i, 1], rects, h)
-            record_hit(hits, i, status.stamp[0], hit, nx, ny, depth)
+            if hit >= 0:  # (path_hits sees rigid outlines too; collide_point leaves them be)
+                record_hit(hits, i, status.stamp[0], hit, nx, ny, depth, px, py, ux, uy, x[i, 0], x[i, 1],
+                           v[i, 0], v[i, 1])
             note_moved(k, dirty, dirty_mark, status.generation[0], touched, touched_mark, status.stamp[0], status)
             moved += 1
     return moved

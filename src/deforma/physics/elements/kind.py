@@ -43,7 +43,7 @@ from numba import njit
 #: Colours of the XPBD sweep order's greedy colouring (one bit each in a uint64 per vertex).
 COLOURS = 64
 #: The material models of the built-in kinds (springs, triangles), which the Model makes itself.
-BUILT_IN = ("springs", "corotated", "neo-hookean")
+BUILT_IN = ("springs", "corotated", "neo-hookean", "rigid")
 
 
 class BodyElements(NamedTuple):

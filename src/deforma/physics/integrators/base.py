@@ -41,7 +41,7 @@ import numpy as np
 from numba import njit
 
 from ..colliders.geometry import jump_reach, n_colliders
-from ..colliders.response import collide_point, contact_planes, push_edges_off_corners, record_hit
+from ..colliders.response import collide_dynamic, collide_point, contact_planes, push_edges_off_corners, record_hit
 from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
 from ..contact.broad_phase import gather_start
 from ..contact.narrow_phase import detect_contacts
@@ -103,9 +103,10 @@ def finish_position_step(x, v, x_prev, rects, hits, stamp, h, vmax2):
             if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                 near = True
         if near or (px - x0) ** 2 + (py - y0) ** 2 > reach2:
+            qx, qy, ux, uy = px, py, vx, vy
             px, py, vx, vy, hit, nx, ny, depth = collide_point(x0, y0, px, py, vx, vy, rects, h)
             if hit >= 0:
-                record_hit(hits, i, stamp, hit, nx, ny, depth)
+                record_hit(hits, i, stamp, hit, nx, ny, depth, qx, qy, ux, uy, px, py, vx, vy)
         x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
         bad += is_bad(px, py, vx, vy, vmax2)
     return bad
@@ -134,12 +135,15 @@ def held_contacts(x_prev, y, rects, planes, touch, h, topo, scr, buf):
 
 @njit(cache=True)
 def contact_epilogue(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow):
-    """The end of every substep, after the collider response: collider corners pushed off
+    """The end of every substep, after the collider response: points in rigid bodies put out
+    of them (:func:`~deforma.physics.colliders.response.collide_dynamic`), collider corners pushed off
     body outlines (:func:`~deforma.physics.colliders.response.push_edges_off_corners`), then
     the body contact stage (:func:`~deforma.physics.contact.stage.contact_stage`; ``follow``:
     whether its velocity impulses move positions too). Returns the stage's result: -1 when
     the buffer was too small (the World grows it and runs the step again)."""
-    push_edges_off_corners(x, v, inv_mass, topo.ce_a, topo.ce_b, topo.cv_vertex, rects)
+    collide_dynamic(x, v, inv_mass, topo.cv_vertex, topo.body_interior[0], scr.xp, rects, hits,
+                    scr.status.stamp[0] + 1, h)
+    push_edges_off_corners(x, v, inv_mass, topo.ce_a, topo.ce_b, topo.cv_vertex, rects, hits)
     return contact_stage(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow)
 
 

@@ -134,9 +134,10 @@ def _symplectic_euler(x, v, fbuf, chunk_ptr, elem_ptr, chunk_vertices, springs, 
                 if rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]:
                     near = True
             if near or (px - x0) * (px - x0) + (py - y0) * (py - y0) > reach2:  # or it may have jumped one
+                qx, qy, ux, uy = px, py, vx, vy
                 px, py, vx, vy, hit, nx, ny, depth = collide_point(x0, y0, px, py, vx, vy, rects, h)
                 if hit >= 0:
-                    record_hit(hits, i, stamp, hit, nx, ny, depth)
+                    record_hit(hits, i, stamp, hit, nx, ny, depth, qx, qy, ux, uy, px, py, vx, vy)
             x[i, 0], x[i, 1], v[i, 0], v[i, 1] = px, py, vx, vy
             bad += is_bad(px, py, vx, vy, vmax2)
         if bad:

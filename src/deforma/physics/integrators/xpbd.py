@@ -213,7 +213,7 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, springs, spring_or
     >>> bad = xpbd_substeps(x, v, x.copy(), np.zeros(1), np.zeros((2, 8)), np.zeros(2, np.int32), np.ones(2),
     ...                     spring, sweep_order(np.array([[0, 1]], np.int32), 2)[0], none,
     ...                     *sweep_order(none.elem, 2), 0, np.zeros((0, 3)), 0.0, 0.0, 1.0, np.zeros((0, 2)), False,
-    ...                     np.full(2, -1, np.int32), np.zeros((0, 3)), np.zeros((0, 19)), make_hits(2),
+    ...                     np.full(2, -1, np.int32), np.zeros((0, 3)), np.zeros((0, 21)), make_hits(2),
     ...                     empty_topology(), make_scratch(0, 0), make_buffer(0, 0), 0.01, 1, 1, 1e6)
     >>> round(float(x[1, 0] - x[0, 0]), 4)  # a very stiff spring snaps to its rest length
     1.0
