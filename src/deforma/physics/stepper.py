@@ -24,7 +24,7 @@ import numpy as np
 from . import behaviours
 from .behaviours import tearing
 from .colliders.response import clear_impulses
-from .rigid.stage import step_rigid_bodies
+from .rigid.stage import begin_joint_forces, end_joint_forces, step_rigid_bodies
 from .diagnostics import SHAPE_CHECK_EVERY, SimulationUnstable, lost_shape, runaway, trapped
 from .topology import BodyTopology
 
@@ -116,11 +116,13 @@ def step(world) -> None:
             # stores the push as elastic energy and the rigid body gets the momentum besides
             # (measured: a jelly ball into a crate at 1/60 s gained 11 % energy, 1 % per substep)
             sub, h = w._sub_start, w.dt / w._substeps
+            begin_joint_forces(w)
             for _ in range(w._substeps):
                 sub.assign(w._state)
                 _integrate(w, sub, moving, 1)
                 step_rigid_bodies(w, sub, w._state, control, w._contacts.hits, w._control.colliders,
                                   len(w._colliders), h)
+            end_joint_forces(w, w.dt)
         else:
             _integrate(w, start, moving, w._substeps)
         for c, _, _ in poses:  # the kernels moved the packed copies; now the objects

@@ -34,6 +34,8 @@ from .contact.contacts import ContactPoints, Contacts
 from .control import Control
 from ..checks import IgnoredSettingWarning, StepBeyondStableWarning
 from .diagnostics import Energy, SimulationUnstable
+from . import joint as _joint
+from .joint import Joint
 from .integrators import make_integrator
 from .material import Material
 from .model import Model
@@ -126,6 +128,7 @@ class World:
         self._grabs_dirty = True
         self._lost_shape = {}  # id(body) -> checks in a row at which it had lost its shape
         self._forces = []  # (body, body-local vertices, forces): applied during the next step
+        self._joints: list[Joint] = []
         self._gravity, self._air_drag = (0.0, -9.81), 0.0
         self._model = Model([], masses=[], stiffness=[], damping=[])
         self._model_bodies = []
@@ -598,6 +601,7 @@ class World:
                 g.active = False
         self._grabs = [g for g in self._grabs if g.active]
         self._forces = [f for f in self._forces if f[0] is not body]  # its loads go with it
+        self._joints = [j for j in self._joints if body not in (j.a, j.b)]  # and its joints
         del self._bodies[b]
         body._world = None
         for k, other in enumerate(self._bodies):
@@ -763,6 +767,102 @@ class World:
                                                                       INV_INERTIA] = rs.inverse_masses(model)
         self._control.colliders = packed
         self._packed_colliders = None if rigid else self._collider_key()
+
+    # -- joints -----------------------------------------------------------------------------
+    @property
+    def joints(self) -> list[Joint]:
+        """The joints, in the order they were made (a new list)."""
+        return list(self._joints)
+
+    def join(self, a: Body, b: Body | None = None, at=None, *, kind: str = "pin", stiffness=None, damping=None,
+             motor_speed=None, max_torque=None) -> Joint:
+        """Join rigid body ``a`` to rigid body ``b`` (None: to the world) at the point ``at``.
+
+        Parameters
+        ----------
+        a, b : Body, Body or None
+            Rigid bodies of this world (``Material("rigid", ...)``), ``b`` None for the world.
+        at : (float, float)
+            The point both hold (m), on ``a`` or ``b`` now.
+        kind : {"pin", "weld", "spring"}
+            A hinge (the bodies turn freely about the point), a weld (they do not turn
+            either), or a zero-length spring and damper between the two points.
+        stiffness, damping : float, optional
+            A spring's N/m (needed) and N s/m (default 0). Solved implicitly: any stiffness
+            is stable.
+        motor_speed : float, optional
+            A pin's motor: drives ``a``'s spin relative to ``b`` towards this many degrees/s
+            (counter-clockwise), with at most ``max_torque`` N m (default: as much as it takes).
+
+        Returns
+        -------
+        Joint
+            Its ``force`` (N, on ``a``) and ``torque`` are the last step's.
+
+        Examples
+        --------
+        A 1 m bar hinged to the world at its end swings as a compound pendulum:
+
+        >>> import deforma
+        >>> w = deforma.World(dt=1 / 60)
+        >>> bar = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.05), (0, 0.05)), detail=2),
+        ...                  position=(0.5, 0.0), material=deforma.Material("rigid", density=100.0))
+        >>> hinge = w.join(bar, None, at=(0.0, 0.0))
+        >>> for _ in range(30):
+        ...     w.step()
+        >>> round(float(bar.center_of_mass[1]), 2)  # a quarter swing (0.48 s) later: hanging down
+        -0.5
+        """
+        if not isinstance(kind, str) or kind not in _joint.KINDS:
+            raise ValueError(f"kind must be one of {', '.join(_joint.KINDS)}, got {kind!r}")
+        for name, body in (("a", a), ("b", b)):
+            if body is None and name == "b":
+                continue
+            self._own_body(body)
+            if not body.material.is_rigid:
+                raise ValueError(f"joints hold rigid bodies: {name} (body {body._index}) is soft; make it of "
+                                 f"deforma.Material('rigid', density=...) (joints on soft bodies are to come)")
+        if a is b:
+            raise ValueError(f"a joint between body {a._index} and itself holds nothing: join it to another body "
+                             f"or to the world (b=None)")
+        if at is None:
+            raise ValueError("at must be the point (x, y) in metres both bodies hold")
+        point = _joint.anchor(at)
+        stiffness, damping = _joint.spring(kind, stiffness, damping)
+        motor_speed, max_torque = _joint.motor(kind, motor_speed, max_torque)
+        on = [body for body in (a, b) if body is not None
+              and _joint.covers(body.positions, body.topology.triangles, point)]
+        if not on:
+            where = "body " + str(a._index) + ("" if b is None else f" or body {b._index}")
+            raise ValueError(f"at = {point} is not on {where}: a joint point must lie on a body it joins")
+        model = self._model
+        rs = rigid_set(model)
+        center, angle, _, _ = rs.poses(model, self._state.x, self._state.v)
+        local, turn = [], 0.0
+        for side, body in enumerate((a, b)):
+            if body is None:
+                local.append(point)
+                continue
+            k = int(np.flatnonzero(rs.bodies == body._index)[0])
+            c, s_ = math.cos(angle[k]), math.sin(angle[k])
+            dx, dy = point[0] - center[k, 0], point[1] - center[k, 1]
+            local.append((c * dx + s_ * dy, -s_ * dx + c * dy))  # turned back to the body frame
+            turn += angle[k] if side == 0 else -angle[k]
+        j = Joint(self, a, b, kind, point, np.concatenate(local), turn, stiffness, damping, motor_speed, max_torque)
+        self._joints.append(j)
+        return j
+
+    def remove_joint(self, joint: Joint) -> None:
+        """Take a joint out of the world.
+
+        Raises
+        ------
+        ValueError
+            If ``joint`` is not one of this world's joints.
+        """
+        if not any(joint is j for j in self._joints):
+            raise ValueError(f"unknown joint {joint!r}: pass one returned by this world's join")
+        self._joints = [j for j in self._joints if j is not joint]
 
     # -- interaction ------------------------------------------------------------------------
     def explode(self, strength: float, *, center=None, radius=None) -> None:

@@ -25,7 +25,9 @@ them in turn, so a soft body never meets an outline that stood still for a whole
    their outline vertices with colliders and with other rigid bodies' outlines, solved by
    sequential impulses (accumulated and clamped, warm-started, Coulomb friction with
    static and dynamic coefficients), and the overlap left removed by a position
-   projection. Its own substeps are at most ``RIGID_SUBSTEP`` (1/240 s).
+   projection. Its own substeps are at most ``RIGID_SUBSTEP`` (1/240 s), ``JOINT_SUBSTEP``
+   (1/960 s) with joints (:mod:`~deforma.physics.rigid.joints`: pins, welds, springs
+   between rigid bodies or to the world, solved in the same passes).
 
 Measured (``tests/physics/test_rigid.py``): a soft ball into a crate of 1.6 to 160 kg
 keeps linear momentum to 1e-9 under symplectic Euler, implicit Euler and XPBD, angular

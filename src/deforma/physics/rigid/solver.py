@@ -9,14 +9,15 @@ Per substep of ``h`` s:
    every outline vertex inside a collider or another rigid body's outline is a contact,
    with the normal and surface point the collider response would take
    (:func:`~deforma.physics.colliders.geometry.exit_face`);
-3. ``iterations`` Gauss-Seidel passes of impulses over the contacts (Catto's sequential
+3. ``iterations`` Gauss-Seidel passes of impulses over the joints
+   (:mod:`~deforma.physics.rigid.joints`) and the contacts (Catto's sequential
    impulses): the normal impulse accumulated and kept >= 0 so that no contact pulls, the
    friction impulse accumulated and held within ``static_friction * normal`` while the
    contact sticks, else within ``friction * normal`` (Coulomb, static and dynamic, the rule
    of every other contact in deforma); each pass starts from the impulses of the last
    substep at the same vertex against the same thing (warm start), so a resting stack
    carries its weight from the first pass;
-4. positions from the velocities, then one projection pass that removes the overlap left
+4. positions from the velocities, the joints' drift removed, then one projection pass that removes the overlap left
    beyond ``SLOP`` (a fraction ``BAUMGARTE`` per substep, positions only: it adds no energy).
 
 A collider is the infinite-mass side (its surface velocity, as for soft vertices); two
@@ -53,6 +54,8 @@ from ..colliders.shapes import (
     VEL_X,
     VEL_Y,
 )
+
+from .joints import joint_positions, joint_velocities, warm_start_joints
 
 SLOP = 5e-4        # m: overlap the projection leaves (a resting contact stays a contact)
 BAUMGARTE = 0.5    # share of the overlap beyond SLOP removed per substep
@@ -113,7 +116,7 @@ def _point_velocity(vel, omega, rects, k, row, rx, ry, qx, qy):
 @njit(cache=True)
 def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse, gravity, outline_ptr,
                 outline_local, cache_row, cache_impulse, friction, rects, first_row, edge_ptr, edges_local, dt,
-                substeps, iterations):
+                substeps, iterations, j_body, j_local, j_kind, j_param, j_motor, j_acc, j_total):
     """Advance the rigid bodies by ``dt`` s in ``substeps`` substeps (see the module docstring).
 
     Parameters
@@ -142,6 +145,9 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
     edge_ptr, edges_local
         The rigid bodies' outline edges in their body frames (see :func:`place_outlines`).
     dt, substeps, iterations : float, int, int
+    j_body, j_local, j_kind, j_param, j_motor, j_acc, j_total
+        The joints (:mod:`~deforma.physics.rigid.joints`); ``j_acc`` is updated (warm starts)
+        and ``j_total`` summed into.
 
     Returns
     -------
@@ -167,6 +173,10 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
     c_mu = np.empty((n_out, 2))         # dynamic, static
     c_j = np.empty((n_out, 2))          # accumulated normal, friction impulse
     body_of = np.empty(n_out, np.int64)
+    joined = np.zeros((nk, nk), np.bool_)  # bodies a joint holds together do not collide
+    for j in range(j_body.shape[0]):
+        if j_body[j, 1] >= 0:
+            joined[j_body[j, 0], j_body[j, 1]] = joined[j_body[j, 1], j_body[j, 0]] = True
     for k in range(nk):
         for o in range(outline_ptr[k], outline_ptr[k + 1]):
             body_of[o] = k
@@ -194,7 +204,7 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
             best_row = -1
             bnx = bny = bqx = bqy = 0.0
             for r in range(n_rows):
-                if r == first_row + k:
+                if r == first_row + k or (r >= first_row and r - first_row < nk and joined[k, r - first_row]):
                     continue
                 if not (rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]):
                     continue
@@ -242,7 +252,10 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
                 _apply(vel, omega, inv_mass, inv_inertia, b, c_rb[c, 0], c_rb[c, 1], jx, jy, -1.0)
             else:
                 c_j[c, 0] = c_j[c, 1] = 0.0
+        warm_start_joints(center, angle, vel, omega, inv_mass, inv_inertia, j_body, j_local, j_kind, j_motor, j_acc)
         for _it in range(iterations):
+            joint_velocities(center, angle, vel, omega, inv_mass, inv_inertia, j_body, j_local, j_kind, j_param,
+                             j_motor, j_acc, h)
             for c in range(count):
                 k, b, row = c_a[c], c_b[c], c_row[c]
                 nx, ny = c_n[c, 0], c_n[c, 1]
@@ -276,10 +289,15 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
             o = c_o[c]
             cache_row[o] = c_row[c]
             cache_impulse[o, 0], cache_impulse[o, 1] = c_j[c, 0], c_j[c, 1]
+        for j in range(j_body.shape[0]):
+            j_total[j, 0] += j_acc[j, 0]
+            j_total[j, 1] += j_acc[j, 1]
+            j_total[j, 2] += j_acc[j, 2] + (j_acc[j, 3] if j_motor[j] else 0.0)
         for k in range(nk):
             center[k, 0] += h * vel[k, 0]
             center[k, 1] += h * vel[k, 1]
             angle[k] += h * omega[k]
+        joint_positions(center, angle, vel, omega, inv_mass, inv_inertia, j_body, j_local, j_kind, j_param, h)
         # the overlap left: a share of it removed by positions alone
         for c in range(count):
             k, b, o = c_a[c], c_b[c], c_o[c]

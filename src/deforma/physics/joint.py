@@ -1,0 +1,157 @@
+"""Handles onto a world's joints: what :meth:`World.join` returns.
+
+A :class:`Joint` holds a point of one rigid body on a point of another, or on the world:
+a ``"pin"`` (a hinge, optionally driven by a motor), a ``"weld"`` (no relative turning
+either) or a ``"spring"`` (a zero-length spring and damper). The rigid solver does the work
+(:mod:`deforma.physics.rigid.joints`); the handle keeps what the user gave, the anchors in
+the bodies' frames, the warm-start impulses, and the force of the last step.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..checks import non_negative as _non_negative
+from ..checks import number as _number
+from ..checks import pair as _pair
+from ..checks import positive as _positive
+from .rigid.joints import KINDS
+
+if TYPE_CHECKING:
+    from .body import Body
+
+#: Largest motor speed (degrees/s) a joint takes, as a collider's spin.
+MAX_MOTOR_SPEED = 1e6
+
+
+def covers(positions: np.ndarray, triangles: np.ndarray, point) -> bool:
+    """Whether ``point`` lies on one of the ``triangles`` (edges included) at ``positions``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> tri = np.array([[0, 1, 2]])
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    >>> covers(x, tri, (0.2, 0.2)), covers(x, tri, (0.6, 0.6)), covers(x, tri, (0.5, 0.5))
+    (True, False, True)
+    """
+    p = np.asarray(point, np.float64)
+    a, b, c = (positions[triangles[:, k]] for k in range(3))
+
+    def side(u, v):  # twice the signed area of (u, v, p), relative to the triangle's size
+        return (v[:, 0] - u[:, 0]) * (p[1] - u[:, 1]) - (v[:, 1] - u[:, 1]) * (p[0] - u[:, 0])
+
+    area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    tol = -1e-12 * np.abs(area)  # a point on an edge counts, as rounding would decide it
+    s = np.sign(area)
+    return bool(np.any((s * side(a, b) >= tol) & (s * side(b, c) >= tol) & (s * side(c, a) >= tol)))
+
+
+class Joint:
+    """A joint of a world (see :meth:`World.join`).
+
+    Attributes
+    ----------
+    a, b : Body, Body or None
+        The bodies it joins (``b`` None: the world).
+    kind : str
+        ``"pin"``, ``"weld"`` or ``"spring"``.
+    anchor : (float, float)
+        Where it was made (m), the point both bodies hold.
+    stiffness, damping : float or None
+        A spring's N/m and N s/m (None on a pin or weld).
+    """
+
+    def __init__(self, world, a: Body, b: Body | None, kind: str, anchor, local, reference: float,
+                 stiffness, damping, motor_speed, max_torque):
+        self._world = world
+        self.a, self.b, self.kind = a, b, kind
+        self.anchor = anchor
+        self._local = np.asarray(local, np.float64)   # a's anchor, b's (or the world point), body frames
+        self._reference = float(reference)            # a weld's angle_a - angle_b (rad)
+        self.stiffness, self.damping = stiffness, damping
+        self._motor_speed = motor_speed
+        self._max_torque = max_torque
+        self._acc = np.zeros(4)                        # warm starts (see rigid.joints)
+        self._impulse = np.zeros(3)                    # over the step so far: point (N s), angle (N m s)
+        self._force = np.zeros(3)                      # the last step's, per second
+
+    @property
+    def force(self) -> np.ndarray:
+        """The force (N, x and y) the joint put on ``a`` over the last step, on average (``b``
+        took the opposite)."""
+        return self._force[:2].copy()
+
+    @property
+    def torque(self) -> float:
+        """The torque (N m, counter-clockwise) a weld or motor put on ``a`` over the last step,
+        on average, besides the moment of :attr:`force`."""
+        return float(self._force[2])
+
+    @property
+    def motor_speed(self) -> float | None:
+        """A pin's motor: the spin of ``a`` relative to ``b`` it drives towards (degrees/s,
+        counter-clockwise), or None for no motor."""
+        return self._motor_speed
+
+    @motor_speed.setter
+    def motor_speed(self, value) -> None:
+        self._motor_speed = motor(self.kind, value, self._max_torque)[0]
+
+    @property
+    def max_torque(self) -> float | None:
+        """The most torque the motor gives (N m); None: as much as it takes."""
+        return self._max_torque
+
+    @max_torque.setter
+    def max_torque(self, value) -> None:
+        self._max_torque = motor(self.kind, self._motor_speed, value)[1]
+
+    def _pack(self) -> tuple[int, np.ndarray, bool]:
+        """``(kind code, param row, motor on)`` for the rigid solver."""
+        speed = self._motor_speed
+        torque = math.inf if self._max_torque is None else self._max_torque
+        param = np.array([self._reference, 0.0 if speed is None else math.radians(speed), torque,
+                          self.stiffness or 0.0, self.damping or 0.0])
+        return KINDS[self.kind], param, speed is not None
+
+    def __repr__(self) -> str:
+        b = "the world" if self.b is None else f"body {self.b._index}"
+        return f"Joint({self.kind} of body {self.a._index} and {b} at {self.anchor})"
+
+
+def motor(kind: str, speed, max_torque) -> tuple[float | None, float | None]:
+    """A motor's ``(speed deg/s, max_torque N m)`` checked: a pin's only, the torque bound
+    only with a speed."""
+    if speed is None:
+        if max_torque is not None:
+            raise ValueError("max_torque needs motor_speed: a motor bounds its torque (N m) while it drives at a "
+                             "speed (degrees/s)")
+        return None, None
+    if kind != "pin":
+        raise ValueError(f"motor_speed is for a pin joint (a driven hinge), not a {kind}")
+    s = _number(speed, "motor_speed")
+    if abs(s) > MAX_MOTOR_SPEED:
+        raise ValueError(f"motor_speed must be within +-{MAX_MOTOR_SPEED:g} degrees/s, got {speed!r}")
+    return s, None if max_torque is None else _positive(max_torque, "max_torque", "N m")
+
+
+def spring(kind: str, stiffness, damping) -> tuple[float | None, float | None]:
+    """A joint's ``(stiffness N/m, damping N s/m)`` checked: a spring's, and only a spring's."""
+    if kind != "spring":
+        for name, value in (("stiffness", stiffness), ("damping", damping)):
+            if value is not None:
+                raise ValueError(f"{name} is for kind='spring'; a {kind} holds rigidly")
+        return None, None
+    if stiffness is None:
+        raise ValueError("a spring joint needs stiffness (N/m, > 0)")
+    return (_positive(stiffness, "stiffness", "N/m"),
+            0.0 if damping is None else _non_negative(damping, "damping", "N*s/m"))
+
+
+def anchor(value) -> tuple[float, float]:
+    """The joint point ``at`` checked (m)."""
+    return _pair(value, "at")

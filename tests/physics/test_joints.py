@@ -1,0 +1,177 @@
+"""Joints between rigid bodies and the world (``World.join``) against known answers, at 1/60 s."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.special import ellipk
+
+import deforma
+
+G = 9.81
+RIGID = deforma.Material("rigid", density=100.0)
+
+
+def bar(w, x0, y0, length=1.0, width=0.05, material=RIGID):
+    """A rigid bar from (x0, y0) along +x."""
+    m = deforma.mesh.box(((0, 0), (length, 0), (length, width), (0, width)), detail=2)
+    return w.add_body(m, position=(x0 + length / 2, y0), material=material)
+
+
+def swing_period(w, body, seconds):
+    """The mean period (s) of ``body``'s swing about hanging straight down (-90 degrees), from
+    its upward crossings of it, and the swing (degrees from hanging) at every step."""
+    t, a = [], []
+    for _ in range(round(seconds / w.dt)):
+        w.step()
+        t.append(w.time)
+        a.append(body.angle + 90.0)
+    t, a = np.array(t), np.array(a)
+    up = np.flatnonzero((a[:-1] < 0) & (a[1:] >= 0))
+    cross = t[up] + (t[up + 1] - t[up]) * (-a[up]) / (a[up + 1] - a[up])
+    return float(np.mean(np.diff(cross))), a
+
+
+def pendulum_period(length, width, amplitude_deg):
+    """A bar hinged at the middle of an end: the compound pendulum's period at this amplitude."""
+    inertia = (length ** 2 + width ** 2) / 12 + (length / 2) ** 2  # per unit mass, about the hinge
+    t0 = 2 * math.pi * math.sqrt(inertia / (G * length / 2))
+    return t0 * 2 / math.pi * ellipk(math.sin(math.radians(amplitude_deg) / 2) ** 2)
+
+
+@pytest.mark.parametrize("amplitude", [10.0, 60.0])
+def test_a_bar_hinged_to_the_world_swings_as_a_compound_pendulum(amplitude):
+    # a 1 m bar hinged at the middle of its end, let go at `amplitude` degrees from hanging
+    w = deforma.World(dt=1 / 60)
+    start = -90.0 + amplitude
+    m = deforma.mesh.box(((0, -0.025), (1, -0.025), (1, 0.025), (0, 0.025)), detail=2)
+    c, s = math.cos(math.radians(start)), math.sin(math.radians(start))
+    body = w.add_body(m, position=(0.5 * c, 0.5 * s), angle=start, material=RIGID)
+    hinge = w.join(body, None, at=(0.0, 0.0))
+    period, angle = swing_period(w, body, 8.0)
+    assert period == pytest.approx(pendulum_period(1.0, 0.05, amplitude), rel=0.02)
+    assert np.abs(angle[-120:]).max() == pytest.approx(amplitude, rel=0.02)  # it keeps its swing
+    assert np.hypot(*hinge.force) > 0
+
+
+def test_two_rigid_bars_pinned_together_swing_as_a_compound_pendulum():
+    w = deforma.World(dt=1 / 60)
+    holder = bar(w, -1.03, 0.025)  # its end 3 cm short of the hinge, clear of the swinging bar's corners
+    holder.pin([0])  # held whole
+    m = deforma.mesh.box(((0, -0.025), (1, -0.025), (1, 0.025), (0, 0.025)), detail=2)
+    start = -90.0 + 20.0
+    c, s = math.cos(math.radians(start)), math.sin(math.radians(start))
+    swinging = w.add_body(m, position=(0.5 * c, 0.025 + 0.5 * s), angle=start, material=RIGID)
+    w.join(swinging, holder, at=(0.0, 0.025))
+    period, _ = swing_period(w, swinging, 8.0)
+    assert period == pytest.approx(pendulum_period(1.0, 0.05, 20.0), rel=0.02)
+    assert np.allclose(holder.center_of_mass, (-0.53, 0.025))
+
+
+def test_a_hanging_bar_at_rest_pulls_its_hinge_with_its_weight():
+    w = deforma.World(dt=1 / 60)
+    m = deforma.mesh.box(((0, -0.025), (1, -0.025), (1, 0.025), (0, 0.025)), detail=2)
+    body = w.add_body(m, position=(0.0, -0.5), angle=-90.0, material=RIGID)
+    hinge = w.join(body, None, at=(0.0, 0.0))
+    for _ in range(60):
+        w.step()
+    weight = body.mass * G
+    assert hinge.force == pytest.approx((0.0, weight), rel=1e-3, abs=1e-6 * weight)
+    assert abs(body.angle + 90.0) < 0.01
+
+
+def test_a_weld_holds_a_cantilever_level_and_carries_its_moment():
+    w = deforma.World(dt=1 / 60)
+    wall = bar(w, -0.2, -0.5, length=0.2, width=1.0)
+    wall.pin([0])
+    arm = bar(w, 0.001, 0.0)
+    weld = w.join(arm, wall, at=(0.0, 0.0), kind="weld")
+    for _ in range(120):
+        w.step()
+    assert abs(arm.angle) < 0.05 and np.abs(arm.center_of_mass - (0.501, 0.0)).max() < 1e-3
+    weight = arm.mass * G
+    assert weld.force == pytest.approx((0.0, weight), rel=1e-3, abs=1e-6 * weight)
+    # the weld's torque and its force's moment about the arm's centre (0.501 m from the weld,
+    # which pulls up there) hold the arm level: torque - 0.501 m * weight = 0
+    assert weld.torque == pytest.approx(weight * 0.501, rel=0.02)
+
+
+def test_a_motor_spins_a_wheel_at_its_speed_and_no_faster_than_its_torque_allows():
+    w = deforma.World(gravity=(0, 0), dt=1 / 60)
+    a = np.arange(48) * 2 * np.pi / 48
+    pts = np.vstack([np.column_stack([np.cos(a), np.sin(a)]) * 0.3, [[0.0, 0.0]]])
+    wheel = w.add_body(deforma.mesh.Mesh(pts, deforma.delaunay(pts)), position=None, material=RIGID)
+    j = w.join(wheel, None, at=(0.0, 0.0), motor_speed=90.0)
+    for _ in range(30):
+        w.step()
+    assert wheel.angular_velocity == pytest.approx(90.0, rel=1e-6)
+    # a bounded torque accelerates at torque / inertia
+    inertia = wheel.mass * 0.3 ** 2 / 2 * 0.99  # the 48-gon's is a little under the disc's
+    j.max_torque = 0.5
+    j.motor_speed = 1e4
+    before = wheel.angular_velocity
+    w.step()
+    gain = math.radians(wheel.angular_velocity - before) / w.dt
+    assert gain == pytest.approx(0.5 / inertia, rel=0.02)
+
+
+def test_a_weight_on_a_spring_stretches_it_by_mg_over_k_and_bounces_at_its_frequency():
+    w = deforma.World(dt=1 / 60)
+    m = deforma.mesh.box(((0, 0), (0.2, 0), (0.2, 0.2), (0, 0.2)), detail=2)
+    weight = w.add_body(m, position=(0.0, -0.1), material=RIGID)  # 4 kg, its top at the origin
+    k = 400.0
+    spring = w.join(weight, None, at=(0.0, 0.0), kind="spring", stiffness=k)
+    y = []
+    for _ in range(240):
+        w.step()
+        y.append(weight.center_of_mass[1])
+    y = np.array(y)
+    mass = weight.mass
+    # the mean of the swing is the static stretch below the start
+    assert np.mean(y[-120:]) + 0.1 == pytest.approx(-mass * G / k, rel=0.02)
+    a = y - np.mean(y)
+    up = np.flatnonzero((a[:-1] < 0) & (a[1:] >= 0))
+    assert np.mean(np.diff(up)) * w.dt == pytest.approx(2 * math.pi * math.sqrt(mass / k), rel=0.03)
+    assert np.hypot(*spring.force) > 0
+
+
+def test_removing_a_joint_or_a_body_lets_go():
+    w = deforma.World(dt=1 / 60)
+    b = bar(w, 0.0, 0.0)
+    j = w.join(b, None, at=(0.0, 0.02))
+    assert w.joints == [j]
+    w.remove_joint(j)
+    assert w.joints == []
+    for _ in range(10):
+        w.step()
+    assert b.velocity[1] < -1.0  # falling freely
+    j2 = w.join(b, None, at=tuple(b.center_of_mass))
+    w.remove_body(b)
+    assert w.joints == []
+    with pytest.raises(ValueError, match="unknown joint"):
+        w.remove_joint(j2)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda w, a, b, s: w.join(a, b, at=(5.0, 5.0)), r"at = \(5.0, 5.0\) is not on body 0 or body 1"),
+    (lambda w, a, b, s: w.join(a, a, at=(0.1, 0.02)), "a joint between body 0 and itself holds nothing"),
+    (lambda w, a, b, s: w.join(s, None, at=(0.1, 3.0)), "joints hold rigid bodies: a .body 2. is soft"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="hinge"), "kind must be one of pin, weld, spring"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="spring"), "a spring joint needs stiffness"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="weld", motor_speed=10.0),
+     "motor_speed is for a pin joint"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), max_torque=1.0), "max_torque needs motor_speed"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), stiffness=10.0), "stiffness is for kind='spring'"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, math.nan)), "at must be a pair of finite numbers"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), motor_speed=10.0, max_torque=-1.0),
+     "max_torque must be"),
+    (lambda w, a, b, s: w.join(a, None), "at must be the point"),
+])
+def test_bad_joints_are_refused_in_one_line_changing_nothing(call, message):
+    w = deforma.World(dt=1 / 60)
+    a = bar(w, 0.0, 0.0)
+    b = bar(w, 0.0, 1.0)
+    soft = bar(w, 0.0, 3.0, material=deforma.Material.preset("jelly"))
+    with pytest.raises(ValueError, match=message) as e:
+        call(w, a, b, soft)
+    assert "\n" not in str(e.value) and w.joints == []
