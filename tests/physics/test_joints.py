@@ -175,3 +175,51 @@ def test_bad_joints_are_refused_in_one_line_changing_nothing(call, message):
     with pytest.raises(ValueError, match=message) as e:
         call(w, a, b, soft)
     assert "\n" not in str(e.value) and w.joints == []
+
+
+SCENE = """
+[physics]
+dt = 0.016666666666666666
+[[body]]
+corners = [[0, 0], [1, 0], [1, 0.05], [0, 0.05]]
+detail = 2
+position = [0.5, 0]
+material = "rigid"
+density = 100
+[[body]]
+corners = [[0, 0], [0.3, 0], [0.3, 0.3], [0, 0.3]]
+detail = 2
+position = [0, 3]
+"""
+
+
+def test_a_scene_joint_hinges_its_bar_and_saves_with_the_scene(tmp_path):
+    p = tmp_path / "hinge.toml"
+    p.write_text(SCENE + "[[joint]]\na = 0\nat = [0, 0]\nmotor_speed = -30\nmax_torque = 1000\n")
+    w = deforma.load_scene(p)
+    (j,) = w.joints
+    assert (j.kind, j.b, j.anchor, j.motor_speed, j.max_torque) == ("pin", None, (0.0, 0.0), -30.0, 1000.0)
+    for _ in range(30):
+        w.step()
+    assert w.bodies[0].angular_velocity == pytest.approx(-30.0, rel=1e-6)  # the motor holds it against gravity
+    saved = deforma.scene.save_scene(w, tmp_path / "again.toml")
+    (k,) = deforma.load_scene(saved).joints
+    assert (k.kind, k.b, k.anchor, k.motor_speed, k.max_torque) == ("pin", None, (0.0, 0.0), -30.0, 1000.0)
+
+
+@pytest.mark.parametrize("joint, message", [
+    ("at = [0, 0]", "joint[0].a: missing: the body the joint holds"),
+    ("a = 0\nb = 5\nat = [0, 0]", "joint[0].b: there is no body 5: the scene has 2 [[body]] tables"),
+    ("a = 0\nb = 0\nat = [0, 0]", "joint[0].b: a joint between body 0 and itself holds nothing"),
+    ("a = 0", "joint[0].at: missing: the point both hold"),
+    ("a = 0\nat = [3, 3]", r"joint[0]: at = (3.0, 3.0) is not on body 0"),
+    ("a = 1\nat = [0, 3]", "joint[0]: joints hold rigid bodies: a (body 1) is soft"),
+    ("a = 0\nat = [0, 0]\nkind = \"hinge\"", "joint[0].kind"),
+    ("a = 0\nat = [0, 0]\nkind = \"spring\"", "joint[0]: a spring joint needs stiffness"),
+])
+def test_a_bad_scene_joint_is_refused_in_one_line_naming_it(tmp_path, joint, message):
+    p = tmp_path / "bad.toml"
+    p.write_text(SCENE + "[[joint]]\n" + joint + "\n")
+    with pytest.raises(deforma.scene.SceneError) as e:
+        deforma.load_scene(p)
+    assert message in str(e.value) and "\n" not in str(e.value)

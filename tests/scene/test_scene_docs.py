@@ -34,7 +34,7 @@ SECTIONS = {
     schema.PolygonCollider: '### `[[collider]]` with `shape = "polygon"`',
     schema.SegmentCollider: '### `[[collider]]` with `shape = "segment"`',
     schema.ImageCollider: '### `[[collider]]` with `shape = "image"`',
-    schema.Event: "### `[[event]]`", schema.Pull: "### `[[pull]]`",
+    schema.Event: "### `[[event]]`", schema.Pull: "### `[[pull]]`", schema.JointSpec: "### `[[joint]]`",
 }
 
 

@@ -26,12 +26,14 @@ from .construct import build, make_colliders, make_mesh
 from .schema import Scene, parse_scene, with_springs
 from .script import Script
 from .tables import (BoxBody, CameraSettings, CircleCollider, ColliderSpec, Event, ImageBody, ImageCollider,
-                     InteractionSettings, MeshBody, PhysicsSettings, PolygonCollider, Pull, RectCollider, RunSettings,
+                     InteractionSettings, JointSpec, MeshBody, PhysicsSettings, PolygonCollider, Pull, RectCollider,
+                     RunSettings,
                      SceneError, SceneInfo, SegmentCollider)
 
 __all__ = [
     "BoxBody", "CameraSettings", "CircleCollider", "ColliderSpec", "Event", "ImageBody", "ImageCollider",
-    "InteractionSettings", "MeshBody", "PhysicsSettings", "PolygonCollider", "Pull", "RectCollider", "RunSettings",
+    "InteractionSettings", "JointSpec", "MeshBody", "PhysicsSettings", "PolygonCollider", "Pull", "RectCollider",
+    "RunSettings",
     "Scene", "SceneError", "SceneInfo", "Script", "SegmentCollider", "body_specs", "build", "builtin_levels",
     "builtin_patterns", "builtin_scenes", "builtin_textures", "collider_spec", "load", "load_scene", "load_texture", "make_colliders",
     "make_mesh", "parse_scene", "save_scene", "scene_of", "with_springs",

@@ -17,8 +17,8 @@ import numpy as np
 from .assets import scene_path
 from .construct import box_mask, build, build_record, pin_mask
 from .schema import Scene, parse_scene, scene_to_dict
-from .tables import (BEHAVIOUR_KEYS, MATERIAL_KEYS, CircleCollider, ColliderSpec, InteractionSettings, MeshBody,
-                     PhysicsSettings, PolygonCollider, SceneError, SegmentCollider, material_settings)
+from .tables import (BEHAVIOUR_KEYS, MATERIAL_KEYS, CircleCollider, ColliderSpec, InteractionSettings, JointSpec,
+                     MeshBody, PhysicsSettings, PolygonCollider, SceneError, SegmentCollider, material_settings)
 
 try:  # Python >= 3.11
     import tomllib
@@ -118,6 +118,9 @@ def _material_keys(world, recorded: PhysicsSettings) -> dict:
     """``[physics]``'s material keys for the world as it is now."""
     m = world.material
     behaviours = _behaviour_keys(m)
+    if m is not None and m.is_rigid:  # density alone ([physics]'s elastic keys are no body's)
+        return dict(material="rigid", youngs_modulus=None, poisson_ratio=None, density=m.density,
+                    material_damping=0.0, plane="stress", **behaviours)
     if m is not None and m.is_fem:
         return dict(material=m.model, youngs_modulus=m.youngs_modulus, poisson_ratio=m.poisson_ratio,
                     density=m.density, material_damping=m.damping, plane=m.plane, **behaviours)
@@ -155,6 +158,9 @@ def _expected_material(physics: PhysicsSettings, spec):
 def _body_material_keys(material) -> dict:
     """A body spec's material keys that give it exactly ``material`` whatever [physics] says."""
     behaviours = _behaviour_keys(material)
+    if material.is_rigid:
+        return dict(material="rigid", youngs_modulus=None, poisson_ratio=None, density=material.density,
+                    material_damping=None, plane=None, **dict.fromkeys(behaviours))
     if not material.is_fem:
         return dict(material="springs", youngs_modulus=None, poisson_ratio=None, density=None,
                     material_damping=None, plane=None, **behaviours)
@@ -256,7 +262,11 @@ def scene_of(world) -> Scene:
         bodies.append(replace(spec, **pins) if pins else spec)
     built = {id(r): (spec, pose) for r, spec, pose in (rec.colliders if rec is not None else [])}
     colliders = tuple(collider_spec(r, *built.get(id(r), (None, None))) for r in world.colliders)
-    return replace(scene, physics=physics, interaction=interaction, body=tuple(bodies), collider=colliders)
+    joints = tuple(JointSpec(a=j.a._index, b=None if j.b is None else j.b._index, at=tuple(j.anchor), kind=j.kind,
+                             stiffness=j.stiffness, damping=j.damping if j.kind == "spring" else None,
+                             motor_speed=j.motor_speed, max_torque=j.max_torque) for j in world.joints)
+    return replace(scene, physics=physics, interaction=interaction, body=tuple(bodies), collider=colliders,
+                   joint=joints)
 
 
 def _xy(p, digits=None) -> tuple:

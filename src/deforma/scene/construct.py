@@ -199,6 +199,13 @@ def build(scene: Scene):
         for r in made:
             world.add_collider(r)
             colliders.append((r, c, (r.center, r.angle)))
+    made = world.bodies
+    for i, j in enumerate(scene.joint):
+        try:
+            world.join(made[j.a], None if j.b is None else made[j.b], at=j.at, kind=j.kind, stiffness=j.stiffness,
+                       damping=j.damping, motor_speed=j.motor_speed, max_torque=j.max_torque)
+        except (ValueError, IndexError, TypeError) as e:  # a scene made in code is checked here
+            raise SceneError(f"{source}: joint[{i}]: {e}") from None
     _REGISTRY[world] = BuildRecord(scene, bodies, colliders)
     return world
 

@@ -58,7 +58,8 @@ from .assets import picture_reference, resolve_picture, resolve_texture, texture
 from .construct import build
 from .tables import (BEHAVIOUR_KEYS, BODY_KINDS, COLLIDER_KINDS, FEM_DEFAULT, FEM_KEYWORD, MATERIAL_KEYS,
                      MATERIAL_MODELS, BodyPhysics, BoxBody, CameraSettings, CircleCollider, ColliderCommon,
-                     ColliderSpec, Event, ImageBody, ImageCollider, InteractionSettings, MaterialKeyError, MeshBody,
+                     ColliderSpec, Event, ImageBody, ImageCollider, InteractionSettings, JointSpec, MaterialKeyError,
+                     MeshBody,
                      PhysicsSettings, PolygonCollider, Pull, RectCollider, RunSettings, SceneError, SceneInfo,
                      SegmentCollider, material_settings)
 
@@ -66,6 +67,7 @@ from .tables import (BEHAVIOUR_KEYS, BODY_KINDS, COLLIDER_KINDS, FEM_DEFAULT, FE
 __all__ = [
     "BEHAVIOUR_KEYS", "MATERIAL_KEYS", "MATERIAL_MODELS", "BodyPhysics", "BoxBody", "CameraSettings",
     "CircleCollider", "ColliderCommon", "ColliderSpec", "Event", "ImageBody", "ImageCollider", "InteractionSettings",
+    "JointSpec",
     "MaterialKeyError", "MeshBody", "PhysicsSettings", "PolygonCollider", "Pull", "RectCollider", "RunSettings",
     "Scene", "SceneError", "SceneInfo", "SegmentCollider", "material_settings", "parse_scene", "scene_to_dict",
     "with_springs",
@@ -98,6 +100,7 @@ class Scene:
     collider: tuple = ()
     event: tuple = ()
     pull: tuple = ()
+    joint: tuple = ()
     path: str | None = field(default=None, compare=False)
 
     def build(self):
@@ -107,7 +110,7 @@ class Scene:
 
 SECTIONS = {"scene": SceneInfo, "run": RunSettings, "camera": CameraSettings, "physics": PhysicsSettings,
             "interaction": InteractionSettings}
-ARRAYS = {"body": None, "collider": None, "event": Event, "pull": Pull}
+ARRAYS = {"body": None, "collider": None, "event": Event, "pull": Pull, "joint": JointSpec}
 
 # each shape's required keys and what to say when one is missing
 _COLLIDER_NEEDS = {
@@ -416,6 +419,26 @@ def _check_pull(pull: Pull, path: str) -> None:
                                             f"got {value:g}")
 
 
+def _check_joint(joint: JointSpec, path: str, n_bodies: int) -> None:
+    """A joint's bodies exist and differ, and its point is given ([[body]] comes before
+    [[joint]] in ARRAYS, so the bodies are read)."""
+    for key in ("a", "b"):
+        i = getattr(joint, key)
+        if i is None:
+            if key == "a":
+                raise _Problem(f"{path}.a", "missing: the body the joint holds, its place among the [[body]] tables "
+                                            "(from 0)")
+            continue
+        if i >= n_bodies:
+            raise _Problem(f"{path}.{key}", f"there is no body {i}: the scene has {n_bodies} [[body]] table"
+                                            f"{'' if n_bodies == 1 else 's'}")
+    if joint.a == joint.b:
+        raise _Problem(f"{path}.b", f"a joint between body {joint.a} and itself holds nothing: name another body, "
+                                    f"or omit b to hold it to the world")
+    if joint.at is None:
+        raise _Problem(f"{path}.at", "missing: the point both hold, [x, y] in metres")
+
+
 def _check_integrator(name: str, path: str) -> None:
     # the registry, not a fixed list: an integrator registered by the user is allowed too
     from ..physics import available_integrators
@@ -518,6 +541,8 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
                         out.append(_table(cls, item, p, ctx))
                     if name == "pull":
                         _check_pull(out[-1], p)
+                    if name == "joint":
+                        _check_joint(out[-1], p, len(values.get("body", ())))
                 values[name] = tuple(out)
         _check_materials(values)
     except _Problem as e:

@@ -45,7 +45,8 @@ from ..physics.material import MODELS, PLANES, PRESETS, material_models
 __all__ = [
     "BEHAVIOUR_KEYS", "BODY_KINDS", "COLLIDER_KINDS", "COLLIDER_SHAPES", "FEM_DEFAULT", "FEM_KEYWORD", "MATERIAL_KEYS",
     "MATERIAL_MODELS", "BodyPhysics", "BoxBody", "CameraSettings", "CircleCollider", "ColliderCommon", "ColliderSpec",
-    "Event", "ImageBody", "ImageCollider", "InteractionSettings", "MaterialKeyError", "MeshBody", "PhysicsSettings",
+    "Event", "ImageBody", "ImageCollider", "InteractionSettings", "JointSpec", "MaterialKeyError", "MeshBody",
+    "PhysicsSettings",
     "PolygonCollider", "Pull", "RectCollider", "RunSettings", "SceneError", "SceneInfo", "SegmentCollider",
     "material_settings", "spec",
 ]
@@ -465,6 +466,28 @@ class Pull:
     strength: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N/m",
                                   doc="Pull per held vertex toward the target; by default "
                                       "interaction.mouse_strength.")
+
+
+@dataclass(frozen=True)
+class JointSpec:
+    """``[[joint]]``: two rigid bodies, or a rigid body and the world, held together at a point
+    (``World.join``)."""
+
+    a: int | None = spec("int", None, lo=0, doc="The body it holds (required): its place among the [[body]] "
+                                                 "tables, from 0; a rigid body.")
+    b: int | None = spec("int", None, lo=0, doc="The other body's place; omit to hold `a` to the world.")
+    at: tuple | None = spec("vec2", None, unit="m",
+                            doc="The point both hold (required), on `a` or `b` where the scene places them.")
+    kind: str = spec("str", "pin", choices=("pin", "weld", "spring"),
+                     doc="pin: a hinge; weld: no turning either; spring: a zero-length spring and damper.")
+    stiffness: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N/m",
+                                   doc="A spring's stiffness (required with kind = \"spring\", only then).")
+    damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="A spring's damping; default 0.")
+    motor_speed: float | None = spec("float", None, lo=-1e6, hi=1e6, unit="deg/s",
+                                     doc="A pin's motor: the spin of `a` relative to `b` it drives towards, "
+                                         "counter-clockwise; omit for a free hinge.")
+    max_torque: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N*m",
+                                    doc="The most torque the motor gives; omit for as much as it takes.")
 
 
 class MaterialKeyError(ValueError):

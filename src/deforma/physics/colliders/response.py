@@ -217,7 +217,7 @@ def collide_point(x0, y0, px, py, vx, vy, rects, h):
 
 
 @njit(cache=True)
-def contact_planes(x0, y, rects, planes, index, h):
+def contact_planes(x0, y, rects, planes, index, rows, dynamic, h):
     """The collider contacts a stable solver puts inside its solve: which vertices, and where.
 
     A vertex whose predicted end of substep ``y`` lies inside a collider gets the plane
@@ -240,6 +240,13 @@ def contact_planes(x0, y, rects, planes, index, h):
         in the substep (m), which friction measures slip against.
     index : (N,) int32
         Output: the listed vertices, ascending.
+    rows : (N,) int32
+        Output: the packed row each listed vertex's plane is of.
+    dynamic : bool
+        Whether rigid bodies' outlines (rows with ``INV_MASS`` > 0) give planes too: for a
+        solver that gives the body back what its planes did (implicit Euler,
+        :func:`~deforma.physics.integrators.implicit.solver.rigid_plane_impulses`); else
+        they are met after the solve, by :func:`collide_dynamic`.
     h : float
         Substep (s).
 
@@ -253,9 +260,9 @@ def contact_planes(x0, y, rects, planes, index, h):
     >>> import numpy as np
     >>> from deforma.physics.colliders.shapes import Rect, pack_colliders
     >>> floor = pack_colliders([Rect((0, -0.5), (10, 1.0), 0.0)], friction=0.3, static_friction=0.5)
-    >>> planes, index = np.zeros((2, 7)), np.zeros(2, np.int32)
+    >>> planes, index, rows = np.zeros((2, 7)), np.zeros(2, np.int32), np.zeros(2, np.int32)
     >>> x0 = np.array([[0.0, 0.01], [1.0, 2.0]])
-    >>> contact_planes(x0, x0 - [0.0, 0.02], floor, planes, index, 0.01)  # the low one only
+    >>> contact_planes(x0, x0 - [0.0, 0.02], floor, planes, index, rows, False, 0.01)  # the low one only
     1
     >>> int(index[0]), (planes[0] + 0.0).round(6).tolist()  # + 0.0 turns -0.0 into 0.0
     (0, [0.0, 1.0, 0.0, 0.5, 0.3, 0.0, 0.0])
@@ -265,15 +272,14 @@ def contact_planes(x0, y, rects, planes, index, h):
         px, py = y[i, 0], y[i, 1]
         best_depth = -np.inf
         for r in range(n_colliders(rects)):
-            # a rigid body's outline is met after the solve (collide_point), where the
-            # velocity change it makes is the impulse the rigid body takes back
-            if rects[r, INV_MASS] != 0.0 or not point_inside(rects, r, px, py):
+            if (rects[r, INV_MASS] != 0.0 and not dynamic) or not point_inside(rects, r, px, py):
                 continue
             rx0, ry0 = relative_start(rects, r, x0[i, 0], x0[i, 1], h)
             nx, ny, qx, qy, depth = exit_face(rects, r, rx0, ry0, px, py)
             if depth > best_depth:
                 best_depth = depth
                 w = rects[r, OMEGA]
+                rows[count] = r
                 planes[count, 0] = nx
                 planes[count, 1] = ny
                 planes[count, 2] = qx * nx + qy * ny + rects[r, RECT_SKIN]
@@ -314,7 +320,7 @@ def record_hit(hits, i, stamp, r, nx, ny, depth, qx, qy, ux, uy, px, py, vx, vy)
 
 
 @njit(cache=True)
-def collide_dynamic(x, v, inv_mass, vertex, n, xp, rects, hits, stamp, h):
+def collide_dynamic(x, v, inv_mass, x_start, rects, hits, stamp, h):
     """Points against rigid bodies' outlines (rows with ``INV_MASS`` > 0), in turn: each point
     inside one leaves it as from a collider (the exit of :func:`collide_point`'s step 2, from
     where it started, seen from the body), and the two take equal and opposite impulses at the
@@ -332,10 +338,10 @@ def collide_dynamic(x, v, inv_mass, vertex, n, xp, rects, hits, stamp, h):
         Positions (m) and velocities (m/s) at the end of the substep, updated in place.
     inv_mass : (N,) float64
         1/kg (0: pinned or a rigid body's own vertex, not moved).
-    vertex : (V,) int32
-        Collision vertex -> row of ``x``; the first ``n`` (the outlines) are tested.
-    xp : (V, 2) float64
-        Where each was at the start of the substep (m).
+    x_start : (N, 2) float64
+        Where each was at the start of the substep (m). Every vertex is tested, not only
+        the outlines: a coarse body's inner vertices meet a rigid body too when it is hit
+        hard (a rubber donut whose outline alone was kept out blew up).
     rects : (R, RECT_COLUMNS) float64
         Packed colliders, rigid outlines among them (their velocity columns updated).
     hits : ColliderHits
@@ -359,8 +365,7 @@ def collide_dynamic(x, v, inv_mass, vertex, n, xp, rects, hits, stamp, h):
     >>> r = pack_colliders([Rect((0, 0), (1, 1), 0.0)], friction=0.0, static_friction=0.0)
     >>> r[0, INV_MASS], r[0, INV_INERTIA] = 1.0, 6.0
     >>> x, v = np.array([[-0.49, 0.0]]), np.array([[2.0, 0.0]])
-    >>> collide_dynamic(x, v, np.ones(1), np.zeros(1, np.int32), 1, np.array([[-0.51, 0.0]]), r,
-    ...                 make_hits(1), 1, 0.01)
+    >>> collide_dynamic(x, v, np.ones(1), np.array([[-0.51, 0.0]]), r, make_hits(1), 1, 0.01)
     1
     >>> v.tolist(), r[0, 15:18].tolist(), round(float(x[0, 0]), 6)
     ([[1.0, 0.0]], [1.0, 0.0, 0.0], -0.5)
@@ -373,8 +378,7 @@ def collide_dynamic(x, v, inv_mass, vertex, n, xp, rects, hits, stamp, h):
             dynamic = True
     if not dynamic:
         return 0
-    for k in range(n):
-        i = vertex[k]
+    for i in range(x.shape[0]):
         w = inv_mass[i]
         if w == 0.0:
             continue
@@ -386,7 +390,7 @@ def collide_dynamic(x, v, inv_mass, vertex, n, xp, rects, hits, stamp, h):
                 continue
             if not point_inside(rects, r, px, py):
                 continue
-            rx0, ry0 = relative_start(rects, r, xp[k, 0], xp[k, 1], h)
+            rx0, ry0 = relative_start(rects, r, x_start[i, 0], x_start[i, 1], h)
             nx, ny, qx, qy, depth = exit_face(rects, r, rx0, ry0, px, py)
             tx, ty = -ny, nx
             cx, cy = rects[r, RECT_CX], rects[r, RECT_CY]
@@ -413,6 +417,12 @@ def collide_dynamic(x, v, inv_mass, vertex, n, xp, rects, hits, stamp, h):
             shift = h * w * jt  # the position the corrected velocity would have reached
             qx2, qy2 = qx + skin * nx + shift * tx, qy + skin * ny + shift * ty
             record_hit(hits, i, stamp, r, nx, ny, depth, px, py, ux, uy, qx2, qy2, vx, vy)
+            # a collider has the last word: a point the body pushed into one (squeezed between
+            # a crate and the floor) goes back out of it, as the collider response puts it
+            fx, fy, fvx, fvy, hit, fnx, fny, fdepth = collide_point(px, py, qx2, qy2, vx, vy, rects, h)
+            if hit >= 0:
+                record_hit(hits, i, stamp, hit, fnx, fny, fdepth, qx2, qy2, vx, vy, fx, fy, fvx, fvy)
+                qx2, qy2, vx, vy = fx, fy, fvx, fvy
             x[i, 0], x[i, 1], v[i, 0], v[i, 1] = qx2, qy2, vx, vy
             px, py = qx2, qy2
             moved += 1

@@ -113,7 +113,7 @@ def finish_position_step(x, v, x_prev, rects, hits, stamp, h, vmax2):
 
 
 @njit(cache=True)
-def held_contacts(x_prev, y, rects, planes, touch, h, topo, scr, buf):
+def held_contacts(x_prev, y, rects, planes, touch, rows, dynamic, h, topo, scr, buf):
     """The contacts a stable solver holds inside its solve or sweep, for the motion from
     ``x_prev`` to the prediction ``y``: the collider contact planes
     (:func:`~deforma.physics.colliders.response.contact_planes`, into ``planes`` and
@@ -121,11 +121,12 @@ def held_contacts(x_prev, y, rects, planes, touch, h, topo, scr, buf):
     into ``buf``, each held no closer than its pair started:
     :func:`~deforma.physics.contact.response.hold_start_distance`). Also notes the start of
     the substep for the contact stage (:func:`~deforma.physics.contact.broad_phase.gather_start`).
+    ``rows``, ``dynamic``: see ``contact_planes``.
 
     Returns ``(count, n_body)``: how many collider and body contacts; ``n_body`` is -1 when
     the buffer was too small (the World grows it and runs the step again).
     """
-    count = contact_planes(x_prev, y, rects, planes, touch, h)
+    count = contact_planes(x_prev, y, rects, planes, touch, rows, dynamic, h)
     gather_start(x_prev, topo, scr)
     n_body = detect_contacts(y, topo, scr, buf)  # of the predicted motion
     if n_body >= 0:
@@ -134,15 +135,15 @@ def held_contacts(x_prev, y, rects, planes, touch, h, topo, scr, buf):
 
 
 @njit(cache=True)
-def contact_epilogue(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow):
+def contact_epilogue(x, v, inv_mass, x_start, topo, scr, buf, rects, hits, h, follow):
     """The end of every substep, after the collider response: points in rigid bodies put out
-    of them (:func:`~deforma.physics.colliders.response.collide_dynamic`), collider corners pushed off
+    of them (:func:`~deforma.physics.colliders.response.collide_dynamic`, from ``x_start``, where the
+    vertices began the substep), collider corners pushed off
     body outlines (:func:`~deforma.physics.colliders.response.push_edges_off_corners`), then
     the body contact stage (:func:`~deforma.physics.contact.stage.contact_stage`; ``follow``:
     whether its velocity impulses move positions too). Returns the stage's result: -1 when
     the buffer was too small (the World grows it and runs the step again)."""
-    collide_dynamic(x, v, inv_mass, topo.cv_vertex, topo.body_interior[0], scr.xp, rects, hits,
-                    scr.status.stamp[0] + 1, h)
+    collide_dynamic(x, v, inv_mass, x_start, rects, hits, scr.status.stamp[0] + 1, h)
     push_edges_off_corners(x, v, inv_mass, topo.ce_a, topo.ce_b, topo.cv_vertex, rects, hits)
     return contact_stage(x, v, inv_mass, topo, scr, buf, rects, hits, h, follow)
 

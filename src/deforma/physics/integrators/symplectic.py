@@ -33,7 +33,7 @@ from numba import njit, prange
 
 from ..colliders.geometry import advance_colliders, jump_reach, n_colliders
 from ..colliders.response import collide_point, record_hit
-from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
+from ..colliders.shapes import INV_MASS, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
 from ..contact.broad_phase import gather_start
 from ..elements.springs import SpringArrays, scatter_spring_forces
 from ..elements.triangles import TriangleArrays, element_forces
@@ -87,9 +87,16 @@ def _symplectic_euler(x, v, fbuf, chunk_ptr, elem_ptr, chunk_vertices, springs, 
     n_chunks = chunk_ptr.shape[0] - 1
     reach2 = jump_reach(rects)
     n_rects = n_colliders(rects)
+    dynamic = False  # a rigid body's outline among the colliders: the substep's start is kept for it
+    for r in range(n_rects):
+        if rects[r, INV_MASS] != 0.0:
+            dynamic = True
+    x_start = np.empty_like(x) if dynamic else np.empty((0, 2))
     for sub in range(substeps):
         advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
         gather_start(x, ctopo, cscr)
+        if dynamic:
+            x_start[...] = x
         stamp = cscr.status.stamp[0] + 1  # the contact stage counts this substep when it runs
         for t in prange(n_chunks):
             lo, hi = chunk_ptr[t], chunk_ptr[t + 1]
@@ -142,7 +149,7 @@ def _symplectic_euler(x, v, fbuf, chunk_ptr, elem_ptr, chunk_vertices, springs, 
             bad += is_bad(px, py, vx, vy, vmax2)
         if bad:
             return bad
-        if contact_epilogue(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h, True) < 0:
+        if contact_epilogue(x, v, inv_mass, x_start, ctopo, cscr, cbuf, rects, hits, h, True) < 0:
             return 0
     return 0
 

@@ -219,6 +219,7 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, springs, spring_or
     1.0
     """
     sequence = np.empty(COLOURS, np.int64)
+    plane_rows = np.empty(touch.shape[0], np.int32)  # (rigid outlines are met after the sweep)
     for sub in range(substeps):
         advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep
         predict(x, v, x_prev, inv_mass, gx, gy, keep, force, has_force, grab_slot, grab_pull, h)
@@ -228,7 +229,7 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, springs, spring_or
             elem_lam_acc[e, 0] = 0.0
             elem_lam_acc[e, 1] = 0.0
             elem_lam_acc[e, 2] = 0.0
-        count, n_body = held_contacts(x_prev, x, rects, planes, touch, h, ctopo, cscr, cbuf)
+        count, n_body = held_contacts(x_prev, x, rects, planes, touch, plane_rows, False, h, ctopo, cscr, cbuf)
         for k in range(count):
             planes[k, 7] = -1.0  # stick or slide: not decided yet
         if n_body < 0:
@@ -248,7 +249,7 @@ def xpbd_substeps(x, v, x_prev, lam, planes, touch, inv_mass, springs, spring_or
         if bad:
             return bad
         # cscr.xp still holds x_prev (detect_contacts only read it): no second gather_start
-        if contact_epilogue(x, v, inv_mass, ctopo, cscr, cbuf, rects, hits, h, True) < 0:
+        if contact_epilogue(x, v, inv_mass, x_prev, ctopo, cscr, cbuf, rects, hits, h, True) < 0:
             return 0  # the contact buffer is too small; the world grows it and repeats the step
     return 0
 
@@ -292,6 +293,7 @@ class XPBD(Integrator):
             self._elem_lam = np.empty((shape[2], 3))
             self._planes = np.empty((shape[0], 8))
             self._touch = np.empty(shape[0], np.int32)
+            self._plane_rows = np.empty(shape[0], np.int32)
             self._n = shape
         if self._orders[0] is not model:  # a Model's springs and elements never change in place
             self._orders = (model, sweep_order(np.stack([model.spring_i, model.spring_j], axis=1), shape[0])[0],
@@ -344,7 +346,8 @@ class XPBD(Integrator):
                     control.has_force, control.grab_slot, control.grab_pull, h)
             for kind in model.elements:
                 kind.begin_substep()
-            count, n_body = held_contacts(self._x_prev, x, rects, self._planes, self._touch, h, topo, scr, buf)
+            count, n_body = held_contacts(self._x_prev, x, rects, self._planes, self._touch, self._plane_rows, False, h,
+                                          topo, scr, buf)
             self._planes[:count, 7] = -1.0  # stick or slide: not decided yet
             if n_body < 0:
                 return 0  # the contact buffer is too small; the world grows it and repeats the step
@@ -358,6 +361,6 @@ class XPBD(Integrator):
                                        vmax2)
             if bad:
                 return bad
-            if contact_epilogue(x, v, inv_mass, topo, scr, buf, rects, contacts.hits, h, True) < 0:
+            if contact_epilogue(x, v, inv_mass, self._x_prev, topo, scr, buf, rects, contacts.hits, h, True) < 0:
                 return 0
         return 0

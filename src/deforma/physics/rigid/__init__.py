@@ -29,10 +29,16 @@ them in turn, so a soft body never meets an outline that stood still for a whole
    (1/960 s) with joints (:mod:`~deforma.physics.rigid.joints`: pins, welds, springs
    between rigid bodies or to the world, solved in the same passes).
 
+Implicit Euler holds the soft vertices headed into an outline inside its solve, the outline
+moving with the velocity the body will have once they stick to it, and gives each plane's
+force back to the body (:func:`~deforma.physics.integrators.implicit.solver.recoil_planes`,
+:func:`~deforma.physics.integrators.implicit.solver.rigid_plane_impulses`).
+
 Measured (``tests/physics/test_rigid.py``): a soft ball into a crate of 1.6 to 160 kg
 keeps linear momentum to 1e-9 under symplectic Euler, implicit Euler and XPBD, angular
 momentum to 1e-14 under symplectic Euler (backward Euler loses a few percent of any spin:
-it is not a property of the coupling), and the total energy never rises; XPBD gains 2 %
-against the heaviest crate, and BDF2's velocity, read from the position history, loses 10 %
-of the momentum a contact moves.
+it is not a property of the coupling), and the total energy never rises under symplectic
+Euler; implicit Euler gains 5.5 % with the 1.6 kg crate and 0.6 % with the 160 kg one, XPBD
+2 % with the heaviest, and BDF2's velocity, read from the position history, loses 10 % of
+the momentum a contact moves.
 """

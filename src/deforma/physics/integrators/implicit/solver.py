@@ -51,6 +51,15 @@ body contact stage run as in the symplectic path, so nothing ends inside a colli
 across an outline; the stage's impulses change velocities only, not positions
 (:func:`~deforma.physics.contact.stage.contact_stage` says why).
 
+A rigid body's outline (:mod:`deforma.physics.rigid`) gives planes too, moving with the
+velocity the body will have once the vertices headed into it stick to it
+(:func:`recoil_planes`: a wall moving at the body's own velocity made a light crate take a
+heavy jelly's whole stop, and fly off with more energy than the jelly brought); after the
+solve each of its planes' forces goes back to the body (:func:`rigid_plane_impulses`), and
+points still inside it are met between two masses
+(:func:`~deforma.physics.colliders.response.collide_dynamic`). Met only after the solve, a
+rubber donut thrown into crates at 5 m/s folded over them and ran away.
+
 Body contacts are in the solve too: the contacts of the predicted motion
 (:func:`~deforma.physics.contact.narrow_phase.detect_contacts`) each add a spring between the vertex and
 the edge point, ``k_c/2 |D x - q|^2`` with ``D x = x_p - (1 - s) x_a - s x_b``, whose
@@ -97,6 +106,8 @@ import numpy as np
 from numba import njit
 
 from ...colliders.geometry import advance_colliders
+from ...colliders.response import note_impulse
+from ...colliders.shapes import INV_INERTIA, INV_MASS, OMEGA, RECT_CX, RECT_CY, VEL_X, VEL_Y
 from ..base import (Integrator, Option, StepReport, contact_epilogue, finish_position_step, held_contacts,
                     register_integrator)
 from .anderson import AndersonMixing
@@ -186,10 +197,10 @@ def free_estimate(ptr, ind, val, x, b, rows, pinned, out):
 
 
 @njit(cache=True)
-def contact_rhs(x, x_n, planes, index, count, weight, b):
+def contact_rhs(x, x_n, planes, index, count, weight, target, b):
     """Add the collider contacts' local step to ``b``: each listed vertex pulled, with its
     ``weight`` (kg), to its projection onto the outside of its contact plane, with
-    Coulomb friction at position level.
+    Coulomb friction at position level; the projections go to ``target`` (count, 2).
 
     ``push`` is how far the vertex is inside (0 if outside: an inactive contact projects
     to itself and exerts no force at convergence). Along the plane the target is where
@@ -203,7 +214,7 @@ def contact_rhs(x, x_n, planes, index, count, weight, b):
     >>> b = np.zeros((1, 2))
     >>> x, x_n = np.array([[0.3, -0.1]]), np.array([[0.0, 0.5]])
     >>> floor = np.array([[0.0, 1.0, 0.0, 0.5, 0.3, 0.0, 0.0]])
-    >>> contact_rhs(x, x_n, floor, np.zeros(1, np.int32), 1, np.array([2.0]), b)
+    >>> contact_rhs(x, x_n, floor, np.zeros(1, np.int32), 1, np.array([2.0]), np.zeros((1, 2)), b)
     >>> b.round(9).tolist()  # slid 0.3 m, more than 0.5 * 0.1: held back by 0.3 * 0.1
     [[0.54, 0.0]]
     """
@@ -223,8 +234,68 @@ def contact_rhs(x, x_n, planes, index, count, weight, b):
                 slide = planes[k, 4] * push * (1.0 if slide > 0.0 else -1.0)
             px -= slide * ny
             py += slide * nx
+        target[k, 0] = px
+        target[k, 1] = py
         b[i, 0] += weight[k] * px
         b[i, 1] += weight[k] * py
+
+
+@njit(cache=True)
+def recoil_planes(planes, index, rows, count, x_n, y, mass, rects, h):
+    """Move each rigid body's contact planes with the velocity the body will have once the
+    vertices headed into it stick to it: ``V* = (M V + sum m v) / (M + sum m)`` over the
+    listed vertices of its row (``v = (y - x_n) / h``, the predicted motion), instead of
+    its velocity ``V`` now. Held still at ``V``, a light crate took the stop of a whole heavy
+    jelly within a substep and then flew off with more energy than the jelly brought; at
+    ``V*`` the solve makes the inelastic exchange of two masses."""
+    for k in range(count):
+        r = rows[k]
+        if r < 0 or rects[r, INV_MASS] == 0.0:
+            continue  # a collider, or a rigid row already moved
+        # the first listed vertex of this row sums the row (later ones find it done: -r - 1)
+        big_m = 1.0 / rects[r, INV_MASS]
+        m_sum, px, py = big_m, big_m * rects[r, VEL_X], big_m * rects[r, VEL_Y]
+        for q in range(k, count):
+            if rows[q] == r:
+                i = index[q]
+                m_sum += mass[i]
+                px += mass[i] * (y[i, 0] - x_n[i, 0]) / h
+                py += mass[i] * (y[i, 1] - x_n[i, 1]) / h
+        sx, sy = h * (px / m_sum - rects[r, VEL_X]), h * (py / m_sum - rects[r, VEL_Y])
+        for q in range(k, count):
+            if rows[q] == r:
+                planes[q, 2] += sx * planes[q, 0] + sy * planes[q, 1]
+                planes[q, 5] += sx
+                planes[q, 6] += sy
+                rows[q] = -r - 1  # done (rigid_plane_impulses reads it back)
+
+
+@njit(cache=True)
+def rigid_plane_impulses(x, index, rows, count, weight, target, rects, hits, inv_mass, h):
+    """Give rigid bodies back what their outlines' planes did in the solve: contact ``k``
+    pulled vertex ``i`` toward ``target[k]`` with ``weight[k] (target - x) / h^2`` N over the
+    substep ``h``, so the vertex took the impulse ``J = weight (target - x) / h``. For a
+    plane of a rigid body's row (``rows[k] = -r - 1``, from :func:`recoil_planes`), ``J / m``
+    goes to ``hits`` as the velocity change it made (the rigid stage gives the body ``-J``)
+    and the row's packed velocity takes its share at once. With ``target`` the last
+    iteration's projections and ``x`` the solve's result, the solve's own equations make the
+    body's momentum change exactly these impulses (its elastic forces sum to zero), so
+    momentum is kept to rounding."""
+    for k in range(count):
+        if rows[k] >= 0:
+            continue
+        r = -rows[k] - 1
+        i = index[k]
+        jx = weight[k] * (target[k, 0] - x[i, 0]) / h
+        jy = weight[k] * (target[k, 1] - x[i, 1]) / h
+        if jx == 0.0 and jy == 0.0:
+            continue
+        w = inv_mass[i]
+        note_impulse(hits, i, r, x[i, 0], x[i, 1], 0.0, 0.0, x[i, 0], x[i, 1], w * jx, w * jy)
+        ax, ay = x[i, 0] - rects[r, RECT_CX], x[i, 1] - rects[r, RECT_CY]
+        rects[r, VEL_X] -= rects[r, INV_MASS] * jx
+        rects[r, VEL_Y] -= rects[r, INV_MASS] * jy
+        rects[r, OMEGA] -= rects[r, INV_INERTIA] * (ax * jy - ay * jx)
 
 
 @njit(cache=True)
@@ -530,6 +601,8 @@ class ImplicitEuler(Integrator):
             self._planes = np.empty((n, 7))
             self._z = np.empty((n, 2))
             self._touch = np.empty(n, np.int32)
+            self._plane_rows = np.empty(n, np.int32)
+            self._targets = np.empty((n, 2))
             self._scratch_n = n
         # BDF2 is backward Euler with the step hs = 2h/3 from (x^, v^) = ((4 x_n - x_{n-1}) / 3,
         # (4 v_n - v_{n-1}) / 3): x = x^ + hs v and v = v^ + hs a(x) (see the module docstring)
@@ -573,7 +646,9 @@ class ImplicitEuler(Integrator):
             # start of the substep (Baraff & Witkin's one Newton step, with the directions
             # of x_n). Starting at the prediction y measured worse on impacts: y can already
             # have a row of vertices pushed through the next, and the iteration keeps it.
-            count, n_body = held_contacts(x_n, y, rects, self._planes, self._touch, float(h), topo, scr, buf)
+            count, n_body = held_contacts(x_n, y, rects, self._planes, self._touch, self._plane_rows, True, float(h),
+                                          topo, scr, buf)
+            recoil_planes(self._planes, self._touch, self._plane_rows, count, x_n, y, model.vertex_mass, rects, float(h))
             if n_body < 0:
                 return StepReport(0, False)  # the contact buffer is too small; the world grows it and repeats
             cv = topo.cv_vertex
@@ -601,7 +676,7 @@ class ImplicitEuler(Integrator):
                         z = self._z
                         free_estimate(self._rows.indptr, self._rows.indices, self._rows.data, x, b,
                                       self._listed, model.pinned, z)
-                contact_rhs(z, x_n, self._planes, self._touch, count, self._contact_weight, b)
+                contact_rhs(z, x_n, self._planes, self._touch, count, self._contact_weight, self._targets, b)
                 body_contact_rhs(z, x_n, self._triples, self._s, self._pair_weight, buf.normal, buf.target, buf.mu,
                                  n_body, b)
                 b[self._pinned] = x_n[self._pinned]  # pinned: x_p = where it is
@@ -635,6 +710,8 @@ class ImplicitEuler(Integrator):
                 # the first iteration's map (projecting the prediction) is not the others'
                 x[...] = mixer.next(x, g) if it > 1 else g
             self.iterations_run += it
+            rigid_plane_impulses(x, self._touch, self._plane_rows, count, self._contact_weight, self._targets, rects,
+                                 hits, model.vertex_inv_mass, float(hs))
             if second:
                 solved = x.copy()
             bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, float(h), vmax2)
@@ -647,7 +724,7 @@ class ImplicitEuler(Integrator):
                 v[free] += (x[free] - x_s[free]) * (1.0 / hs) - (x[free] - x_n[free]) * (1.0 / h)
             # scr.xp still holds x_n (detect_contacts only read it): no second gather_start; the
             # stage's impulses change velocities only (contact_stage says why)
-            if contact_epilogue(x, v, model.vertex_inv_mass, topo, scr, buf, rects, hits, float(h), False) < 0:
+            if contact_epilogue(x, v, model.vertex_inv_mass, x_n, topo, scr, buf, rects, hits, float(h), False) < 0:
                 return StepReport(0, False)  # the contact buffer is too small; the world grows it and repeats
             if second:
                 np.subtract(x, x_n, out=dx)
