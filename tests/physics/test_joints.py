@@ -223,3 +223,36 @@ def test_a_bad_scene_joint_is_refused_in_one_line_naming_it(tmp_path, joint, mes
     with pytest.raises(deforma.scene.SceneError) as e:
         deforma.load_scene(p)
     assert message in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_jointed_body_cannot_be_made_soft_while_the_joint_holds_it():
+    w = deforma.World(dt=1 / 60, material=RIGID)
+    b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.05), (0, 0.05)), detail=2), position=(0.5, 0.0))
+    w.join(b, None, at=(0.0, 0.0))
+    for change in (lambda: setattr(b, "material", deforma.Material.preset("jelly")),
+                   lambda: setattr(w, "material", deforma.Material.preset("jelly")),
+                   lambda: setattr(w, "material", None)):
+        with pytest.raises(ValueError, match="is held by a joint .* remove the joint first") as e:
+            change()
+        assert "\n" not in str(e.value) and b.material == RIGID
+    w.material = deforma.Material("rigid", density=50.0)  # rigid to rigid is fine
+    w.remove_joint(w.joints[0])
+    b.material = deforma.Material.preset("jelly")
+    assert not b.material.is_rigid
+
+
+def test_the_picture_shows_a_dot_where_each_joint_is(gl_ctx):
+    from deforma.render import Renderer, WorldView
+
+    w = deforma.World(dt=1 / 60)
+    b = bar(w, 0.0, 0.0)
+    j = w.join(b, None, at=(0.0, 0.0))
+    for _ in range(20):
+        w.step()
+    assert np.hypot(*j.point) < 1e-6  # the hinge stays at the origin as the bar swings
+    r = Renderer(gl_ctx, (320, 180), samples=0)
+    img = WorldView(r, w).draw().astype(int)
+    col, row = np.floor(r.camera.world_to_pixel(j.point[None], r.size)[0]).astype(int)
+    assert np.abs(img[row, col] - (0xF4, 0xF1, 0xDE)).max() < 16  # the light centre
+    assert img[row, col + 4].max() < 80  # the dark rim (#1d2433, shaded as bodies are)
+    r.release()

@@ -353,6 +353,8 @@ class Body:
         value = _material(value)
         if value is not None and value.is_fem:
             _fem_mesh_check(self.topology)
+        made = value if value is not None else (world.material or SPRINGS)
+        world._check_joined_stay_rigid([self] if not made.is_rigid else [])
         self._overrides["material"] = value
         world._material_changed()
 

@@ -18,6 +18,7 @@ from ..checks import non_negative as _non_negative
 from ..checks import number as _number
 from ..checks import pair as _pair
 from ..checks import positive as _positive
+from . import rigid_motion
 from .rigid.joints import KINDS
 
 if TYPE_CHECKING:
@@ -78,6 +79,18 @@ class Joint:
         self._acc = np.zeros(4)                        # warm starts (see rigid.joints)
         self._impulse = np.zeros(3)                    # over the step so far: point (N s), angle (N m s)
         self._force = np.zeros(3)                      # the last step's, per second
+
+    @property
+    def point(self) -> np.ndarray:
+        """Where ``a`` holds the joint now (m): its anchor carried with it since the joint
+        was made (``b``'s point is there too, up to the solver's drift)."""
+        a = self.a
+        x, m = a.positions, a.vertex_masses
+        center = rigid_motion.center_of_mass(x, m)
+        angle = rigid_motion.fit_angle(a.topology.rest_positions, x, m)
+        c, s = math.cos(angle), math.sin(angle)
+        lx, ly = self._local[0], self._local[1]
+        return np.array([center[0] + c * lx - s * ly, center[1] + s * lx + c * ly])
 
     @property
     def force(self) -> np.ndarray:

@@ -391,8 +391,18 @@ class World:
             for body in self._bodies:
                 if body._overrides["material"] is None:
                     _fem_mesh_check(body.topology)
+        if value is None or not value.is_rigid:
+            self._check_joined_stay_rigid([b for b in self._bodies if b._overrides["material"] is None])
         self._material = value
         self._material_changed()
+
+    def _check_joined_stay_rigid(self, softened) -> None:
+        """Refuse to make a body a joint holds soft (joints hold rigid bodies)."""
+        for j in self._joints:
+            for body in (j.a, j.b):
+                if body is not None and any(body is s for s in softened):
+                    raise ValueError(f"body {body._index} is held by a joint ({j!r}), and joints hold rigid bodies: "
+                                     f"remove the joint first (world.remove_joint)")
 
     def _material_changed(self) -> None:
         # springs and elements are different arrays: rebuild the Model, keep the state

@@ -6,9 +6,16 @@ once and then, per frame, only the positions.
 
 from __future__ import annotations
 
+import numpy as np
+
 from .renderer import Camera, Renderer, _as_rgba
 
 __all__ = ["BODY_PALETTE", "WorldView"]
+
+#: A joint's dot: its radius in pixels, its sides, its rim and centre colours.
+JOINT_DOT_PIXELS = 5.0
+JOINT_DOT_SIDES = 16
+JOINT_DOT_COLORS = ("#1d2433", "#f4f1de")
 
 #: Colours for bodies that name neither a colour nor a texture, in order of the bodies.
 BODY_PALETTE = ("#e07a5f", "#3d9970", "#f2a541", "#5b8def", "#b56576", "#81b29a")
@@ -65,6 +72,7 @@ class WorldView:
         self._handles = []
         self._bodies = []
         self._shown = None
+        self._markers = None  # the joints' dots (a dark disc, a light one on it), made when first needed
         self.sync()
 
     def sync(self) -> None:
@@ -106,6 +114,23 @@ class WorldView:
         self._shown = [(id(b), id(b.topology)) for b in bodies]  # a torn body has a new topology
         self._topologies = [b.topology for b in bodies]
 
+    def _draw_joints(self) -> None:
+        """A dot on every joint, over the bodies: 5 pixels across, dark with a light centre."""
+        joints = getattr(self.world, "joints", ())
+        if not joints:
+            return
+        r = self.renderer
+        t = np.arange(JOINT_DOT_SIDES) * 2 * np.pi / JOINT_DOT_SIDES
+        ring = np.vstack([[0.0, 0.0], np.column_stack([np.cos(t), np.sin(t)])])
+        if self._markers is None:
+            fan = np.array([[0, 1 + k, 1 + (k + 1) % JOINT_DOT_SIDES] for k in range(JOINT_DOT_SIDES)])
+            self._markers = (r.add_mesh(fan, color=JOINT_DOT_COLORS[0]), r.add_mesh(fan, color=JOINT_DOT_COLORS[1]))
+        px = r.camera.metres_per_pixel(r.size)
+        for j in joints:
+            p = j.point
+            for handle, radius in zip(self._markers, (JOINT_DOT_PIXELS * px, 0.5 * JOINT_DOT_PIXELS * px)):
+                r.draw_mesh(handle, p + radius * ring)
+
     def _looks(self):
         # the world whose scene gives the looks: the one shown unless told otherwise, so that a
         # view given another world (the viewer's, when a scene is loaded) takes that world's
@@ -125,6 +150,7 @@ class WorldView:
         r = self.renderer
         r.render([(h, b.positions) for h, b in zip(self._handles, self._bodies)], self.world.colliders,
                  wireframe=self.wireframe, collider_colors=self.collider_colors)
+        self._draw_joints()
         if not read:
             return None
         frame = r.read()
