@@ -68,6 +68,7 @@ def test_builtin_scene_runs_finite_with_no_vertex_inside_a_collider(name):
 @pytest.mark.parametrize("name", NAMES)
 def test_builtin_scene_frame_shows_each_body_where_it_is(gl_ctx, name):
     from deforma.render import Renderer, WorldView
+    from deforma.render.world_view import JOINT_DOT_PIXELS
 
     world = scenes.load_scene(name)
     for _ in range(60):
@@ -88,9 +89,13 @@ def test_builtin_scene_frame_shows_each_body_where_it_is(gl_ctx, name):
         # around each vertex (3x3 pixels) the picture differs from the empty one: the body is there
         hits = [changed[r_ - 1 : r_ + 2, c - 1 : c + 2].any() for c, r_ in px[onscreen]]
         assert np.mean(hits) > 0.9, (name, np.mean(hits))
-    # and far from every body nothing changed
+    # and far from every body (and every joint's dot) nothing changed
     allpx = np.concatenate([r.camera.world_to_pixel(b.positions, r.size) for b in world.bodies])
     lo, hi = allpx.min(axis=0) - 4, allpx.max(axis=0) + 4
+    if world.joints:
+        dots = r.camera.world_to_pixel(np.array([j.point for j in world.joints]), r.size)
+        lo = np.minimum(lo, dots.min(axis=0) - JOINT_DOT_PIXELS - 2)
+        hi = np.maximum(hi, dots.max(axis=0) + JOINT_DOT_PIXELS + 2)
     cols, rows = np.meshgrid(np.arange(320), np.arange(180))
     outside = (cols < lo[0]) | (cols > hi[0]) | (rows < lo[1]) | (rows > hi[1])
     assert not changed[outside].any()
