@@ -471,3 +471,26 @@ def test_a_spring_value_set_on_a_finite_element_scene_is_noted_in_the_panel():
     s = Session("demo")
     s.set_param("stiffness", 3000.0)
     assert s.note_is_warning and s.note.startswith("world.stiffness changes no body: body 0 (neo-hookean)")
+
+
+def test_two_clicks_hinge_a_rigid_body_to_another_or_to_the_world():
+    s = Session("chain")
+    world = s.world
+    n = len(world.joints)
+    crate = world.bodies[-1]
+    corner = crate.positions[np.argmax(crate.positions[:, 0] + crate.positions[:, 1])] - 0.02
+    j = s.join(corner, (50.0, 50.0))  # the second click off every body: the world
+    assert j.a is crate and j.b is None and len(world.joints) == n + 1
+    link = world.bodies[0].center_of_mass
+    k = s.join(crate.center_of_mass, link)
+    assert k.a is crate and k.b is world.bodies[0]
+    with pytest.raises(ValueError, match="no body under the first click"):
+        s.join((50.0, 50.0), link)
+    s.reset()  # the scene of the world as it is: its joints too
+    assert len(s.world.joints) == n + 2
+
+
+def test_the_join_key_is_listed():
+    from deforma.viewer.controls import KEYS
+
+    assert any(action == "join" for _names, action, _text in KEYS)

@@ -571,3 +571,30 @@ def largest_triangle_centre(b, piece):
 def vertex_pixel_of(v, point):
     px = v.to_pixel(point)
     return int(round(px[0])), int(round(px[1]))
+
+
+def test_the_join_key_and_two_clicks_hinge_a_crate_to_the_world(viewer):
+    import deforma
+
+    viewer.load(deforma.scene.load("chain"))
+    viewer.panel_visible, viewer.help_visible, viewer.running = True, False, True
+    pygame.event.clear()
+    viewer.frame(1 / 60)
+    world = viewer.session.world
+    n = len(world.joints)
+    crate = world.bodies[-1]
+    on_crate = viewer.to_pixel(crate.center_of_mass)
+    on_crate = (int(round(on_crate[0])), int(round(on_crate[1])))
+    key(pygame.K_j)
+    post(pygame.MOUSEBUTTONDOWN, pos=on_crate, button=1)
+    post(pygame.MOUSEBUTTONUP, pos=on_crate, button=1)
+    post(pygame.MOUSEBUTTONDOWN, pos=(5, 5), button=1)  # the background: the world
+    post(pygame.MOUSEBUTTONUP, pos=(5, 5), button=1)
+    run(viewer, 1)
+    assert viewer.grab is None and len(world.joints) == n + 1
+    assert world.joints[-1].a is crate and world.joints[-1].b is None
+    assert "hinged body" in viewer.inspector.message
+    key(pygame.K_j)  # J then J: nothing
+    key(pygame.K_j)
+    run(viewer, 1)
+    assert len(world.joints) == n + 1 and "cancelled" in viewer.inspector.message

@@ -170,6 +170,7 @@ class Viewer:
         self.unstable: str | None = None
         self.running = True
         self.grab = None
+        self._joining = None           # the J key's clicks so far (world points), while joining
         self._collider_drag = None     # offset from the pointer to the collider centre
         self._pan = None               # last pointer position while panning
         self.pointer = (0, 0)
@@ -294,6 +295,32 @@ class Viewer:
             self.inspector.say(f"{'pinned' if pinned else 'unpinned'} vertex {vertex} of body {body}"
                                + ("; U unpins all" if pinned else ""))
 
+    def start_join(self) -> None:
+        """The J key: the next two left clicks make a hinge (J again: forget it)."""
+        self._release_grab()
+        if self._joining is not None:
+            self._joining = None
+            self.inspector.say("join cancelled")
+            return
+        self._joining = []
+        self.inspector.say("join: click a rigid body where the hinge goes, then the body to hinge it to "
+                           "(the background or the same body: the world)")
+
+    def _join_click(self, pos) -> None:
+        self._joining.append(self.to_world(pos))
+        if len(self._joining) < 2:
+            self.inspector.say("now click the body to hinge it to (the background: the world)")
+            return
+        first, second = self._joining
+        self._joining = None
+        try:
+            j = self.session.join(first, second)
+        except ValueError as e:
+            self.inspector.say(str(e), error=True)
+            return
+        other = "the world" if j.b is None else f"body {j.b._index}"
+        self.inspector.say(f"hinged body {j.a._index} to {other} at ({first[0]:.2f}, {first[1]:.2f}) m")
+
     def unpin_all(self) -> None:
         """Free every pinned vertex (the U key)."""
         n = self.session.unpin_all()
@@ -370,6 +397,8 @@ class Viewer:
             self.toggle_pin()
         elif action == "unpin":
             self.unpin_all()
+        elif action == "join":
+            self.start_join()
         elif action.startswith("object:"):
             self.select_object(action.split(":", 1)[1])
         elif action == "panel":
@@ -470,6 +499,8 @@ class Viewer:
         if t == pg.MOUSEBUTTONDOWN and e.button == 1 and pg.key.get_mods() & pg.KMOD_SHIFT:
             self._release_grab()
             self.toggle_pin(e.pos)
+        elif t == pg.MOUSEBUTTONDOWN and e.button == 1 and self._joining is not None:
+            self._join_click(e.pos)
         elif t == pg.MOUSEBUTTONDOWN and e.button == 1:
             p = self.to_world(e.pos)
             self._release_grab()

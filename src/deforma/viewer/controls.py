@@ -17,6 +17,7 @@ KEYS: tuple[tuple[tuple[str, ...], str, str], ...] = (
     (("w",), "wireframe", "springs on / off"),
     (("f",), "pin", "pin / unpin the vertex under the pointer (fix it in place)"),
     (("u",), "unpin", "unpin every vertex"),
+    (("j",), "join", "join: click a rigid body where the hinge goes, then another body (or the background)"),
     (("z",), "rotate:5", "turn the selected collider 5° counter-clockwise (with Shift: 1°)"),
     (("x",), "rotate:-5", "turn the selected collider 5° clockwise (with Shift: 1°)"),
     (("delete",), "remove_collider", "remove the selected collider"),

@@ -489,6 +489,25 @@ class Session:
             body.pin([i])
         return k, i, bool(body.pinned[i])
 
+    def join(self, first, second):
+        """Hinge the body under ``first`` (metres) at that point to the body under ``second``,
+        or to the world when ``second`` is on no body or on the same one: the J key and two
+        clicks. Returns the :class:`deforma.Joint`.
+
+        Raises
+        ------
+        ValueError
+            No body under ``first``, or what ``World.join`` refuses (a soft body, ...); one
+            line, nothing changed.
+        """
+        hit = self.vertex_at(first)
+        if hit is None:
+            raise ValueError("no body under the first click: click a rigid body where the hinge goes")
+        a = self.world.bodies[hit[0]]
+        other = self.vertex_at(second)
+        b = None if other is None or other[0] == hit[0] else self.world.bodies[other[0]]
+        return self.world.join(a, b, at=(float(first[0]), float(first[1])))
+
     def unpin_all(self) -> int:
         """Free every pinned vertex of every body; returns how many were pinned."""
         n = 0
