@@ -128,6 +128,11 @@ def test_a_soft_body_rests_on_a_rigid_box_under_every_integrator(integrator):
     assert jelly.center_of_mass[1] < 0.5  # and it fell onto it
     assert np.abs(crate.center_of_mass - (0, 0.15)).max() < 0.01  # the crate carries it on the floor
     assert np.abs(jelly.velocity).max() < 0.05
+    # world.contacts names the crate as a body, never as a collider past world.colliders
+    c = w.contacts
+    assert set(c.collider.tolist()) <= {-1, 0} and set(c.rigid_body.tolist()) <= {-1, 0}
+    on_crate = c.vertex[c.rigid_body == 0]
+    assert len(on_crate) and (on_crate >= jelly.vertex_slice.start).all()
 
 
 def crate_and_ball(integrator: str, crate_density: float, ball: deforma.Material, speed: float = 3.0):

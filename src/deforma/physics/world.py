@@ -695,7 +695,8 @@ class World:
         """The contacts of the last substep: with colliders, other bodies and itself.
 
         A struct of arrays (see :class:`~deforma.physics.contact.contacts.ContactPoints`); collider
-        contacts have ``collider >= 0``, body contacts ``collider == -1`` and an ``edge``.
+        contacts have ``collider >= 0``, contacts with a rigid body's outline ``rigid_body >= 0``,
+        body contacts ``collider == -1`` and an ``edge``.
 
         Examples
         --------
@@ -713,7 +714,9 @@ class World:
         """
         if self._colliders_changed():
             self._pack_colliders()
-        return self._contacts.points(self._model.contact, self._control.colliders)
+        m = self._model
+        rigid = rigid_set(m).bodies if m.n_vertices and m.rigid.any() else np.zeros(0, np.int64)
+        return self._contacts.points(m.contact, self._control.colliders, len(self._colliders), rigid)
 
     # -- colliders --------------------------------------------------------------------------
     @property

@@ -160,15 +160,16 @@ class ContactPoints:
     """The contacts of the last substep, as arrays (struct of arrays, one row per contact).
 
     Collider contacts come first: the vertices the collider response put back outside a
-    collider. Then body contacts: what the contact stage found before its response (a
-    vertex against another body's outline edge, or against its own).
+    collider, or outside a rigid body's outline (``rigid_body``). Then body contacts: what
+    the contact stage found before its response (a vertex against another body's outline
+    edge, or against its own).
 
     Attributes
     ----------
     vertex : (C,) int64
         World vertex index (rows of the world's state arrays).
     collider : (C,) int64
-        Index into ``world.colliders``, or -1 for a body contact.
+        Index into ``world.colliders``, or -1 for a body or rigid-body contact.
     edge : (C, 2) int64
         World vertex indices of the boundary edge's ends, or -1 for a collider contact.
     weight : (C,) float64
@@ -181,6 +182,8 @@ class ContactPoints:
         collider for collider contacts.
     friction, static_friction : (C,) float64
         The coefficients the contact used.
+    rigid_body : (C,) int64
+        Index into ``world.bodies`` of the rigid body whose outline the vertex touched, or -1.
     """
 
     vertex: np.ndarray
@@ -191,6 +194,7 @@ class ContactPoints:
     depth: np.ndarray
     friction: np.ndarray
     static_friction: np.ndarray
+    rigid_body: np.ndarray
 
     def __len__(self) -> int:
         return len(self.vertex)
@@ -198,7 +202,7 @@ class ContactPoints:
     @property
     def body_contacts(self) -> np.ndarray:
         """(C,) bool: rows that are body (edge) contacts."""
-        return self.collider < 0
+        return self.edge[:, 0] >= 0
 
 
 
@@ -276,10 +280,11 @@ class Contacts:
         b = self.buffer
         self.buffer = make_buffer(max(2 * need_c, len(b.vertex)), max(2 * need_p, len(b.pair_vertex)))
 
-    def points(self, topo: ContactTopology, rects) -> "ContactPoints":
+    def points(self, topo: ContactTopology, rects, n_colliders: int, rigid_bodies) -> "ContactPoints":
         """The contacts of the last substep as a :class:`ContactPoints`, in world vertex
         indices; ``rects`` are the packed colliders (for the coefficients each collider
-        contact used)."""
+        contact used): the world's ``n_colliders`` first, then the outline of each body in
+        ``rigid_bodies`` (world body indices)."""
         scr, buf, hits = self.scratch, self.buffer, self.hits
         n = int(scr.status["contacts"][0])
         k = buf.vertex[:n]
@@ -290,12 +295,15 @@ class Contacts:
         touched = np.flatnonzero(hits.stamp == stamp) if stamp > 0 else np.zeros(0, int)
         col = hits.collider[touched].astype(np.int64)
         m = len(touched)
+        rigid = np.where(col >= n_colliders, np.asarray(rigid_bodies, np.int64)[np.maximum(col - n_colliders, 0)]
+                         if len(rigid_bodies) else -1, -1)
         return ContactPoints(
             vertex=np.concatenate([touched.astype(np.int64), cv[k]]),
-            collider=np.concatenate([col, np.full(n, -1, np.int64)]),
+            collider=np.concatenate([np.where(col >= n_colliders, -1, col), np.full(n, -1, np.int64)]),
             edge=np.concatenate([np.full((m, 2), -1, np.int64), edge]),
             weight=np.concatenate([np.zeros(m), buf.s[:n]]),
             normal=np.concatenate([hits.normal[touched], buf.normal[:n]]),
             depth=np.concatenate([hits.depth[touched], buf.depth[:n]]),
             friction=np.concatenate([rects[col, RECT_FRICTION], buf.mu[:n, 0]]),
-            static_friction=np.concatenate([rects[col, RECT_STATIC_FRICTION], buf.mu[:n, 1]]))
+            static_friction=np.concatenate([rects[col, RECT_STATIC_FRICTION], buf.mu[:n, 1]]),
+            rigid_body=np.concatenate([rigid, np.full(n, -1, np.int64)]))
