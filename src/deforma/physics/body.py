@@ -42,6 +42,16 @@ def _material(value):
                      f"poisson_ratio=0.3, density=100.0)")
 
 
+def _spin(value, max_speed: float) -> float:
+    """An angular velocity given in deg/s, checked against ``max_speed`` (read as rad/s);
+    returned in rad/s."""
+    spin = math.radians(_number(value, "angular_velocity"))
+    if not abs(spin) <= max_speed:
+        raise ValueError(f"angular_velocity must be within +-{math.degrees(max_speed):g} deg/s "
+                         f"(world.max_speed in rad/s), got {value!r}")
+    return spin
+
+
 def _fem_mesh_check(topology) -> None:
     """Refuse a mesh that cannot be made of finite elements (before anything changes)."""
     element_geometry(topology)  # raises with the reason
@@ -254,7 +264,7 @@ class Body:
     def center_of_mass(self) -> np.ndarray:
         """(2,) centre of mass in metres (vertices weighted by their masses)."""
         m = self._check()._model.vertex_mass[self.vertex_slice]
-        return (m @ self.positions) / m.sum()
+        return rigid_motion.center_of_mass(self.positions, m)
 
     @property
     def velocity(self) -> np.ndarray:
@@ -273,7 +283,7 @@ class Body:
         ([1.0, 2.0], [1.0, 2.0])
         """
         m = self._check()._model.vertex_mass[self.vertex_slice]
-        return (m @ self.velocities) / m.sum()
+        return rigid_motion.center_of_mass(self.velocities, m)  # the momentum over the mass
 
     @velocity.setter
     def velocity(self, value):
@@ -304,10 +314,7 @@ class Body:
     @angular_velocity.setter
     def angular_velocity(self, value):
         world = self._check()
-        spin = math.radians(_number(value, "angular_velocity"))
-        if not abs(spin) <= world.max_speed:
-            raise ValueError(f"angular_velocity must be within +-{math.degrees(world.max_speed):g} deg/s "
-                             f"(world.max_speed in rad/s), got {value!r}")
+        spin = _spin(value, world.max_speed)
         m = world._model.vertex_mass[self.vertex_slice]
         x = self.positions
         _, omega = rigid_motion.linear_and_angular_velocity(x, self.velocities, m)

@@ -28,29 +28,6 @@ if TYPE_CHECKING:
 MAX_MOTOR_SPEED = 1e6
 
 
-def covers(positions: np.ndarray, triangles: np.ndarray, point) -> bool:
-    """Whether ``point`` lies on one of the ``triangles`` (edges included) at ``positions``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> tri = np.array([[0, 1, 2]])
-    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
-    >>> covers(x, tri, (0.2, 0.2)), covers(x, tri, (0.6, 0.6)), covers(x, tri, (0.5, 0.5))
-    (True, False, True)
-    """
-    p = np.asarray(point, np.float64)
-    a, b, c = (positions[triangles[:, k]] for k in range(3))
-
-    def side(u, v):  # twice the signed area of (u, v, p), relative to the triangle's size
-        return (v[:, 0] - u[:, 0]) * (p[1] - u[:, 1]) - (v[:, 1] - u[:, 1]) * (p[0] - u[:, 0])
-
-    area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-    tol = -1e-12 * np.abs(area)  # a point on an edge counts, as rounding would decide it
-    s = np.sign(area)
-    return bool(np.any((s * side(a, b) >= tol) & (s * side(b, c) >= tol) & (s * side(c, a) >= tol)))
-
-
 class Joint:
     """A joint of a world (see :meth:`World.join`).
 

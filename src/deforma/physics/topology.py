@@ -193,6 +193,31 @@ class BodyTopology:
         return lengths(x, e[:, 0], e[:, 1])
 
 
+def triangles_under(x: np.ndarray, triangles: np.ndarray, point, tolerance: float = 0.0) -> np.ndarray:
+    """(M,) bool: which ``triangles`` of the positions ``x`` hold ``point`` (edges included;
+    ``tolerance`` widens them by that share of twice each triangle's area, for a point put
+    on an edge whose rounding would decide it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    >>> t = np.array([[0, 1, 2], [1, 3, 2]])
+    >>> triangles_under(x, t, (0.2, 0.2)).tolist(), triangles_under(x, t, (0.5, 0.5)).tolist()
+    ([True, False], [True, True])
+    """
+    p = np.asarray(point, dtype=np.float64)
+    a, b, c = x[triangles[:, 0]], x[triangles[:, 1]], x[triangles[:, 2]]
+
+    def side(o, q):  # twice the signed area of (o, q, p)
+        return (q[:, 0] - o[:, 0]) * (p[1] - o[:, 1]) - (q[:, 1] - o[:, 1]) * (p[0] - o[:, 0])
+
+    d1, d2, d3 = side(a, b), side(b, c), side(c, a)
+    slack = tolerance * np.abs(d1 + d2 + d3)  # d1 + d2 + d3 is twice the triangle's area
+    return (((d1 >= -slack) & (d2 >= -slack) & (d3 >= -slack))
+            | ((d1 <= slack) & (d2 <= slack) & (d3 <= slack)))
+
+
 def element_geometry(topology: BodyTopology):
     """A body's triangles as finite elements: ``(triangles, B, rest areas, lumped vertex areas,
     order)``, ``order`` (M,) each element's row in ``topology.triangles``.

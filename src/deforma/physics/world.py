@@ -27,7 +27,7 @@ from ..checks import pair as _pair
 from ..checks import positive as _positive
 from ..checks import switch as _switch
 from . import diagnostics, rigid_motion, stepper
-from .body import Body, Grab, _fem_mesh_check, _material, _pressure
+from .body import Body, Grab, _fem_mesh_check, _material, _pressure, _spin
 from .colliders.shapes import INV_INERTIA, INV_MASS, SHAPES, Collider, pack_colliders
 from .contact.clearance import outlines_overlap
 from .contact.contacts import ContactPoints, Contacts
@@ -41,7 +41,7 @@ from .material import Material
 from .model import Model
 from .rigid.stage import RIGID_SUBSTEP, rigid_set
 from .state import State
-from .topology import BodyTopology
+from .topology import BodyTopology, triangles_under
 
 __all__ = ["Body", "Energy", "Grab", "SimulationUnstable", "World"]
 
@@ -527,10 +527,7 @@ class World:
         if not abs(turn) <= MAX_ANGLE:
             raise ValueError(f"angle must be within +-{MAX_ANGLE:g} degrees, got {angle!r}")
         vel = _pair(velocity, "velocity", limit=self.max_speed)
-        spin = _finite(angular_velocity, "angular_velocity")
-        if not abs(math.radians(spin)) <= self.max_speed:
-            raise ValueError(f"angular_velocity must be within +-{math.degrees(self.max_speed):g} deg/s "
-                             f"(world.max_speed in rad/s), got {angular_velocity!r}")
+        spin = _spin(angular_velocity, self.max_speed)
         try:
             vertices, edges = mesh.vertices, mesh.edges
         except AttributeError:
@@ -575,8 +572,7 @@ class World:
         self._bodies.append(body)
         self._rebuild(np.concatenate(xs), np.concatenate(vs))
         if vel != (0.0, 0.0) or spin:
-            body.velocities[...] = rigid_motion.rigid_velocities(body.positions, body.vertex_masses, vel,
-                                                                 math.radians(spin))
+            body.velocities[...] = rigid_motion.rigid_velocities(body.positions, body.vertex_masses, vel, spin)
         if self._auto and not self._integrator.unconditionally_stable:
             try:  # say so now, not at the first step
                 self._substeps = self._auto_substeps(ValueError)
@@ -844,7 +840,7 @@ class World:
         stiffness, damping = _joint.spring(kind, stiffness, damping)
         motor_speed, max_torque = _joint.motor(kind, motor_speed, max_torque)
         on = [body for body in (a, b) if body is not None
-              and _joint.covers(body.positions, body.topology.triangles, point)]
+              and triangles_under(body.positions, body.topology.triangles, point, tolerance=1e-12).any()]
         if not on:
             where = "body " + str(a._index) + ("" if b is None else f" or body {b._index}")
             raise ValueError(f"at = {point} is not on {where}: a joint point must lie on a body it joins")
@@ -965,13 +961,7 @@ class World:
             picked = np.zeros(0, np.int64)
             t = body.triangles
             if len(t):
-                a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
-
-                def cross(o, q):
-                    return (q[:, 0] - o[:, 0]) * (p[1] - o[:, 1]) - (q[:, 1] - o[:, 1]) * (p[0] - o[:, 0])
-                d1, d2, d3 = cross(a, b), cross(b, c), cross(c, a)
-                inside = ((d1 >= 0) & (d2 >= 0) & (d3 >= 0)) | ((d1 <= 0) & (d2 <= 0) & (d3 <= 0))
-                hit = np.flatnonzero(inside)
+                hit = np.flatnonzero(triangles_under(x, t, p))
                 if len(hit):
                     picked = t[hit[0]].astype(np.int64)
             if r is not None and (len(picked) or not len(t)):

@@ -38,6 +38,7 @@ from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 from ..scene.construct import pin_mask
 from ..physics.material import material_models
+from ..physics.topology import triangles_under
 from ..scene.tables import MATERIAL_MODELS, BodyPhysics
 from .params import INTEGRATOR_PREFIX, integrator_params
 
@@ -455,12 +456,7 @@ class Session:
             x, t = bodies[k].positions, bodies[k].triangles
             if not len(t):
                 continue
-            a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
-
-            def side(o, q):
-                return (q[:, 0] - o[:, 0]) * (p[1] - o[:, 1]) - (q[:, 1] - o[:, 1]) * (p[0] - o[:, 0])
-            d1, d2, d3 = side(a, b), side(b, c), side(c, a)
-            if np.any(((d1 >= 0) & (d2 >= 0) & (d3 >= 0)) | ((d1 <= 0) & (d2 <= 0) & (d3 <= 0))):
+            if triangles_under(x, t, p).any():
                 return k, int(np.argmin(np.linalg.norm(x - p, axis=1)))
         best = None
         for k, body in enumerate(bodies):

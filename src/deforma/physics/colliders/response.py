@@ -303,7 +303,6 @@ def note_impulse(hits, i, r, qx, qy, ux, uy, px, py, vx, vy):
     hits.dv[i, 1] += vy - uy
     hits.dm[i] += (px * vy - py * vx) - (qx * uy - qy * ux)
     hits.dv_collider[i] = r
-    hits.dv_collider[i] = r
 
 
 @njit(cache=True, inline="always")
@@ -317,6 +316,25 @@ def record_hit(hits, i, stamp, r, nx, ny, depth, qx, qy, ux, uy, px, py, vx, vy)
     hits.normal[i, 1] = ny
     hits.depth[i] = depth
     note_impulse(hits, i, r, qx, qy, ux, uy, px, py, vx, vy)
+
+
+@njit(cache=True, inline="always")
+def push_rigid_row(rects, r, ax, ay, jx, jy):
+    """Give the rigid body of packed row ``r`` the impulse ``-(jx, jy)`` (N s) at the arm
+    ``(ax, ay)`` from its centre: the opposite of what a soft vertex took from it, so that
+    the next vertex meets it moving (its row's velocity and spin)."""
+    rects[r, VEL_X] -= rects[r, INV_MASS] * jx
+    rects[r, VEL_Y] -= rects[r, INV_MASS] * jy
+    rects[r, OMEGA] -= rects[r, INV_INERTIA] * (ax * jy - ay * jx)
+
+
+@njit(cache=True, inline="always")
+def has_rigid_rows(rects) -> bool:
+    """Whether any packed row is a rigid body's outline (``INV_MASS`` > 0)."""
+    for r in range(n_colliders(rects)):
+        if rects[r, INV_MASS] != 0.0:
+            return True
+    return False
 
 
 @njit(cache=True)
@@ -372,11 +390,7 @@ def collide_dynamic(x, v, inv_mass, x_start, rects, hits, stamp, h):
     """
     moved = 0
     n_rects = n_colliders(rects)
-    dynamic = False
-    for r in range(n_rects):
-        if rects[r, INV_MASS] != 0.0:
-            dynamic = True
-    if not dynamic:
+    if not has_rigid_rows(rects):
         return 0
     for i in range(x.shape[0]):
         w = inv_mass[i]
@@ -397,8 +411,9 @@ def collide_dynamic(x, v, inv_mass, x_start, rects, hits, stamp, h):
             ax, ay = qx - cx, qy - cy
             om = rects[r, OMEGA]
             ux, uy = v[i, 0], v[i, 1]
-            vn = (ux - rects[r, VEL_X] + om * ay) * nx + (uy - rects[r, VEL_Y] - om * ax) * ny
-            vt = (ux - rects[r, VEL_X] + om * ay) * tx + (uy - rects[r, VEL_Y] - om * ax) * ty
+            rvx, rvy = ux - rects[r, VEL_X] + om * ay, uy - rects[r, VEL_Y] - om * ax  # relative to q on the body
+            vn = rvx * nx + rvy * ny
+            vt = rvx * tx + rvy * ty
             big_i = rects[r, INV_INERTIA]
             an = ax * ny - ay * nx
             at = ax * ty - ay * tx
@@ -410,9 +425,7 @@ def collide_dynamic(x, v, inv_mass, x_start, rects, hits, stamp, h):
             jt = (coulomb(vt, jn * kt, rects[r, RECT_STATIC_FRICTION], rects[r, RECT_FRICTION]) - vt) / kt
             jx, jy = jn * nx + jt * tx, jn * ny + jt * ty
             vx, vy = ux + w * jx, uy + w * jy
-            rects[r, VEL_X] -= big_w * jx
-            rects[r, VEL_Y] -= big_w * jy
-            rects[r, OMEGA] -= big_i * (ax * jy - ay * jx)
+            push_rigid_row(rects, r, ax, ay, jx, jy)
             skin = rects[r, RECT_SKIN]
             shift = h * w * jt  # the position the corrected velocity would have reached
             qx2, qy2 = qx + skin * nx + shift * tx, qy + skin * ny + shift * ty

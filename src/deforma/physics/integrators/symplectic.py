@@ -32,8 +32,8 @@ import numpy as np
 from numba import njit, prange
 
 from ..colliders.geometry import advance_colliders, jump_reach, n_colliders
-from ..colliders.response import collide_point, record_hit
-from ..colliders.shapes import INV_MASS, RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
+from ..colliders.response import collide_point, has_rigid_rows, record_hit
+from ..colliders.shapes import RECT_XMAX, RECT_XMIN, RECT_YMAX, RECT_YMIN
 from ..contact.broad_phase import gather_start
 from ..elements.springs import SpringArrays, scatter_spring_forces
 from ..elements.triangles import TriangleArrays, element_forces
@@ -87,10 +87,7 @@ def _symplectic_euler(x, v, fbuf, chunk_ptr, elem_ptr, chunk_vertices, springs, 
     n_chunks = chunk_ptr.shape[0] - 1
     reach2 = jump_reach(rects)
     n_rects = n_colliders(rects)
-    dynamic = False  # a rigid body's outline among the colliders: the substep's start is kept for it
-    for r in range(n_rects):
-        if rects[r, INV_MASS] != 0.0:
-            dynamic = True
+    dynamic = has_rigid_rows(rects)  # then the substep's start is kept for collide_dynamic
     x_start = np.empty_like(x) if dynamic else np.empty((0, 2))
     for sub in range(substeps):
         advance_colliders(rects, h)  # moving colliders to where they are at the end of the substep

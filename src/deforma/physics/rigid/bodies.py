@@ -12,7 +12,7 @@ import numpy as np
 
 from ..behaviours.pressure import _loops
 from ..colliders.shapes import POLYGON, _polygon_reach
-from ..rigid_motion import fit_angle, linear_and_angular_velocity
+from ..rigid_motion import center_of_mass, fit_angle, linear_and_angular_velocity
 
 
 def triangle_inertia(x: np.ndarray, triangles: np.ndarray, density: float) -> tuple[float, np.ndarray, float]:
@@ -136,7 +136,7 @@ class RigidSet:
             sl = slice(off[b], off[b + 1])
             m = model.vertex_mass[sl]
             xb = x[sl]
-            center[j] = (m @ xb) / m.sum()
+            center[j] = center_of_mass(xb, m)
             angle[j] = fit_angle(model.topologies[b].rest_positions, xb, m)
             vel[j], omega[j] = linear_and_angular_velocity(xb, v[sl], m)
         return center, angle, vel, omega

@@ -64,8 +64,10 @@ def _masses(inv_mass, inv_inertia, k):
 
 
 @njit(cache=True, inline="always")
-def _push(vel, omega, inv_mass, inv_inertia, k, rx, ry, px, py, ang, sign):
-    """Give side ``k`` the impulse ``sign * (px, py)`` at its arm and ``sign * ang`` about its centre."""
+def apply_impulse(vel, omega, inv_mass, inv_inertia, k, rx, ry, px, py, ang, sign):
+    """Give rigid body ``k`` (-1: a collider or the world, which nothing moves) the impulse
+    ``sign * (px, py)`` (N s) at its arm ``(rx, ry)`` from its centre, and ``sign * ang``
+    (N m s) about its centre: the joints' and the contacts' one way to push a body."""
     if k < 0:
         return
     vel[k, 0] += sign * inv_mass[k] * px
@@ -81,8 +83,8 @@ def warm_start_joints(center, angle, vel, omega, inv_mass, inv_inertia, body, lo
         rax, ray, _, _ = _arm(center, angle, local[j], a, 0)
         rbx, rby, _, _ = _arm(center, angle, local[j], b, 2)
         ang = acc[j, 2] + (acc[j, 3] if motor[j] else 0.0)
-        _push(vel, omega, inv_mass, inv_inertia, a, rax, ray, acc[j, 0], acc[j, 1], ang, 1.0)
-        _push(vel, omega, inv_mass, inv_inertia, b, rbx, rby, acc[j, 0], acc[j, 1], ang, -1.0)
+        apply_impulse(vel, omega, inv_mass, inv_inertia, a, rax, ray, acc[j, 0], acc[j, 1], ang, 1.0)
+        apply_impulse(vel, omega, inv_mass, inv_inertia, b, rbx, rby, acc[j, 0], acc[j, 1], ang, -1.0)
 
 
 @njit(cache=True)
@@ -142,8 +144,8 @@ def joint_velocities(center, angle, vel, omega, inv_mass, inv_inertia, body, loc
         py = -(k11 * dvy - k12 * dvx) / det
         acc[j, 0] += px
         acc[j, 1] += py
-        _push(vel, omega, inv_mass, inv_inertia, a, rax, ray, px, py, 0.0, 1.0)
-        _push(vel, omega, inv_mass, inv_inertia, b, rbx, rby, px, py, 0.0, -1.0)
+        apply_impulse(vel, omega, inv_mass, inv_inertia, a, rax, ray, px, py, 0.0, 1.0)
+        apply_impulse(vel, omega, inv_mass, inv_inertia, b, rbx, rby, px, py, 0.0, -1.0)
 
 
 @njit(cache=True)
@@ -187,5 +189,5 @@ def joint_positions(center, angle, vel, omega, inv_mass, inv_inertia, body, loca
             center[b, 0] -= mb * px
             center[b, 1] -= mb * py
             angle[b] -= ib * (rbx * py - rby * px)
-        _push(vel, omega, inv_mass, inv_inertia, a, rax, ray, px / h, py / h, 0.0, 1.0)
-        _push(vel, omega, inv_mass, inv_inertia, b, rbx, rby, px / h, py / h, 0.0, -1.0)
+        apply_impulse(vel, omega, inv_mass, inv_inertia, a, rax, ray, px / h, py / h, 0.0, 1.0)
+        apply_impulse(vel, omega, inv_mass, inv_inertia, b, rbx, rby, px / h, py / h, 0.0, -1.0)

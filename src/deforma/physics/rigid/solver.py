@@ -33,10 +33,6 @@ from numba import njit
 
 from ..colliders.geometry import exit_face, n_colliders, point_inside
 from ..colliders.shapes import (
-    EDGE_AX,
-    EDGE_AY,
-    EDGE_BX,
-    EDGE_BY,
     EDGE_NX,
     EDGE_NY,
     OMEGA,
@@ -54,8 +50,7 @@ from ..colliders.shapes import (
     VEL_X,
     VEL_Y,
 )
-
-from .joints import joint_positions, joint_velocities, warm_start_joints
+from .joints import apply_impulse, joint_positions, joint_velocities, warm_start_joints
 
 SLOP = 5e-4        # m: overlap the projection leaves (a resting contact stays a contact)
 BAUMGARTE = 0.5    # share of the overlap beyond SLOP removed per substep
@@ -93,15 +88,6 @@ def place_outlines(rects, first_row, edge_ptr, edges_local, center, angle, vel, 
 @njit(cache=True, inline="always")
 def _cross(ax, ay, bx, by):
     return ax * by - ay * bx
-
-
-@njit(cache=True)
-def _apply(vel, omega, inv_mass, inv_inertia, k, rx, ry, jx, jy, sign):
-    if k < 0:
-        return
-    vel[k, 0] += sign * jx * inv_mass[k]
-    vel[k, 1] += sign * jy * inv_mass[k]
-    omega[k] += sign * _cross(rx, ry, jx, jy) * inv_inertia[k]
 
 
 @njit(cache=True)
@@ -206,7 +192,8 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
             for r in range(n_rows):
                 if r == first_row + k or (r >= first_row and r - first_row < nk and joined[k, r - first_row]):
                     continue
-                if not (rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX] and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]):
+                if not (rects[r, RECT_XMIN] < px < rects[r, RECT_XMAX]
+                        and rects[r, RECT_YMIN] < py < rects[r, RECT_YMAX]):
                     continue
                 if not point_inside(rects, r, px, py):
                     continue
@@ -248,8 +235,8 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
                 c_j[c, 0], c_j[c, 1] = cache_impulse[o, 0], cache_impulse[o, 1]
                 jx = c_j[c, 0] * bnx + c_j[c, 1] * tx
                 jy = c_j[c, 0] * bny + c_j[c, 1] * ty
-                _apply(vel, omega, inv_mass, inv_inertia, k, rx, ry, jx, jy, 1.0)
-                _apply(vel, omega, inv_mass, inv_inertia, b, c_rb[c, 0], c_rb[c, 1], jx, jy, -1.0)
+                apply_impulse(vel, omega, inv_mass, inv_inertia, k, rx, ry, jx, jy, 0.0, 1.0)
+                apply_impulse(vel, omega, inv_mass, inv_inertia, b, c_rb[c, 0], c_rb[c, 1], jx, jy, 0.0, -1.0)
             else:
                 c_j[c, 0] = c_j[c, 1] = 0.0
         warm_start_joints(center, angle, vel, omega, inv_mass, inv_inertia, j_body, j_local, j_kind, j_motor, j_acc)
@@ -270,8 +257,8 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
                 jn = max(jn_old - (dvx * nx + dvy * ny) * c_mass[c, 0], 0.0)
                 d = jn - jn_old
                 c_j[c, 0] = jn
-                _apply(vel, omega, inv_mass, inv_inertia, k, rx, ry, d * nx, d * ny, 1.0)
-                _apply(vel, omega, inv_mass, inv_inertia, b, sx, sy, d * nx, d * ny, -1.0)
+                apply_impulse(vel, omega, inv_mass, inv_inertia, k, rx, ry, d * nx, d * ny, 0.0, 1.0)
+                apply_impulse(vel, omega, inv_mass, inv_inertia, b, sx, sy, d * nx, d * ny, 0.0, -1.0)
                 # friction: stick within static friction, else slide against dynamic friction
                 ax_, ay_ = _point_velocity(vel, omega, rects, k, row, rx, ry, 0.0, 0.0)
                 bx_, by_ = _point_velocity(vel, omega, rects, b, row, sx, sy, c_q[c, 0], c_q[c, 1])
@@ -283,8 +270,8 @@ def solve_rigid(center, angle, vel, omega, inv_mass, inv_inertia, force, impulse
                     jt = min(max(jt, -limit), limit)
                 d = jt - jt_old
                 c_j[c, 1] = jt
-                _apply(vel, omega, inv_mass, inv_inertia, k, rx, ry, d * tx, d * ty, 1.0)
-                _apply(vel, omega, inv_mass, inv_inertia, b, sx, sy, d * tx, d * ty, -1.0)
+                apply_impulse(vel, omega, inv_mass, inv_inertia, k, rx, ry, d * tx, d * ty, 0.0, 1.0)
+                apply_impulse(vel, omega, inv_mass, inv_inertia, b, sx, sy, d * tx, d * ty, 0.0, -1.0)
         for c in range(count):
             o = c_o[c]
             cache_row[o] = c_row[c]

@@ -106,8 +106,8 @@ import numpy as np
 from numba import njit
 
 from ...colliders.geometry import advance_colliders
-from ...colliders.response import note_impulse
-from ...colliders.shapes import INV_INERTIA, INV_MASS, OMEGA, RECT_CX, RECT_CY, VEL_X, VEL_Y
+from ...colliders.response import note_impulse, push_rigid_row
+from ...colliders.shapes import INV_MASS, RECT_CX, RECT_CY, VEL_X, VEL_Y
 from ..base import (Integrator, Option, StepReport, contact_epilogue, finish_position_step, held_contacts,
                     register_integrator)
 from .anderson import AndersonMixing
@@ -292,10 +292,7 @@ def rigid_plane_impulses(x, index, rows, count, weight, target, rects, hits, inv
             continue
         w = inv_mass[i]
         note_impulse(hits, i, r, x[i, 0], x[i, 1], 0.0, 0.0, x[i, 0], x[i, 1], w * jx, w * jy)
-        ax, ay = x[i, 0] - rects[r, RECT_CX], x[i, 1] - rects[r, RECT_CY]
-        rects[r, VEL_X] -= rects[r, INV_MASS] * jx
-        rects[r, VEL_Y] -= rects[r, INV_MASS] * jy
-        rects[r, OMEGA] -= rects[r, INV_INERTIA] * (ax * jy - ay * jx)
+        push_rigid_row(rects, r, x[i, 0] - rects[r, RECT_CX], x[i, 1] - rects[r, RECT_CY], jx, jy)
 
 
 @njit(cache=True)
@@ -648,7 +645,8 @@ class ImplicitEuler(Integrator):
             # have a row of vertices pushed through the next, and the iteration keeps it.
             count, n_body = held_contacts(x_n, y, rects, self._planes, self._touch, self._plane_rows, True, float(h),
                                           topo, scr, buf)
-            recoil_planes(self._planes, self._touch, self._plane_rows, count, x_n, y, model.vertex_mass, rects, float(h))
+            recoil_planes(self._planes, self._touch, self._plane_rows, count, x_n, y, model.vertex_mass, rects,
+                          float(h))
             if n_body < 0:
                 return StepReport(0, False)  # the contact buffer is too small; the world grows it and repeats
             cv = topo.cv_vertex
