@@ -11,7 +11,7 @@ from deforma.physics.elements import triangles as triangles_module
 from deforma.physics.elements.kind import ElementKind, register_element_kind, unregister_element_kind
 from deforma.physics.elements.triangles import deformation_gradients, rest_geometry
 
-INTEGRATORS = ["symplectic-euler", "implicit-euler", "xpbd"]
+INTEGRATORS = ["symplectic-euler", "implicit-euler", "xpbd", "avbd"]
 
 
 def area_shape(x, tris, b):

@@ -7,6 +7,8 @@ kind a user writes) and the kernels the integrators need, each over all its elem
 - :meth:`ElementKind.energy`, :meth:`ElementKind.gradient_hessian`: the elastic energy (J)
   per element, its gradient per element corner and its Hessian block, projected to be
   positive semi-definite (what a Newton-type solver and, later, gradients need);
+- :meth:`ElementKind.vertex_blocks` (avbd): per vertex, the gradient and the 2 x 2 Hessian
+  block (damping included) of the elements around it;
 - :meth:`ElementKind.begin_substep`, :meth:`ElementKind.project` (XPBD): one Gauss-Seidel
   sweep over its constraints, with multipliers that start each substep at zero;
 - :meth:`ElementKind.matrix_weights`, :meth:`ElementKind.matrix_entries`,
@@ -102,6 +104,26 @@ class ElementKind:
         By default minus the energy's gradient (no damping)."""
         g, _ = self.gradient_hessian(x)
         np.subtract.at(f, self.vertices.ravel(), g.reshape(-1, 2))
+
+    # -- vertex block descent (avbd) ----------------------------------------------------------
+    def vertex_blocks(self, x, x_n, h: float, g, hb) -> None:
+        """Add each vertex's share of the elements' energy gradient to ``g`` (N, 2), N, and
+        of its diagonal Hessian block to ``hb`` (N, 3: xx, xy, yy), N/m, at positions ``x``
+        (``x_n``: at the start of the step of ``h`` s, for damping).
+
+        The fallback for a registered kind: the corners' gradients and diagonal blocks of
+        :meth:`gradient_hessian` (already positive semi-definite), with no damping. The
+        built-in kinds add their damping too."""
+        grad, hess = self.gradient_hessian(x)
+        vertices = np.asarray(self.vertices)
+        k = vertices.shape[1]
+        flat = vertices.ravel()
+        np.add.at(g, flat, grad.reshape(-1, 2))
+        c = np.arange(k)
+        hxx = hess[:, 2 * c, 2 * c].ravel()
+        hxy = 0.5 * (hess[:, 2 * c, 2 * c + 1] + hess[:, 2 * c + 1, 2 * c]).ravel()
+        hyy = hess[:, 2 * c + 1, 2 * c + 1].ravel()
+        np.add.at(hb, flat, np.stack([hxx, hxy, hyy], axis=1))
 
     # -- XPBD ----------------------------------------------------------------------------------
     def begin_substep(self) -> None:

@@ -205,6 +205,45 @@ def spring_gradient_hessian(x, spring_i, spring_j, rest, ks, grad, hess):
                 hess[e, 2 * a + 1, 2 * c + 1] = sign * k11
 
 
+@njit(cache=True, inline="always")
+def spring_vertex_block(x, x_n, i, j, rest, ks, kd, inv_h):
+    """A spring's share of the block of its end ``i`` (the other end ``j``): ``(gx, gy, hxx,
+    hxy, hyy)``."""
+    dx = x[j, 0] - x[i, 0]
+    dy = x[j, 1] - x[i, 1]
+    length = np.sqrt(dx * dx + dy * dy)
+    if length > 0.0:
+        ux, uy = dx / length, dy / length
+        t = max(1.0 - rest / length, 0.0)
+    else:  # coincident ends: no direction; the stiffness along any is ks, none across
+        ux, uy, t = 1.0, 0.0, 0.0
+    f = ks * (length - rest)
+    # relative velocity along the spring, (v_j - v_i) . u with v = (x - x_n) / h
+    rv = ((x[j, 0] - x_n[j, 0] - x[i, 0] + x_n[i, 0]) * ux + (x[j, 1] - x_n[j, 1] - x[i, 1] + x_n[i, 1]) * uy) * inv_h
+    f += kd * rv
+    kk = ks + kd * inv_h
+    hxx = kk * ux * ux + ks * t * (1.0 - ux * ux)
+    hxy = kk * ux * uy - ks * t * ux * uy
+    hyy = kk * uy * uy + ks * t * (1.0 - uy * uy)
+    return -f * ux, -f * uy, hxx, hxy, hyy
+
+
+
+@njit(cache=True)
+def spring_vertex_blocks(x, x_n, spring_i, spring_j, rest, ks, kd, inv_h, g, hb):
+    """Every spring's share of both its ends' blocks (:func:`spring_vertex_block`), added to
+    ``g`` (N, 2) and ``hb`` (N, 3: xx, xy, yy)."""
+    for s in range(spring_i.shape[0]):
+        for end in range(2):
+            i, j = (spring_i[s], spring_j[s]) if end == 0 else (spring_j[s], spring_i[s])
+            gx, gy, hxx, hxy, hyy = spring_vertex_block(x, x_n, i, j, rest[s], ks[s], kd[s], inv_h)
+            g[i, 0] += gx
+            g[i, 1] += gy
+            hb[i, 0] += hxx
+            hb[i, 1] += hxy
+            hb[i, 2] += hyy
+
+
 class SpringKind(ElementKind):
     """The springs of every body of the ``"springs"`` material: a view of the Model's
     ``spring_*`` arrays (which plasticity and the body parameters change in place).
@@ -253,6 +292,10 @@ class SpringKind(ElementKind):
         a = self.arrays
         scatter_spring_forces(x, v, a.i, a.j, a.rest, a.ks,
                               a.kd, f)
+
+    def vertex_blocks(self, x, x_n, h, g, hb) -> None:
+        a = self.arrays
+        spring_vertex_blocks(x, x_n, a.i, a.j, a.rest, a.ks, a.kd, 1.0 / h, g, hb)
 
     def begin_substep(self) -> None:
         if self._lam is None:

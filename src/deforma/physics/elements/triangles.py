@@ -476,6 +476,96 @@ def triangle_gradient_hessian(x, elem, b, area, mu, lam, kind, grad, hess):
                 hess[e, p, q] = area[e] * s
 
 
+@njit(cache=True, inline="always")
+def shape_gradient(corner, b0, b1, b2, b3):
+    """``D_a`` of corner ``corner`` (0, 1, 2 for ``i, j, k``) from the rest-shape inverse."""
+    if corner == 1:
+        return b0, b1
+    if corner == 2:
+        return b2, b3
+    return -b0 - b2, -b1 - b3
+
+
+@njit(cache=True, inline="always")
+def psd2(hxx, hxy, hyy):
+    """The symmetric 2 x 2 block ``[[hxx, hxy], [hxy, hyy]]`` with its negative eigenvalues
+    set to zero."""
+    tr = 0.5 * (hxx + hyy)
+    d = 0.5 * (hxx - hyy)
+    r = np.sqrt(d * d + hxy * hxy)
+    lo = tr - r
+    if lo >= 0.0:
+        return hxx, hxy, hyy
+    hi = tr + r
+    if hi <= 0.0:
+        return 0.0, 0.0, 0.0
+    # only the larger eigenvalue stays: hi q q^T, q its unit eigenvector
+    if r == 0.0:
+        return hi, 0.0, hi
+    cx, cy = d + r, hxy  # an eigenvector of hi (or (hxy, r - d) when this one is zero)
+    n2 = cx * cx + cy * cy
+    if n2 < 1e-300:
+        cx, cy = hxy, r - d
+        n2 = cx * cx + cy * cy
+    return hi * cx * cx / n2, hi * cx * cy / n2, hi * cy * cy / n2
+
+
+@njit(cache=True)
+def triangle_vertex_block(x, x_n, e, corner, elem, b, area, mu, lam, beta, kind, inv_h, hf):
+    """Element ``e``'s share of the block of its corner ``corner``: ``(gx, gy, hxx, hxy,
+    hyy)``. ``hf`` is (4, 4) scratch."""
+    i, j, k = elem[e, 0], elem[e, 1], elem[e, 2]
+    b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+    d0, d1 = shape_gradient(corner, b0, b1, b2, b3)
+    f00, f01, f10, f11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
+    p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
+    a = area[e]
+    gx = a * (p00 * d0 + p01 * d1)
+    gy = a * (p10 * d0 + p11 * d1)
+    if kind[e] == KIND_COROTATED:
+        corotated.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
+    else:
+        neo_hookean.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
+    # H[s, t] = A sum_{c, c'} hf[2 s + c, 2 t + c'] d_c d_c'
+    hxx = a * (hf[0, 0] * d0 * d0 + (hf[0, 1] + hf[1, 0]) * d0 * d1 + hf[1, 1] * d1 * d1)
+    hxy = a * (hf[0, 2] * d0 * d0 + (hf[0, 3] + hf[1, 2]) * d0 * d1 + hf[1, 3] * d1 * d1)
+    hyy = a * (hf[2, 2] * d0 * d0 + (hf[2, 3] + hf[3, 2]) * d0 * d1 + hf[3, 3] * d1 * d1)
+    hxx, hxy, hyy = psd2(hxx, hxy, hyy)
+    be = beta[e]
+    if be > 0.0:
+        # the damping stress of the rate F(x - x_n) / h, and beta / h times its linear stiffness
+        r00, r01, r10, r11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
+        q00, q01, q10, q11 = deformation_gradient(x_n, i, j, k, b0, b1, b2, b3)
+        s00, s01, s10, s11 = rate_stress(f00, f01, f10, f11, (r00 - q00) * inv_h, (r01 - q01) * inv_h,
+                                         (r10 - q10) * inv_h, (r11 - q11) * inv_h, mu[e], lam[e])
+        gx += a * be * (s00 * d0 + s01 * d1)
+        gy += a * be * (s10 * d0 + s11 * d1)
+        w = a * be * inv_h
+        u00, u01, u10, u11 = rate_stress(f00, f01, f10, f11, d0, d1, 0.0, 0.0, mu[e], lam[e])  # x moves
+        v00, v01, v10, v11 = rate_stress(f00, f01, f10, f11, 0.0, 0.0, d0, d1, mu[e], lam[e])  # y moves
+        hxx += w * (u00 * d0 + u01 * d1)
+        hxy += w * (v00 * d0 + v01 * d1)
+        hyy += w * (v10 * d0 + v11 * d1)
+    return gx, gy, hxx, hxy, hyy
+
+
+
+@njit(cache=True)
+def triangle_vertex_blocks(x, x_n, elem, b, area, mu, lam, beta, kind, inv_h, g, hb):
+    """Every element's share of each corner's block (:func:`triangle_vertex_block`), added
+    to ``g`` (N, 2) and ``hb`` (N, 3: xx, xy, yy)."""
+    hf = np.empty((4, 4))
+    for e in range(elem.shape[0]):
+        for c in range(3):
+            v = elem[e, c]
+            gx, gy, hxx, hxy, hyy = triangle_vertex_block(x, x_n, e, c, elem, b, area, mu, lam, beta, kind, inv_h, hf)
+            g[v, 0] += gx
+            g[v, 1] += gy
+            hb[v, 0] += hxx
+            hb[v, 1] += hxy
+            hb[v, 2] += hyy
+
+
 def triangle_weights(area, beta, mu, lam, h: float) -> np.ndarray:
     """Weight (kg) of each element in implicit Euler's constant matrix: ``A (h^2 + h beta) k``,
     ``k`` its stiffness bound (:func:`max_stiffness`)."""
@@ -532,6 +622,10 @@ class TriangleKind(ElementKind):
         if len(a.elem):
             element_forces(x, v, a.elem, a.b, a.area, a.mu, a.lam, a.beta,
                            a.kind, bool(a.beta.any()), f)
+
+    def vertex_blocks(self, x, x_n, h, g, hb) -> None:
+        a = self.arrays
+        triangle_vertex_blocks(x, x_n, a.elem, a.b, a.area, a.mu, a.lam, a.beta, a.kind, 1.0 / h, g, hb)
 
     def begin_substep(self) -> None:
         if self._lam is None:

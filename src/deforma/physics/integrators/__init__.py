@@ -5,14 +5,16 @@
 - :mod:`~deforma.physics.integrators.symplectic`: ``"symplectic-euler"`` (the default);
 - :mod:`~deforma.physics.integrators.implicit`: ``"implicit-euler"`` and, second order,
   ``"implicit-bdf2"``;
-- :mod:`~deforma.physics.integrators.xpbd`: ``"xpbd"``.
+- :mod:`~deforma.physics.integrators.xpbd`: ``"xpbd"``;
+- :mod:`~deforma.physics.integrators.avbd`: ``"avbd"``, Augmented Vertex Block Descent.
 
-Importing this package registers the four, the default first.
+Importing this package registers the five, the default first.
 """
 
 # isort: skip_file
 from .base import available_integrators, make_integrator, register_integrator
 from . import symplectic, implicit, xpbd  # noqa: F401  (each registers its integrator; the default first)
 from .implicit import bdf2  # noqa: F401  (after xpbd: the first three keep their order)
+from . import avbd  # noqa: F401
 
 __all__ = ["available_integrators", "make_integrator", "register_integrator"]

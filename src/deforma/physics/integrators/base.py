@@ -21,10 +21,11 @@ the integrator's own work; the collider response per vertex; then :func:`contact
 sweep (XPBD, implicit Euler) also list them first, for the predicted motion
 (:func:`held_contacts`), and end with velocities from positions (:func:`finish_position_step`).
 
-Three are registered, one module each, by :mod:`deforma.physics.integrators`:
+Five are registered, one module each, by :mod:`deforma.physics.integrators`:
 ``"symplectic-euler"`` (:mod:`~deforma.physics.integrators.symplectic`, the default),
-``"implicit-euler"`` (:mod:`~deforma.physics.integrators.implicit`) and ``"xpbd"``
-(:mod:`~deforma.physics.integrators.xpbd`). Another is a subclass of :class:`Integrator`
+``"implicit-euler"`` and ``"implicit-bdf2"`` (:mod:`~deforma.physics.integrators.implicit`),
+``"xpbd"`` (:mod:`~deforma.physics.integrators.xpbd`) and ``"avbd"``
+(:mod:`~deforma.physics.integrators.avbd`). Another is a subclass of :class:`Integrator`
 registered with :func:`register_integrator`; its :attr:`Integrator.OPTIONS` are its settings
 (``World(integrator_options=...)``, ``world.integrator_options``, the scene key
 ``[physics.integrator_options]``).

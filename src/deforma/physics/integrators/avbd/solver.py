@@ -1,0 +1,536 @@
+"""``"avbd"``: Augmented Vertex Block Descent (Chen, Ferguson, Yuksel, "Vertex Block Descent",
+SIGGRAPH 2024; Giles, Diaz, Yuksel, "Augmented Vertex Block Descent", SIGGRAPH 2025).
+
+One step of ``h`` (per substep)::
+
+    collide: the collider contacts of the predicted motion, as rows (rows.py), warm-started
+    y = x_n + h v_n + h^2 (g + f / m)                    # the inertial target
+    x = x_n + h v_n + h^2 a~                             # adaptive start (a~: last step's
+                                                         #   acceleration along g, in [0, g])
+    repeat iterations (or until every vertex moves less than tolerance * h):
+        for colour in colours:                           # vertices sharing no element
+            for vertex i in colour:
+                g = M/h^2 (x_i - y_i) + sum element gradients + grab + rows
+                H = M/h^2 + sum element blocks (PSD) + grab + rows
+                x_i -= H^-1 g
+        x = omega (x - x'') + x''                        # Chebyshev, if rho > 0
+        rows: lambda = clamp(k C + lambda); k += beta |C| inside the bounds
+    v = (x - x_n) / h;  the collider fail-safe and the body contact stage
+
+Each vertex block is one Newton step on backward Euler's objective restricted to the vertex
+(:mod:`~deforma.physics.integrators.avbd.blocks`), so any iteration budget is stable, and run
+to a tolerance the step is backward Euler's. A plain sweep carries information about one ring
+of vertices per colour pass, so a large stiff body is softer than its material at a small
+budget; Chebyshev's semi-iterative acceleration (VBD's, ``chebyshev`` the spectral radius it
+assumes) speeds that up.
+
+Collider contacts and their Coulomb friction are rows inside the sweep
+(:mod:`~deforma.physics.integrators.avbd.rows`); contacts between and within bodies are met
+after it by the shared contact stage, as for the other position-based integrators. Pins stay
+put (infinite mass); a grab is a zero-length spring of its strength to its target.
+
+Units: m, s, kg, N, N/m.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ...colliders.geometry import advance_colliders
+from ...colliders.response import contact_planes
+from ...contact.broad_phase import gather_start
+from ..base import Integrator, Option, StepReport, contact_epilogue, finish_position_step, register_integrator
+from ...elements.springs import spring_vertex_block
+from ...elements.triangles import triangle_vertex_block
+from .blocks import incidence
+from .colouring import colour_vertices
+from .rows import MEMORY_COLUMNS, ROW_COLUMNS, close_rows, contact_block, contact_energy, start_rows, update_rows
+
+
+@njit(cache=True)
+def predict(x, v, x_n, y, v_last, has_last, inv_mass, gx, gy, keep, force, has_force, h):
+    """Start a substep: ``x_n = x``, the inertial target ``y`` (gravity, the applied
+    ``force`` if ``has_force``, air drag's ``keep``), and ``x`` moved to the adaptive start
+    ``x_n + h v + h^2 a~``: ``a~`` is gravity scaled by how much of it the vertex took last
+    substep (its acceleration then, ``(v - v_last) / h``, along gravity, clamped to ``[0,
+    g]``): a resting vertex starts where it is, a falling one where free fall takes it.
+    ``v_last`` then takes ``v``."""
+    g2 = gx * gx + gy * gy
+    h2 = h * h
+    for i in range(x.shape[0]):
+        x_n[i, 0] = x[i, 0]
+        x_n[i, 1] = x[i, 1]
+        if inv_mass[i] == 0.0:  # pinned: it stays
+            y[i, 0], y[i, 1] = x[i, 0], x[i, 1]
+            v_last[i, 0] = v_last[i, 1] = 0.0
+            continue
+        ax, ay = gx, gy
+        if has_force:
+            ax += force[i, 0] * inv_mass[i]
+            ay += force[i, 1] * inv_mass[i]
+        vx, vy = v[i, 0] * keep, v[i, 1] * keep
+        y[i, 0] = x[i, 0] + h * vx + h2 * keep * ax
+        y[i, 1] = x[i, 1] + h * vy + h2 * keep * ay
+        share = 1.0
+        if has_last and g2 > 0.0:
+            along = ((v[i, 0] - v_last[i, 0]) * gx + (v[i, 1] - v_last[i, 1]) * gy) / (h * g2)
+            share = min(max(along, 0.0), 1.0)
+        v_last[i, 0], v_last[i, 1] = v[i, 0], v[i, 1]
+        x[i, 0] = x[i, 0] + h * vx + h2 * keep * (share * gx + ax - gx)
+        x[i, 1] = x[i, 1] + h * vy + h2 * keep * (share * gy + ay - gy)
+
+
+@njit(cache=True, inline="always")
+def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, vertex_row, planes, rows):
+    """Finish vertex ``i``'s block (its elements' share ``g``, ``H`` given): add the inertia,
+    its grab and its contact row, and take the Newton step. Returns the squared move (m^2)."""
+    m = mass_h2[i]
+    gx += m * (x[i, 0] - y[i, 0])
+    gy += m * (x[i, 1] - y[i, 1])
+    hxx += m
+    hyy += m
+    s = grab_slot[i]
+    if s >= 0:  # a zero-length spring of strength S to the target: S (x - t)
+        gx += grab_pull[s, 0] * x[i, 0] - grab_pull[s, 1]
+        gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
+        hxx += grab_pull[s, 0]
+        hyy += grab_pull[s, 0]
+    k = vertex_row[i]
+    if k >= 0:
+        cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, planes, rows, k, False)
+        gx += cgx
+        gy += cgy
+        hxx += cxx
+        hxy += cxy
+        hyy += cyy
+    det = hxx * hyy - hxy * hxy
+    if not det > 0.0:
+        return 0.0
+    dx = (hyy * gx - hxy * gy) / det
+    dy = (hxx * gy - hxy * gx) / det
+    x[i, 0] -= dx
+    x[i, 1] -= dy
+    return dx * dx + dy * dy
+
+
+@njit(cache=True)
+def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_corner, elem, b, area, mu, lam,
+          beta, kind, spring_start, spring_item, spring_corner, spring_i, spring_j, rest, ks, kd, grab_slot,
+          grab_pull, vertex_row, planes, rows, inv_h, hf):
+    """One Gauss-Seidel sweep, colour after colour, over every free vertex's block (the
+    built-in element kinds). Returns the largest squared move (m^2)."""
+    most = 0.0
+    for c in range(starts.shape[0] - 1):
+        for p in range(starts[c], starts[c + 1]):
+            i = order[p]
+            if inv_mass[i] == 0.0:
+                continue
+            gx = gy = hxx = hxy = hyy = 0.0
+            for q in range(tri_start[i], tri_start[i + 1]):
+                ex, ey, exx, exy, eyy = triangle_vertex_block(x, x_n, tri_item[q], tri_corner[q], elem, b, area, mu,
+                                                              lam, beta, kind, inv_h, hf)
+                gx += ex
+                gy += ey
+                hxx += exx
+                hxy += exy
+                hyy += eyy
+            for q in range(spring_start[i], spring_start[i + 1]):
+                s = spring_item[q]
+                j = spring_j[s] if spring_corner[q] == 0 else spring_i[s]
+                ex, ey, exx, exy, eyy = spring_vertex_block(x, x_n, i, j, rest[s], ks[s], kd[s], inv_h)
+                gx += ex
+                gy += ey
+                hxx += exx
+                hxy += exy
+                hyy += eyy
+            moved = descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, vertex_row, planes,
+                            rows)
+            if moved > most:
+                most = moved
+    return most
+
+
+@njit(cache=True)
+def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, grab_slot, grab_pull, vertex_row,
+                       planes, rows):
+    """The vertices ``order[start:stop]`` (one colour) with their elements' share of the
+    block given (``g`` (N, 2), ``hb`` (N, 3)): the path for element kinds that are not
+    built in. Returns the largest squared move (m^2)."""
+    most = 0.0
+    for p in range(start, stop):
+        i = order[p]
+        if inv_mass[i] == 0.0:
+            continue
+        moved = descend(x, x_n, y, i, g[i, 0], g[i, 1], hb[i, 0], hb[i, 1], hb[i, 2], mass_h2, grab_slot, grab_pull,
+                        vertex_row, planes, rows)
+        if moved > most:
+            most = moved
+    return most
+
+
+@njit(cache=True)
+def chebyshev(x, x_prev, x_prev2, inv_mass, vertex_row, omega):
+    """VBD's Chebyshev step ``x = omega (x - x'') + x''`` (``x''`` the iterate two sweeps back),
+    then the history shifts (``x'' = x'``, ``x' = x``). Vertices on a contact row are left
+    alone (extrapolated, they overshot their rows' multipliers and a block on a slope slid)."""
+    for i in range(x.shape[0]):
+        if inv_mass[i] != 0.0 and omega != 1.0 and vertex_row[i] < 0:
+            x[i, 0] = omega * (x[i, 0] - x_prev2[i, 0]) + x_prev2[i, 0]
+            x[i, 1] = omega * (x[i, 1] - x_prev2[i, 1]) + x_prev2[i, 1]
+        x_prev2[i, 0], x_prev2[i, 1] = x_prev[i, 0], x_prev[i, 1]
+        x_prev[i, 0], x_prev[i, 1] = x[i, 0], x[i, 1]
+
+
+@njit(cache=True)
+def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_pull, vertex_row, planes, rows):
+    """Move each body as a whole by the Newton step of the objective over its rigid motions.
+
+    A vertex sweep moves a stiff body's rigid modes slowly: each vertex is held by its
+    elements (stiffness ~ E) while the inertia pulls with only ``m / h^2``, so a block
+    sliding down a frictionless slope took 2 % of ``g sin a`` in ten sweeps. Over a rigid
+    motion (a translation ``d`` and a turn ``theta`` about the centre of mass) the elements'
+    energy does not change, so the objective there is the inertia's, the grabs' and the
+    contact rows' alone: its gradient ``(sum g_i, sum r_i x g_i)`` and 3 x 3 Hessian ``sum
+    J_i^T H_i J_i`` (``J_i = [I | perp(r_i)]``) cost one pass over the vertices, and one
+    Newton step solves the rigid modes as well as the iterate allows. Without outside
+    forces it makes ``sum m (x - y) = 0``: the step keeps the body's momentum. A body with a
+    pinned vertex does not move as a whole."""
+    for body in range(body_start.shape[0] - 1):
+        lo, hi = body_start[body], body_start[body + 1]
+        sm = cx = cy = 0.0
+        pinned = False
+        for i in range(lo, hi):
+            if inv_mass[i] == 0.0:
+                pinned = True
+                break
+            m = mass_h2[i]
+            sm += m
+            cx += m * x[i, 0]
+            cy += m * x[i, 1]
+        if pinned or sm == 0.0:
+            continue
+        cx /= sm
+        cy /= sm
+        g0 = g1 = g2 = 0.0
+        a00 = a01 = a02 = a11 = a12 = a22 = 0.0
+        for i in range(lo, hi):
+            m = mass_h2[i]
+            gx = m * (x[i, 0] - y[i, 0])
+            gy = m * (x[i, 1] - y[i, 1])
+            hxx = hyy = m
+            hxy = 0.0
+            s = grab_slot[i]
+            if s >= 0:
+                gx += grab_pull[s, 0] * x[i, 0] - grab_pull[s, 1]
+                gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
+                hxx += grab_pull[s, 0]
+                hyy += grab_pull[s, 0]
+            k = vertex_row[i]
+            if k >= 0:
+                # the row's gradient where it is, and its stiffness whether it pushes now or
+                # not: a row that starts to push within the step bounds the step (with only
+                # the active rows a resting block rocked on its warm-started contacts)
+                cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, planes, rows, k, True)
+                gx += cgx
+                gy += cgy
+                hxx += cxx
+                hxy += cxy
+                hyy += cyy
+            # J = [[1, 0, -ry], [0, 1, rx]]
+            rx, ry = x[i, 0] - cx, x[i, 1] - cy
+            g0 += gx
+            g1 += gy
+            g2 += rx * gy - ry * gx
+            a00 += hxx
+            a01 += hxy
+            a11 += hyy
+            a02 += -hxx * ry + hxy * rx
+            a12 += -hxy * ry + hyy * rx
+            a22 += hxx * ry * ry - 2.0 * hxy * rx * ry + hyy * rx * rx
+        # solve the 3 x 3 system A d = -g (symmetric positive definite: A includes sum m / h^2)
+        c00 = a11 * a22 - a12 * a12
+        c01 = a02 * a12 - a01 * a22
+        c02 = a01 * a12 - a02 * a11
+        det = a00 * c00 + a01 * c01 + a02 * c02
+        if not det > 0.0:
+            continue
+        c11 = a00 * a22 - a02 * a02
+        c12 = a01 * a02 - a00 * a12
+        c22 = a00 * a11 - a01 * a01
+        dx = -(c00 * g0 + c01 * g1 + c02 * g2) / det
+        dy = -(c01 * g0 + c11 * g1 + c12 * g2) / det
+        th = -(c02 * g0 + c12 * g1 + c22 * g2) / det
+        # Backtracking on the objective: the rows are piecewise quadratic, and a full Newton
+        # step across their kinks rocked a block on the floor from step to step until it
+        # walked off sideways. The turn is exact (a rotation, not its linearisation, leaves
+        # the elements unstrained, so they need no part in the test).
+        slope = g0 * dx + g1 * dy + g2 * th
+        if not slope < 0.0:
+            continue
+        e0 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, vertex_row, planes, rows, cx, cy,
+                          0.0, 0.0, 0.0)
+        t = 1.0
+        while t > 1e-3:
+            e1 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, vertex_row, planes, rows, cx, cy,
+                              t * dx, t * dy, t * th)
+            if e1 <= e0 + 1e-4 * t * slope + 1e-12 * abs(e0):  # (rounding: a step too small to measure is taken)
+                break
+            t *= 0.5
+        if t <= 1e-3:
+            continue
+        co, si = np.cos(t * th), np.sin(t * th)
+        for i in range(lo, hi):
+            rx, ry = x[i, 0] - cx, x[i, 1] - cy
+            x[i, 0] = cx + t * dx + co * rx - si * ry
+            x[i, 1] = cy + t * dy + si * rx + co * ry
+
+
+@njit(cache=True)
+def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, vertex_row, planes, rows, cx, cy, dx, dy, th):
+    """The objective's inertia, grab and contact-row part (J) over the vertices ``lo:hi`` moved
+    as a whole: turned by ``th`` about ``(cx, cy)`` and shifted by ``(dx, dy)``."""
+    co, si = np.cos(th), np.sin(th)
+    e = 0.0
+    for i in range(lo, hi):
+        rx, ry = x[i, 0] - cx, x[i, 1] - cy
+        px = cx + dx + co * rx - si * ry
+        py = cy + dy + si * rx + co * ry
+        e += 0.5 * mass_h2[i] * ((px - y[i, 0]) ** 2 + (py - y[i, 1]) ** 2)
+        s = grab_slot[i]
+        if s >= 0:
+            tx, ty = grab_pull[s, 1] / grab_pull[s, 0], grab_pull[s, 2] / grab_pull[s, 0]
+            e += 0.5 * grab_pull[s, 0] * ((px - tx) ** 2 + (py - ty) ** 2)
+        k = vertex_row[i]
+        if k >= 0:
+            e += contact_energy(px, py, x_n, i, planes, rows, k)
+    return e
+
+
+def chebyshev_omega(k: int, rho: float, previous: float) -> float:
+    """Chebyshev's weight for sweep ``k`` (0-based) with spectral radius ``rho``."""
+    if rho <= 0.0 or k == 0:
+        return 1.0
+    if k == 1:
+        return 2.0 / (2.0 - rho * rho)
+    return 4.0 / (4.0 - rho * rho * previous)
+
+
+@register_integrator("avbd")
+class AVBD(Integrator):
+    """Augmented Vertex Block Descent: backward Euler by Gauss-Seidel over per-vertex blocks,
+    contacts as augmented-Lagrangian rows (see the module docstring).
+
+    Options
+    -------
+    iterations : int
+        Sweeps per step (in [1, 10000]): the budget, or with ``tolerance`` the most.
+    tolerance : float
+        Stop once no vertex moves faster than this in a sweep (m/s; 0, the default: run the
+        budget). Run to a tight tolerance the step is backward Euler's.
+    chebyshev : float
+        The spectral radius Chebyshev's acceleration assumes, in [0, 1) (0: none).
+    penalty_start : float
+        A contact row's first stiffness, as a multiple of its vertex's ``m / h^2`` plus its
+        elements' stiffness (> 0).
+    penalty_ramp : float
+        ``beta``, N/m per m of violation: how fast a row's penalty stiffens (>= 0).
+    penalty_max : float
+        The stiffest a row gets (N/m).
+
+    Examples
+    --------
+    >>> import deforma
+    >>> w = deforma.World(dt=1 / 60, integrator="avbd")
+    >>> w.integrator_options["iterations"]
+    10
+    """
+
+    name = "avbd"
+    unconditionally_stable = True
+    OPTIONS = (Option("iterations", 10, "int", low=1, high=10_000, doc="sweeps per step (the most, with tolerance)"),
+               Option("tolerance", 0.0, "float", low=0.0, high=math.inf, closed_low=True,
+                      doc="stop when no vertex moves faster than this in a sweep (m/s; 0: run every sweep)"),
+               Option("chebyshev", 0.0, "float", low=0.0, high=1.0, closed_low=True,
+                      doc="spectral radius for Chebyshev acceleration (0: none)"),
+               Option("penalty_start", 1.0, "float", low=0.0, high=1e12,
+                      doc="a contact row's first stiffness, in its vertex's m / h^2 plus its elements' stiffness"),
+               Option("penalty_ramp", 1e5, "float", low=0.0, high=1e15, closed_low=True,
+                      doc="penalty growth per metre of violation per sweep (N/m^2)"),
+               Option("penalty_max", 1e10, "float", low=0.0, high=1e18, doc="the stiffest a contact row gets (N/m)"))
+
+    #: a row's multiplier and penalty carried into the next step: lambda * CARRY, k * SOFTEN
+    CARRY = 0.99 * 0.99
+    SOFTEN = 0.99
+
+    def __init__(self, **options):
+        super().__init__(**options)
+        self._topology = (None,)
+        self._stiff = None
+        self._n = -1
+        self.iterations_run = 0
+        self.unconverged = 0
+        self.residual = 0.0
+        self.active_contacts = 0
+
+    def stats(self) -> dict:
+        """``{"iterations", "unconverged", "residual", "contacts"}``: sweeps run so far,
+        substeps that stopped at the budget short of a tolerance, the last sweep's largest
+        vertex speed change (m/s) and the collider contacts of the last step."""
+        return {"iterations": self.iterations_run, "unconverged": self.unconverged, "residual": self.residual,
+                "contacts": self.active_contacts}
+
+    def _prepare(self, model):
+        """Incidence and colouring, once per Model (its elements never change in place)."""
+        if self._topology[0] is model:
+            return self._topology
+        n = model.n_vertices
+        tris = model.triangles.arrays if model.fused else None
+        elem = tris.elem if tris is not None else np.zeros((0, 3), np.int32)
+        springs = np.stack([model.spring_i, model.spring_j], axis=1)
+        t_start, t_item, t_corner = incidence(elem, n)
+        s_start, s_item, s_corner = incidence(springs, n)
+        # the colouring must see every kind's elements: those not built in add their edges
+        extra = [k.vertices for k in model.elements if not k.fused and k.n_elements]
+        c_elem, c_start, c_item = model.elem, *incidence(model.elem, n)[:2]
+        if extra:
+            pairs = [springs] + [np.stack([v[:, a], v[:, b]], axis=1) for v in extra
+                                 for a in range(v.shape[1]) for b in range(a + 1, v.shape[1])]
+            springs_all = np.concatenate(pairs).astype(np.int64)
+            cs_start, cs_item, _ = incidence(springs_all, n)
+            order, starts = colour_vertices(n, c_start, c_item, c_elem, cs_start, cs_item, springs_all[:, 0],
+                                            springs_all[:, 1])
+        else:
+            order, starts = colour_vertices(n, c_start, c_item, c_elem, s_start, s_item, model.spring_i,
+                                            model.spring_j)
+        self._topology = (model, t_start, t_item, t_corner, s_start, s_item, s_corner, order, starts)
+        return self._topology
+
+    def _stiffness(self, model, h):
+        """Per vertex, the stiffness of its elements (N/m: the kinds' row sums, damping's
+        ``1 / h`` share included), once per Model version and ``h``: a contact row starts as
+        stiff as the material around its vertex, so its multiplier's force is not carried by
+        a gap (a row as soft as the inertia, ``m / h^2``, held a resting block's bottom
+        vertices millimetres above the floor, and the block hopped)."""
+        key = (model, model.version, h)
+        if self._stiff is None or self._stiff[0] is not model or self._stiff[1:3] != key[1:]:
+            n = model.n_vertices
+            rows = sum((k.stiffness_rows(n) + k.damping_rows(n) / h for k in model.elements), np.zeros(n))
+            self._stiff = (*key, rows)
+        return self._stiff[3]
+
+    def _scratch(self, n):
+        if self._n != n:
+            self._x_n = np.empty((n, 2))
+            self._y = np.empty((n, 2))
+            self._v_last = np.zeros((n, 2))
+            self._has_last = False
+            self._x1 = np.empty((n, 2))
+            self._x2 = np.empty((n, 2))
+            self._planes = np.empty((n, 7))
+            self._touch = np.empty(n, np.int32)
+            self._plane_rows = np.empty(n, np.int32)
+            self._vertex_row = np.full(n, -1, np.int32)
+            self._rows = np.empty((n, ROW_COLUMNS))
+            self._memory = np.full((n, MEMORY_COLUMNS), -1.0)
+            self._hf = np.empty((4, 4))
+            self._n = n
+
+    def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
+        n = model.n_vertices
+        if self._n != n or self._topology[0] is not model:
+            self._memory = None  # vertices renumbered: no warm start
+        self._scratch(n)
+        if self._memory is None:
+            self._memory = np.full((n, MEMORY_COLUMNS), -1.0)
+        topo = self._prepare(model)
+        opts = self._options
+        x, v = state_out.x, state_out.v
+        h = float(h)
+        keep = 1.0 / (1.0 + h * model.air_drag)
+        mass_h2 = model.vertex_mass * ((1.0 + h * model.air_drag) / (h * h))
+        inv_mass = model.vertex_inv_mass
+        k_start = opts["penalty_start"] * (mass_h2 + self._stiffness(model, h))
+        gx, gy = (float(c) for c in model.gravity)
+        rects, hits, ctopo, scr, buf = control.colliders, contacts.hits, model.contact, contacts.scratch, contacts.buffer
+        vmax2 = float(max_speed) ** 2
+        tol = opts["tolerance"] * h
+        for _ in range(substeps):
+            advance_colliders(rects, h)
+            predict(x, v, self._x_n, self._y, self._v_last, self._has_last, inv_mass, gx, gy, keep,
+                    control.force, control.has_force, h)
+            self._has_last = True
+            x_n = self._x_n
+            count = contact_planes(x_n, self._y, rects, self._planes, self._touch, self._plane_rows, False, h)
+            gather_start(x_n, ctopo, scr)  # for the contact stage after the sweep
+            start_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows, k_start,
+                       self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, h)
+            self._solve(model, topo, control, x, x_n, mass_h2, inv_mass, count, h, tol)
+            close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
+            self.active_contacts = count
+            bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, h, vmax2)
+            if bad:
+                return StepReport(int(bad), contacts.complete)
+            if contact_epilogue(x, v, inv_mass, x_n, ctopo, scr, buf, rects, hits, h, True) < 0:
+                return StepReport(0, False)
+        return StepReport(0, contacts.complete)
+
+    def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, h, tol):
+        """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
+        opts = self._options
+        rho = opts["chebyshev"]
+        _, t_start, t_item, t_corner, s_start, s_item, s_corner, order, starts = topo
+        inv_h = 1.0 / h
+        y = self._y
+        if rho > 0.0:
+            np.copyto(self._x1, x)
+            np.copyto(self._x2, x)
+        omega = 1.0
+        if model.fused:
+            tris, springs = model.triangles.arrays, model.springs.arrays
+        most = 0.0
+        sweeps = opts["iterations"]
+        it = 0
+        for it in range(sweeps):
+            if model.fused:
+                most = sweep(x, x_n, y, mass_h2, inv_mass, order, starts, t_start, t_item, t_corner, tris.elem,
+                             tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start, s_item, s_corner,
+                             springs.i, springs.j, springs.rest, springs.ks, springs.kd, control.grab_slot,
+                             control.grab_pull, self._vertex_row, self._planes, self._rows, inv_h, self._hf)
+            else:
+                most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h)
+            rigid_correction(x, x_n, y, mass_h2, inv_mass, model.body_vertex_offsets, control.grab_slot,
+                             control.grab_pull, self._vertex_row, self._planes, self._rows)
+            update_rows(x, x_n, self._touch, self._planes, self._rows, count, opts["penalty_ramp"],
+                        opts["penalty_max"])
+            if rho > 0.0:
+                omega = chebyshev_omega(it, rho, omega)
+                chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)
+            if tol > 0.0 and most <= tol * tol:
+                break
+        self.iterations_run += it + 1
+        self.residual = math.sqrt(most) * inv_h
+        if tol > 0.0 and most > tol * tol:
+            self.unconverged += 1
+
+    def _sweep_kinds(self, model, control, x, x_n, mass_h2, inv_mass, order, starts, h):
+        """One sweep with the elements' share of each colour's blocks from the kinds'
+        :meth:`~deforma.physics.elements.kind.ElementKind.vertex_blocks` (every kind, once per
+        colour: exact, since a colour's vertices share no element, and slow)."""
+        n = model.n_vertices
+        g, hb = np.zeros((n, 2)), np.zeros((n, 3))
+        most = 0.0
+        for c in range(len(starts) - 1):
+            g[:] = 0.0
+            hb[:] = 0.0
+            for kind in model.elements:
+                kind.vertex_blocks(x, x_n, h, g, hb)
+            most = max(most, sweep_colour_given(x, x_n, self._y, mass_h2, inv_mass, order, starts[c], starts[c + 1],
+                                                g, hb, control.grab_slot, control.grab_pull, self._vertex_row,
+                                                self._planes, self._rows))
+        return most
+
+
+__all__ = ["AVBD"]

@@ -1,0 +1,160 @@
+"""avbd (Augmented Vertex Block Descent) against known answers at 1/60 s, one step a frame.
+
+References: the converged backward Euler step (implicit-euler solved tight) for the spin and
+the bar's ring; the analytic hanging column (rho g L^2 / 2E); an incline's stick and slide
+(g (sin a - friction cos a)); momentum kept where nothing acts from outside.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import deforma
+from physics_meshes import grid_mesh, slide_acceleration
+from test_converged_implicit import TIGHT, angular_momentum, momentum, spin_kept, spinning_box
+from test_fem_validation import EXPECTED, L, column, E, NU, RHO
+
+H = 1 / 60
+G = 9.81
+
+
+@pytest.mark.parametrize("youngs_modulus", [1e4, 1e7])
+def test_a_spinning_box_keeps_the_spin_of_backward_euler_at_the_default_budget(youngs_modulus):
+    # 60 steps of 1/60 s at 5 rad/s: ten sweeps a step keep what the converged backward
+    # Euler step keeps (0.748 at 1e4 Pa), and the linear momentum stays zero to rounding
+    kept, drift, _ = spin_kept(youngs_modulus=youngs_modulus, integrator="avbd")
+    reference, _, _ = spin_kept(youngs_modulus=youngs_modulus, **TIGHT)
+    assert kept == pytest.approx(reference, rel=0.01)
+    assert np.abs(drift).max() < 1e-9 * 100 * 3.5  # 100 kg at up to 3.5 m/s
+
+
+def test_run_to_a_tolerance_it_is_the_backward_euler_step():
+    w, b = spinning_box(integrator="avbd", tolerance=1e-6, iterations=10_000)
+    ref, rb = spinning_box(**TIGHT)
+    for _ in range(10):
+        w.step()
+        ref.step()
+    assert np.abs(b.positions - rb.positions).max() < 1e-5
+    assert angular_momentum(b) == pytest.approx(angular_momentum(rb), rel=1e-4)
+    assert w.integrator_stats["unconverged"] == 0
+
+
+def test_free_fall_is_backward_eulers_discrete_motion():
+    w = deforma.World(dt=H, integrator="avbd")
+    b = w.add_body(grid_mesh(0.3, 0.2, 4, 3), position=(1.0, 10.0))
+    b.velocities[:] = (0.5, 2.0)
+    n = 60
+    for _ in range(n):
+        w.step()
+    # v_k = v0 - g h k, x_k = x_{k-1} + h v_k, the springs at rest throughout
+    assert b.center_of_mass[1] == pytest.approx(10.0 + 2.0 * n * H - G * H * H * n * (n + 1) / 2, abs=1e-9)
+    assert b.center_of_mass[0] == pytest.approx(1.0 + 0.5 * n * H, abs=1e-9)
+    assert momentum(b)[1] == pytest.approx(b.mass * (2.0 - G * n * H), rel=1e-12)
+
+
+def hang(model, nx, **options):
+    w = deforma.World(integrator="avbd", air_drag=20.0, dt=H, integrator_options=options)
+    m = column(nx)
+    b = w.add_body(m, material=deforma.Material(model, youngs_modulus=E, poisson_ratio=NU, density=RHO), position=None)
+    b.pin(np.flatnonzero(np.isclose(m.vertices[:, 1], 0.0)))
+    for _ in range(int(3.0 / H)):
+        w.step()
+    assert np.abs(b.velocities).max() < 1e-3  # settled
+    bottom = np.isclose(m.vertices[:, 1], -L)
+    return -L - b.positions[bottom, 1].mean()
+
+
+@pytest.mark.parametrize("model", ["corotated", "neo-hookean"])
+def test_hanging_column_stretches_by_its_weight(model):
+    # rho g L^2 / 2E; the 4-wide column at the default budget within 1 %; the 8-wide (80
+    # rows) within 3 % at ten sweeps a step, which carry its load down slowly (2.4 % long
+    # after 3 s: docs/integrators.md), and within 1 % at forty
+    assert hang(model, 4) == pytest.approx(EXPECTED, rel=0.01)
+    assert hang(model, 8) == pytest.approx(EXPECTED, rel=0.03)
+    assert hang(model, 8, iterations=40) == pytest.approx(EXPECTED, rel=0.01)
+
+
+def test_a_bar_rings_at_backward_eulers_frequency():
+    # the clamped column set ringing in its first mode, 20 steps a period: backward Euler
+    # rings at 0.969 of c / 4L and keeps almost nothing after 10 periods
+    f = math.sqrt(E / RHO) / (4 * L)
+    w = deforma.World(gravity=(0.0, 0.0), dt=1 / (f * 20), integrator="avbd", integrator_options={"tolerance": 1e-7,
+                                                                                                 "iterations": 5000})
+    m = column(4)
+    b = w.add_body(m, material=deforma.Material("corotated", youngs_modulus=E, poisson_ratio=0.3, density=RHO),
+                   position=None)
+    b.pin(np.flatnonzero(np.isclose(m.vertices[:, 1], 0.0)))
+    v = b.velocities
+    v[:, 1] = 0.05 * np.sin(math.pi * -m.vertices[:, 1] / (2 * L))
+    b.velocities = v
+    tip = np.isclose(m.vertices[:, 1], -L)
+    s = []
+    for _ in range(60):
+        w.step()
+        s.append(b.positions[tip, 1].mean() + L)
+    s = np.array(s)
+    up = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0))
+    crossings = (up + 1 - s[up] / (s[up + 1] - s[up])) * w.dt
+    assert 1 / np.diff(crossings).mean() / f == pytest.approx(0.969, abs=0.02)
+
+
+def slope(angle, mu_s, mu_d, material=None):
+    """A 20 cm x 10 cm block (springs 2e4 N/m, damping 2) resting on a rectangle tilted by ``angle``."""
+    a = math.radians(angle)
+    n = np.array([-math.sin(a), math.cos(a)])
+    t = np.array([math.cos(a), math.sin(a)])
+    w = deforma.World(dt=H, friction=mu_d, static_friction=mu_s, stiffness=2e4, damping=2.0, integrator="avbd",
+                      material=material)
+    w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle))
+    b = w.add_body(grid_mesh(0.2, 0.1, 6, 3, angle=angle, center=tuple(0.0501 * n)))
+    return w, b, n, t
+
+
+def test_a_block_sticks_just_below_the_static_limit():
+    w, b, n, t = slope(math.degrees(math.atan(0.95 * 0.5)), 0.5, 0.3)
+    for _ in range(60):
+        w.step()
+    s0 = b.center_of_mass @ t
+    for _ in range(60):
+        w.step()
+    assert abs(b.center_of_mass @ t - s0) < 1e-4  # m in 1 s
+    assert np.abs(b.velocities).max() < 1e-4
+    assert (b.positions @ n).min() > -1e-6
+
+
+@pytest.mark.parametrize("ratio, mu_s, mu_d, rel", [(1.1, 0.5, 0.3, 0.03), (0.47, 0.0, 0.0, 0.01)])
+def test_a_block_slides_at_g_sin_minus_friction_cos(ratio, mu_s, mu_d, rel):
+    # just past the static limit it slides with the dynamic coefficient; frictionless at 25 degrees
+    angle = math.degrees(math.atan(ratio * mu_s)) if mu_s else 25.0
+    w, b, n, t = slope(angle, mu_s, mu_d)
+    accel, _ = slide_acceleration(w, b, t, steps=90, after=0.3)
+    a = math.radians(angle)
+    assert accel == pytest.approx(G * (math.sin(a) - mu_d * math.cos(a)), rel=rel)
+    assert (b.positions @ n).min() > -1e-6
+
+
+def test_a_block_dropped_on_the_floor_comes_to_rest():
+    w, b, n, t = slope(0.0, 0.5, 0.3, material=deforma.Material("corotated", youngs_modulus=1e5, poisson_ratio=0.3,
+                                                                 density=100.0))
+    for _ in range(120):
+        w.step()
+    assert np.abs(b.velocities).max() < 1e-3
+    assert 0.0 < b.positions[:, 1].min() < 1e-6
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"iterations": 0}, "avbd option iterations must be an integer in [1, 10000], got 0"),
+    ({"iterations": 10_001}, "avbd option iterations must be an integer in [1, 10000], got 10001"),
+    ({"tolerance": -1.0}, "avbd option tolerance must be a number in [0, inf), got -1.0"),
+    ({"tolerance": math.nan}, "avbd option tolerance must be a number in [0, inf), got nan"),
+    ({"chebyshev": 1.0}, "avbd option chebyshev must be a number in [0, 1), got 1.0"),
+    ({"penalty_start": 0.0}, "avbd option penalty_start must be a number in (0, 1e+12), got 0.0"),
+])
+def test_bad_options_are_one_line_and_change_nothing(options, message):
+    w = deforma.World(integrator="avbd")
+    before = w.integrator_options
+    with pytest.raises(ValueError) as e:
+        w.integrator_options = options
+    assert str(e.value) == message
+    assert w.integrator_options == before
