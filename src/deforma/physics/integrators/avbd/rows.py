@@ -35,8 +35,8 @@ import numpy as np
 from numba import njit
 
 #: Columns of a step's contact rows (K, ROW_COLUMNS).
-LAM_N, LAM_T, K_N, K_T, STICK = 0, 1, 2, 3, 4
-ROW_COLUMNS = 5
+LAM_N, LAM_T, K_N, K_T, STICK, BOUND = 0, 1, 2, 3, 4, 5
+ROW_COLUMNS = 6
 #: Columns of the per-vertex warm-start memory (N, MEMORY_COLUMNS): the collider row, then the same four.
 MEM_ROW = 0
 MEMORY_COLUMNS = 5
@@ -118,8 +118,7 @@ def contact_energy(px, py, x_n, i, planes, state, k):
     e = 0.5 * fn * fn / kn
     if fn <= 0.0:
         return e
-    mu = planes[k, 3] if state[k, STICK] > 0.0 else planes[k, 4]
-    bound = mu * state[k, LAM_N]
+    bound = state[k, BOUND]
     slip = (px - x_n[i, 0] - planes[k, 5]) * -ny + (py - x_n[i, 1] - planes[k, 6]) * nx
     ft = state[k, LAM_T] - kt * slip
     if abs(ft) <= bound:
@@ -139,10 +138,9 @@ def contact_block(x, x_n, i, planes, state, k, whole):
         nx, ny = planes[k, 0], planes[k, 1]
         kn = state[k, K_N]
         return 0.0, 0.0, kn * nx * nx, kn * nx * ny, kn * ny * ny
-    # bounded by the normal row's multiplier, not its force at this iterate: the force
-    # swings with every micrometre of gap (k_n is as stiff as the material), the multiplier
-    # only from sweep to sweep
-    bound = mu * state[k, LAM_N]
+    # bounded by the normal force at this iterate (for a step of the whole body, by the
+    # bound frozen before it, so that the line search sees one potential)
+    bound = state[k, BOUND] if whole else mu * fn
     kn, kt = state[k, K_N], state[k, K_T]
     if abs(ft) >= bound:
         # sliding: the friction force is mu f_n whatever the slip, so it adds no stiffness
@@ -154,6 +152,14 @@ def contact_block(x, x_n, i, planes, state, k, whole):
     tx, ty = -ny, nx
     return (-fn * nx - ft * tx, -fn * ny - ft * ty, kn * nx * nx + kt * tx * tx, kn * nx * ny + kt * tx * ty,
             kn * ny * ny + kt * ty * ty)
+
+
+@njit(cache=True)
+def freeze_bounds(x, x_n, touch, planes, state, count):
+    """Each row's friction bound ``mu f_n`` at the iterate ``x``, into ``state[:, BOUND]``."""
+    for k in range(count):
+        fn, _, _, _, mu = contact_forces(x, x_n, touch[k], planes, state, k)
+        state[k, BOUND] = mu * fn
 
 
 @njit(cache=True)

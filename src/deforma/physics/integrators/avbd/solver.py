@@ -47,7 +47,8 @@ from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
 from .blocks import incidence
 from .colouring import colour_vertices
-from .rows import MEMORY_COLUMNS, ROW_COLUMNS, close_rows, contact_block, contact_energy, start_rows, update_rows
+from .rows import (MEMORY_COLUMNS, ROW_COLUMNS, close_rows, contact_block, contact_energy, freeze_bounds, start_rows,
+                   update_rows)
 
 
 @njit(cache=True)
@@ -501,15 +502,18 @@ class AVBD(Integrator):
                              control.grab_pull, self._vertex_row, self._planes, self._rows, inv_h, self._hf)
             else:
                 most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h)
+            freeze_bounds(x, x_n, self._touch, self._planes, self._rows, count)
             rigid_correction(x, x_n, y, mass_h2, inv_mass, model.body_vertex_offsets, control.grab_slot,
                              control.grab_pull, self._vertex_row, self._planes, self._rows)
-            update_rows(x, x_n, self._touch, self._planes, self._rows, count, opts["penalty_ramp"],
-                        opts["penalty_max"])
             if rho > 0.0:
                 omega = chebyshev_omega(it, rho, omega)
                 chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)
             if tol > 0.0 and most <= tol * tol:
                 break
+        # the rows' dual step, once a step: updated after every sweep, the multipliers of a
+        # stiff body's contacts chased its unconverged sweeps (a 1e5 Pa block's support jumped
+        # between its corners from sweep to sweep and it slid off a slope it should stand on)
+        update_rows(x, x_n, self._touch, self._planes, self._rows, count, opts["penalty_ramp"], opts["penalty_max"])
         self.iterations_run += it + 1
         self.residual = math.sqrt(most) * inv_h
         if tol > 0.0 and most > tol * tol:
