@@ -13,8 +13,10 @@ One step of ``h`` (per substep)::
                 g = M/h^2 (x_i - y_i) + sum element gradients + grab + rows
                 H = M/h^2 + sum element blocks (PSD) + grab + rows
                 x_i -= H^-1 g
+        for patch in patches: affine Newton step        # the coarse level
+        for body: rigid Newton step with a line search
         x = omega (x - x'') + x''                        # Chebyshev, if rho > 0
-        rows: lambda = clamp(k C + lambda); k += beta |C| inside the bounds
+    rows: lambda = clamp(k C + lambda); k += beta |C| inside the bounds   # once a step
     v = (x - x_n) / h;  the collider fail-safe and the body contact stage
 
 Each vertex block is one Newton step on backward Euler's objective restricted to the vertex
@@ -23,6 +25,11 @@ to a tolerance the step is backward Euler's. A plain sweep carries information a
 of vertices per colour pass, so a large stiff body is softer than its material at a small
 budget; Chebyshev's semi-iterative acceleration (VBD's, ``chebyshev`` the spectral radius it
 assumes) speeds that up.
+
+Between sweeps, patches of about ``cluster_size`` vertices each take a Newton step over their
+affine motions (:mod:`~deforma.physics.integrators.avbd.clusters`, a coarse level that moves a
+correction a patch per visit), and every body without a pin one over its rigid motions
+(:func:`rigid_correction`).
 
 Collider contacts and their Coulomb friction are rows inside the sweep
 (:mod:`~deforma.physics.integrators.avbd.rows`); contacts between and within bodies are met
@@ -46,6 +53,7 @@ from ..base import Integrator, Option, StepReport, contact_epilogue, finish_posi
 from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
 from .blocks import incidence
+from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .rows import (MEMORY_COLUMNS, ROW_COLUMNS, close_rows, contact_block, contact_energy, freeze_bounds, start_rows,
                    update_rows)
@@ -331,6 +339,11 @@ class AVBD(Integrator):
     tolerance : float
         Stop once no vertex moves faster than this in a sweep (m/s; 0, the default: run the
         budget). Run to a tight tolerance the step is backward Euler's.
+    cluster_size : int
+        Vertices per patch of the coarse level: after every sweep each patch takes a
+        Newton step over its affine motions (:mod:`~deforma.physics.integrators.avbd.clusters`;
+        0: none). Over the built-in element kinds only: with a kind registered from outside
+        there is no coarse level.
     chebyshev : float
         The spectral radius Chebyshev's acceleration assumes, in [0, 1) (0: none).
     penalty_start : float
@@ -354,6 +367,8 @@ class AVBD(Integrator):
     OPTIONS = (Option("iterations", 10, "int", low=1, high=10_000, doc="sweeps per step (the most, with tolerance)"),
                Option("tolerance", 0.0, "float", low=0.0, high=math.inf, closed_low=True,
                       doc="stop when no vertex moves faster than this in a sweep (m/s; 0: run every sweep)"),
+               Option("cluster_size", 64, "int", low=0, high=1_000_000,
+                      doc="vertices per patch of the affine coarse level (0: none)"),
                Option("chebyshev", 0.0, "float", low=0.0, high=1.0, closed_low=True,
                       doc="spectral radius for Chebyshev acceleration (0: none)"),
                Option("penalty_start", 1.0, "float", low=0.0, high=1e12,
@@ -370,6 +385,7 @@ class AVBD(Integrator):
         super().__init__(**options)
         self._topology = (None,)
         self._stiff = None
+        self._patches = None
         self._n = -1
         self.iterations_run = 0
         self.unconverged = 0
@@ -408,6 +424,19 @@ class AVBD(Integrator):
                                             model.spring_j)
         self._topology = (model, t_start, t_item, t_corner, s_start, s_item, s_corner, order, starts)
         return self._topology
+
+    def _clusters(self, model, x):
+        """The coarse level's patches, once per Model and cluster size."""
+        size = self._options["cluster_size"]
+        if size <= 0 or not model.fused:
+            return None
+        if self._patches is None or self._patches[0] is not model or self._patches[1] != size:
+            cluster, count = make_clusters(x, model.body_vertex_offsets, model.vertex_inv_mass, size)
+            v_start, v_list, te_start, te_list = cluster_members(cluster, count, model.elem)
+            springs = np.stack([model.spring_i, model.spring_j], axis=1)
+            _, _, se_start, se_list = cluster_members(cluster, count, springs)
+            self._patches = (model, size, cluster, v_start, v_list, te_start, te_list, se_start, se_list)
+        return self._patches[2:]
 
     def _stiffness(self, model, h):
         """Per vertex, the stiffness of its elements (N/m: the kinds' row sums, damping's
@@ -491,6 +520,7 @@ class AVBD(Integrator):
         omega = 1.0
         if model.fused:
             tris, springs = model.triangles.arrays, model.springs.arrays
+        patches = self._clusters(model, x_n)
         most = 0.0
         sweeps = opts["iterations"]
         it = 0
@@ -503,6 +533,10 @@ class AVBD(Integrator):
             else:
                 most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h)
             freeze_bounds(x, x_n, self._touch, self._planes, self._rows, count)
+            if patches is not None:
+                cluster_sweep(x, x_n, y, mass_h2, *patches, tris.elem, tris.b, tris.area, tris.mu, tris.lam,
+                              tris.beta, tris.kind, springs.i, springs.j, springs.rest, springs.ks, springs.kd,
+                              control.grab_slot, control.grab_pull, self._vertex_row, self._planes, self._rows, inv_h)
             rigid_correction(x, x_n, y, mass_h2, inv_mass, model.body_vertex_offsets, control.grab_slot,
                              control.grab_pull, self._vertex_row, self._planes, self._rows)
             if rho > 0.0:

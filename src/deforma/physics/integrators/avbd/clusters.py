@@ -1,0 +1,279 @@
+"""A coarse level for block descent: patches of vertices moved by one affine map each.
+
+A vertex sweep carries a correction one ring of vertices per colour pass, so the slow modes
+of a large body (its sag under its own weight, a column's stretch) take hundreds of sweeps:
+the README's 3.7 m springs bunny on a floor folded at ten sweeps a step. Between sweeps,
+each patch ("cluster") of about ``size`` neighbouring vertices takes one Newton step over
+the affine motions ``dx_v = d + A (x_v - c)`` of its vertices (6 unknowns: ``d``, and the
+2 x 2 ``A``), the rest held: the same objective as the vertex blocks (inertia, elements,
+grabs, contact rows), its gradient and Hessian gathered through the Jacobian of each
+element's deformation gradient in ``(d, A)``. Patches are visited one after another
+(Gauss-Seidel), so a correction crosses a patch per visit instead of a ring.
+
+Element by element: a triangle with the patch's corners ``v`` moving has ``dF[a, c] = d[a]
+S_c + sum_b A[a, b] T_bc`` with ``S_c = sum_v D_v[c]``, ``T_bc = sum_v r_v[b] D_v[c]`` (for a
+triangle inside the patch ``S = 0`` and ``T = F``: ``dF = A F``); a spring with its ends
+``i``, ``j`` gets ``d(x_j - x_i) = `` the moving ends' ``+-(d + A r)``.
+
+Units: m, s, kg, N, N/m.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ...elements import corotated, neo_hookean
+from ...elements.triangles import deformation_gradient, rate_stress, stress
+from ...material import KIND_COROTATED
+from .rows import contact_block
+
+
+def make_clusters(x, body_start, inv_mass, size):
+    """Group each body's free vertices into patches of about ``size`` by a grid over their
+    positions ``x``: ``(cluster (N,) int64, -1 for pinned vertices; count)``."""
+    n = len(x)
+    cluster = np.full(n, -1, np.int64)
+    count = 0
+    for body in range(len(body_start) - 1):
+        lo, hi = int(body_start[body]), int(body_start[body + 1])
+        free = np.flatnonzero(inv_mass[lo:hi] != 0.0) + lo
+        if len(free) == 0:
+            continue
+        p = x[free]
+        span = np.maximum(np.ptp(p, axis=0), 1e-12)
+        cells = max(1, round(len(free) / size))
+        # square cells: as many as it takes to hold about `size` vertices each
+        side = float(np.sqrt(span[0] * span[1] / cells)) if span.min() > 1e-9 else float(span.max() / cells)
+        side = max(side, 1e-12)
+        key = np.floor((p - p.min(axis=0)) / side).astype(np.int64)
+        _, label = np.unique(key[:, 0] * (1 << 31) + key[:, 1], return_inverse=True)
+        cluster[free] = label + count
+        count += int(label.max()) + 1
+    return cluster, count
+
+
+def cluster_members(cluster, count, items):
+    """CSR lists: each cluster's vertices, and the items (triangles (T, 3) or springs (E, 2))
+    with a corner in it: ``(v_start, v_list, e_start, e_list)``."""
+    free = np.flatnonzero(cluster >= 0)
+    order = free[np.argsort(cluster[free], kind="stable")]
+    v_start = np.searchsorted(cluster[order], np.arange(count + 1))
+    if len(items):
+        c = cluster[items]  # (E, k)
+        pairs = np.unique(np.stack([np.repeat(np.arange(len(items)), items.shape[1]), c.ravel()], axis=1), axis=0)
+        pairs = pairs[pairs[:, 1] >= 0]
+        pairs = pairs[np.argsort(pairs[:, 1], kind="stable")]
+        e_start = np.searchsorted(pairs[:, 1], np.arange(count + 1))
+        e_list = pairs[:, 0].astype(np.int64)
+    else:
+        e_start, e_list = np.zeros(count + 1, np.int64), np.zeros(0, np.int64)
+    return v_start.astype(np.int64), order.astype(np.int64), e_start.astype(np.int64), e_list
+
+
+@njit(cache=True, inline="always")
+def _add_jacobian_terms(g, hm, jac, pvec, hf, a):
+    """``g += a jac^T pvec``, ``hm += a jac^T hf jac`` for a (4, 6) ``jac`` over vec F."""
+    for p in range(6):
+        s = 0.0
+        for m in range(4):
+            s += jac[m, p] * pvec[m]
+        g[p] += a * s
+    tmp = np.empty((4, 6))
+    for m in range(4):
+        for q in range(6):
+            s = 0.0
+            for k in range(4):
+                s += hf[m, k] * jac[k, q]
+            tmp[m, q] = s
+    for p in range(6):
+        for q in range(6):
+            s = 0.0
+            for m in range(4):
+                s += jac[m, p] * tmp[m, q]
+            hm[p, q] += a * s
+
+
+@njit(cache=True)
+def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_list, se_start, se_list, elem, b,
+                  area, mu, lam, beta, kind, spring_i, spring_j, rest, ks, kd, grab_slot, grab_pull, vertex_row,
+                  planes, rows, inv_h):
+    """One Gauss-Seidel pass over the clusters, each an affine Newton step (module docstring)."""
+    hf = np.empty((4, 4))
+    cf = np.empty((4, 4))
+    jac = np.zeros((4, 6))
+    pvec = np.empty(4)
+    g = np.empty(6)
+    hm = np.empty((6, 6))
+    n_clusters = v_start.shape[0] - 1
+    for cl in range(n_clusters):
+        lo, hi = v_start[cl], v_start[cl + 1]
+        if hi - lo < 4:
+            continue
+        touching = False
+        for p in range(lo, hi):
+            if vertex_row[v_list[p]] >= 0:
+                touching = True
+        if touching:
+            # a patch on a contact is left to the vertex blocks and the whole-body step:
+            # moved affinely against its rows (piecewise, with friction), it sheared a
+            # block sliding down a slope to a stop
+            continue
+        sm = cx = cy = 0.0
+        for p in range(lo, hi):
+            i = v_list[p]
+            sm += mass_h2[i]
+            cx += mass_h2[i] * x[i, 0]
+            cy += mass_h2[i] * x[i, 1]
+        cx /= sm
+        cy /= sm
+        for p in range(6):
+            g[p] = 0.0
+            for q in range(6):
+                hm[p, q] = 0.0
+        # unknowns: (d0, d1, A00, A01, A10, A11); dx_v = (d0 + A00 rx + A01 ry, d1 + A10 rx + A11 ry)
+        for p in range(lo, hi):
+            i = v_list[p]
+            m = mass_h2[i]
+            gx = m * (x[i, 0] - y[i, 0])
+            gy = m * (x[i, 1] - y[i, 1])
+            hxx = hyy = m
+            hxy = 0.0
+            s = grab_slot[i]
+            if s >= 0:
+                gx += grab_pull[s, 0] * x[i, 0] - grab_pull[s, 1]
+                gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
+                hxx += grab_pull[s, 0]
+                hyy += grab_pull[s, 0]
+            k = vertex_row[i]
+            if k >= 0:
+                cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, planes, rows, k, True)
+                gx += cgx
+                gy += cgy
+                hxx += cxx
+                hxy += cxy
+                hyy += cyy
+            rx, ry = x[i, 0] - cx, x[i, 1] - cy
+            # J_v: row x = (1, 0, rx, ry, 0, 0), row y = (0, 1, 0, 0, rx, ry)
+            jx = (1.0, 0.0, rx, ry, 0.0, 0.0)
+            jy = (0.0, 1.0, 0.0, 0.0, rx, ry)
+            for a in range(6):
+                g[a] += jx[a] * gx + jy[a] * gy
+                for c in range(6):
+                    hm[a, c] += jx[a] * (hxx * jx[c] + hxy * jy[c]) + jy[a] * (hxy * jx[c] + hyy * jy[c])
+        # triangles with a corner in the cluster
+        for q in range(te_start[cl], te_start[cl + 1]):
+            e = te_list[q]
+            i0, i1, i2 = elem[e, 0], elem[e, 1], elem[e, 2]
+            b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
+            s0 = s1 = t00 = t01 = t10 = t11 = 0.0
+            for corner in range(3):
+                v = elem[e, corner]
+                if cluster[v] != cl:
+                    continue
+                if corner == 1:
+                    d0, d1 = b0, b1
+                elif corner == 2:
+                    d0, d1 = b2, b3
+                else:
+                    d0, d1 = -b0 - b2, -b1 - b3
+                rx, ry = x[v, 0] - cx, x[v, 1] - cy
+                s0 += d0
+                s1 += d1
+                t00 += rx * d0
+                t01 += rx * d1
+                t10 += ry * d0
+                t11 += ry * d1
+            # vec F = (F00, F01, F10, F11); dF[a, c] = d[a] S_c + A[a, 0] T_0c + A[a, 1] T_1c
+            for mm in range(4):
+                for pp in range(6):
+                    jac[mm, pp] = 0.0
+            jac[0, 0], jac[0, 2], jac[0, 3] = s0, t00, t10
+            jac[1, 0], jac[1, 2], jac[1, 3] = s1, t01, t11
+            jac[2, 1], jac[2, 4], jac[2, 5] = s0, t00, t10
+            jac[3, 1], jac[3, 4], jac[3, 5] = s1, t01, t11
+            f00, f01, f10, f11 = deformation_gradient(x, i0, i1, i2, b0, b1, b2, b3)
+            p00, p01, p10, p11 = stress(kind[e], f00, f01, f10, f11, mu[e], lam[e])
+            pvec[0], pvec[1], pvec[2], pvec[3] = p00, p01, p10, p11
+            if kind[e] == KIND_COROTATED:
+                corotated.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
+            else:
+                neo_hookean.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
+            be = beta[e]
+            if be > 0.0:
+                r00, r01, r10, r11 = deformation_gradient(x, i0, i1, i2, b0, b1, b2, b3)
+                q00, q01, q10, q11 = deformation_gradient(x_n, i0, i1, i2, b0, b1, b2, b3)
+                u00, u01, u10, u11 = rate_stress(f00, f01, f10, f11, (r00 - q00) * inv_h, (r01 - q01) * inv_h,
+                                                 (r10 - q10) * inv_h, (r11 - q11) * inv_h, mu[e], lam[e])
+                pvec[0] += be * u00
+                pvec[1] += be * u01
+                pvec[2] += be * u10
+                pvec[3] += be * u11
+                # the damping stress's linear map, times beta / h
+                for col in range(4):
+                    e00 = 1.0 if col == 0 else 0.0
+                    e01 = 1.0 if col == 1 else 0.0
+                    e10 = 1.0 if col == 2 else 0.0
+                    e11 = 1.0 if col == 3 else 0.0
+                    c00, c01, c10, c11 = rate_stress(f00, f01, f10, f11, e00, e01, e10, e11, mu[e], lam[e])
+                    cf[0, col], cf[1, col], cf[2, col], cf[3, col] = c00, c01, c10, c11
+                for mm in range(4):
+                    for kk in range(4):
+                        hf[mm, kk] += be * inv_h * 0.5 * (cf[mm, kk] + cf[kk, mm])
+            _add_jacobian_terms(g, hm, jac, pvec, hf, area[e])
+        # springs with an end in the cluster
+        for q in range(se_start[cl], se_start[cl + 1]):
+            e = se_list[q]
+            i, j = spring_i[e], spring_j[e]
+            dx = x[j, 0] - x[i, 0]
+            dy = x[j, 1] - x[i, 1]
+            length = np.sqrt(dx * dx + dy * dy)
+            if length > 0.0:
+                ux, uy = dx / length, dy / length
+                tt = max(1.0 - rest[e] / length, 0.0)
+            else:
+                ux, uy, tt = 1.0, 0.0, 0.0
+            rv = ((x[j, 0] - x_n[j, 0] - x[i, 0] + x_n[i, 0]) * ux
+                  + (x[j, 1] - x_n[j, 1] - x[i, 1] + x_n[i, 1]) * uy) * inv_h
+            f = ks[e] * (length - rest[e]) + kd[e] * rv
+            kk = ks[e] + kd[e] * inv_h
+            kxx = kk * ux * ux + ks[e] * tt * (1.0 - ux * ux)
+            kxy = kk * ux * uy - ks[e] * tt * ux * uy
+            kyy = kk * uy * uy + ks[e] * tt * (1.0 - uy * uy)
+            # J of (x_j - x_i) in the unknowns: the moving ends' +-(d + A r)
+            jx = np.zeros(6)
+            jy = np.zeros(6)
+            for end in range(2):
+                v = j if end == 1 else i
+                if cluster[v] != cl:
+                    continue
+                sg = 1.0 if end == 1 else -1.0
+                rx, ry = x[v, 0] - cx, x[v, 1] - cy
+                jx[0] += sg
+                jx[2] += sg * rx
+                jx[3] += sg * ry
+                jy[1] += sg
+                jy[4] += sg * rx
+                jy[5] += sg * ry
+            fx, fy = f * ux, f * uy
+            for a in range(6):
+                g[a] += jx[a] * fx + jy[a] * fy
+                for c in range(6):
+                    hm[a, c] += jx[a] * (kxx * jx[c] + kxy * jy[c]) + jy[a] * (kxy * jx[c] + kyy * jy[c])
+        # the Newton step: H delta = -g, H projected to be positive definite (eigenvalues
+        # below a small share of the inertia's raised to it)
+        w, vec = np.linalg.eigh(hm)
+        floor = 1e-3 * sm
+        delta = np.zeros(6)
+        for mm in range(6):
+            lam_m = max(w[mm], floor)
+            s = 0.0
+            for a in range(6):
+                s += vec[a, mm] * g[a]
+            for a in range(6):
+                delta[a] -= vec[a, mm] * s / lam_m
+        for p in range(lo, hi):
+            i = v_list[p]
+            rx, ry = x[i, 0] - cx, x[i, 1] - cy
+            x[i, 0] += delta[0] + delta[2] * rx + delta[3] * ry
+            x[i, 1] += delta[1] + delta[4] * rx + delta[5] * ry
