@@ -10,7 +10,7 @@ by the outline's spacing ``h``: the last touching vertex lies up to one ``h`` in
 (0.91 of ``a`` at h = 2 cm and 1.4 cm, 0.97 at 1 cm, measured).
 
 The answer does not depend on the step: the same within rounding at 1/60 s and 1/600 s,
-under the default symplectic Euler (substeps="auto") and the converged implicit solvers.
+under the default symplectic Euler (substeps="auto"), the converged implicit solvers and avbd.
 Air drag lets the disc settle without changing where it rests.
 """
 
@@ -64,6 +64,9 @@ def test_the_default_world_rests_a_disc_on_its_hertz_half_width_at_any_step(h, d
     assert half_width(h, dt, "symplectic-euler") == pytest.approx(HERTZ, rel=0.15)
 
 
-@pytest.mark.parametrize("integrator, options", [("implicit-bdf2", None), ("implicit-euler", {"tolerance": 1e-3})])
+@pytest.mark.parametrize("integrator, options", [("implicit-bdf2", None), ("implicit-euler", {"tolerance": 1e-3}),
+                                                 ("avbd", None)])
 def test_the_converged_implicit_solvers_rest_it_there_at_a_display_step(integrator, options):
-    assert half_width(0.02, 1 / 60, integrator, options) == pytest.approx(HERTZ, rel=0.15)
+    # (avbd at its default ten sweeps a step: 0.911 of a on both meshes, as the others)
+    for h in (0.02, 0.014) if integrator == "avbd" else (0.02,):
+        assert half_width(h, 1 / 60, integrator, options) == pytest.approx(HERTZ, rel=0.15)

@@ -26,7 +26,7 @@ from numba import njit
 from ...elements import corotated, neo_hookean
 from ...elements.triangles import deformation_gradient, rate_stress, stress
 from ...material import KIND_COROTATED
-from .rows import contact_block
+from .rows import on_rows
 
 
 def make_clusters(x, body_start, inv_mass, size):
@@ -96,8 +96,7 @@ def _add_jacobian_terms(g, hm, jac, pvec, hf, a):
 
 @njit(cache=True)
 def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_list, se_start, se_list, elem, b,
-                  area, mu, lam, beta, kind, spring_i, spring_j, rest, ks, kd, grab_slot, grab_pull, vertex_row,
-                  planes, rows, inv_h):
+                  area, mu, lam, beta, kind, spring_i, spring_j, rest, ks, kd, grab_slot, grab_pull, rs, inv_h):
     """One Gauss-Seidel pass over the clusters, each an affine Newton step (module docstring)."""
     hf = np.empty((4, 4))
     cf = np.empty((4, 4))
@@ -112,7 +111,7 @@ def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_lis
             continue
         touching = False
         for p in range(lo, hi):
-            if vertex_row[v_list[p]] >= 0:
+            if on_rows(v_list[p], rs):
                 touching = True
         if touching:
             # a patch on a contact is left to the vertex blocks and the whole-body step:
@@ -145,14 +144,6 @@ def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_lis
                 gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
                 hxx += grab_pull[s, 0]
                 hyy += grab_pull[s, 0]
-            k = vertex_row[i]
-            if k >= 0:
-                cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, planes, rows, k, True)
-                gx += cgx
-                gy += cgy
-                hxx += cxx
-                hxy += cxy
-                hyy += cyy
             rx, ry = x[i, 0] - cx, x[i, 1] - cy
             # J_v: row x = (1, 0, rx, ry, 0, 0), row y = (0, 1, 0, 0, rx, ry)
             jx = (1.0, 0.0, rx, ry, 0.0, 0.0)

@@ -31,8 +31,16 @@ Units: m, N, N/m.
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 from numba import njit
+
+#: A step's contact rows as the sweeps read them: the collider rows (``vertex_row`` (N,),
+#: ``planes`` (N, 7), ``rows`` (N, ROW_COLUMNS)) and the body rows (the contact stage's
+#: topology ``topo`` and buffer ``buf``, their state ``bstate`` (C, ROW_COLUMNS), and which
+#: rows each vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``).
+RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "topo", "buf", "bstate", "b_start", "b_entry"])
 
 #: Columns of a step's contact rows (K, ROW_COLUMNS).
 LAM_N, LAM_T, K_N, K_T, STICK, BOUND = 0, 1, 2, 3, 4, 5
@@ -179,3 +187,209 @@ def update_rows(x, x_n, touch, planes, state, count, beta, k_max):
             state[k, K_T] = min(state[k, K_T] + beta * abs(slip), k_max)
         else:
             state[k, LAM_T] = bound if ft > 0.0 else -bound
+
+
+# -- body contacts: a vertex against an outline edge of another body or its own ---------------
+#
+# Row c of the contact stage's buffer (:mod:`deforma.physics.contact`) holds vertex p against
+# the point (1 - s) x_a + s x_b of an edge, with a normal n fixed for the step and a target
+# distance: C_n = n . (x_p - (1 - s) x_a - s x_b) - target, and the slip C_t along t = (-n_y,
+# n_x) of that relative point since the step began. The rows take the same forces as a
+# collider's, shared by the three vertices with the weights (1, -(1 - s), -s): the pair's
+# momentum is kept. Warm start by the pair (collision vertex, edge).
+
+
+@njit(cache=True, inline="always")
+def body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, mu, state, c):
+    """Body row ``c``'s normal and friction force: ``(f_n, f_t, C_n, C_t, mu)`` (friction
+    unclamped; ``mu`` (dynamic, static) by the row's stick flag)."""
+    ca = 1.0 - s
+    gap = (x[ip, 0] - ca * x[ia, 0] - s * x[ib, 0]) * nx + (x[ip, 1] - ca * x[ia, 1] - s * x[ib, 1]) * ny - target
+    fn = max(0.0, state[c, LAM_N] - state[c, K_N] * gap)
+    rx = (x[ip, 0] - x_n[ip, 0]) - ca * (x[ia, 0] - x_n[ia, 0]) - s * (x[ib, 0] - x_n[ib, 0])
+    ry = (x[ip, 1] - x_n[ip, 1]) - ca * (x[ia, 1] - x_n[ia, 1]) - s * (x[ib, 1] - x_n[ib, 1])
+    slip = -rx * ny + ry * nx
+    ft = state[c, LAM_T] - state[c, K_T] * slip
+    m = mu[c, 1] if state[c, STICK] > 0.0 else mu[c, 0]
+    return fn, ft, gap, slip, m
+
+
+@njit(cache=True)
+def start_body_rows(topo, buf, count, memory, state, k_start, carry, soften, k_max, v):
+    """Open the step's body rows (``buf[:count]``), warm-started from ``memory`` (per collision
+    vertex: edge, ``lambda_n``, ``lambda_t``, ``k_n``, ``k_t``) when the same vertex met the
+    same edge last step; static friction for the step when the pair's relative velocity
+    along the edge was below :data:`STICK_SPEED` as it began."""
+    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    for c in range(count):
+        q = buf.vertex[c]
+        ip, ia, ib = cv[q], cv[ce_a[buf.edge[c]]], cv[ce_b[buf.edge[c]]]
+        k0 = max(k_start[ip], k_start[ia], k_start[ib])
+        if memory[q, MEM_ROW] == buf.edge[c]:
+            state[c, LAM_N] = memory[q, 1] * carry
+            state[c, LAM_T] = memory[q, 2] * carry
+            state[c, K_N] = min(max(memory[q, 3] * soften, k0), k_max)
+            state[c, K_T] = min(max(memory[q, 4] * soften, k0), k_max)
+        else:
+            state[c, LAM_N] = 0.0
+            state[c, LAM_T] = 0.0
+            state[c, K_N] = k0
+            state[c, K_T] = k0
+        s = buf.s[c]
+        nx, ny = buf.normal[c, 0], buf.normal[c, 1]
+        rvx = v[ip, 0] - (1.0 - s) * v[ia, 0] - s * v[ib, 0]
+        rvy = v[ip, 1] - (1.0 - s) * v[ia, 1] - s * v[ib, 1]
+        state[c, STICK] = 1.0 if abs(-rvx * ny + rvy * nx) <= STICK_SPEED else 0.0
+
+
+@njit(cache=True)
+def close_body_rows(buf, count, memory, state):
+    """Keep the body rows' multipliers and penalties by (collision vertex, edge) for the next
+    step; forget the rest."""
+    memory[:, MEM_ROW] = -1.0
+    for c in range(count):
+        q = buf.vertex[c]
+        if memory[q, MEM_ROW] >= 0.0 and state[c, LAM_N] <= memory[q, 1]:
+            continue  # a vertex on two edges (a corner) keeps the one that pushes more
+        memory[q, MEM_ROW] = buf.edge[c]
+        memory[q, 1] = state[c, LAM_N]
+        memory[q, 2] = state[c, LAM_T]
+        memory[q, 3] = state[c, K_N]
+        memory[q, 4] = state[c, K_T]
+
+
+@njit(cache=True)
+def body_row_incidence(topo, buf, count, n_vertices, start, entry):
+    """Which body rows each vertex takes part in, as CSR into ``start`` (N + 1) and ``entry``
+    (3 count,): ``entry`` holds ``3 c + role`` (role 0: the vertex, 1: the edge's first end,
+    2: its second)."""
+    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    for i in range(n_vertices + 1):
+        start[i] = 0
+    for c in range(count):
+        start[cv[buf.vertex[c]] + 1] += 1
+        start[cv[ce_a[buf.edge[c]]] + 1] += 1
+        start[cv[ce_b[buf.edge[c]]] + 1] += 1
+    for i in range(n_vertices):
+        start[i + 1] += start[i]
+    fill = start[:n_vertices].copy()
+    for c in range(count):
+        for role in range(3):
+            if role == 0:
+                i = cv[buf.vertex[c]]
+            elif role == 1:
+                i = cv[ce_a[buf.edge[c]]]
+            else:
+                i = cv[ce_b[buf.edge[c]]]
+            entry[fill[i]] = 3 * c + role
+            fill[i] += 1
+
+
+@njit(cache=True, inline="always")
+def body_row_parts(topo, buf, c):
+    """``(ip, ia, ib, s, nx, ny, target)`` of body row ``c``."""
+    cv = topo.cv_vertex
+    e = buf.edge[c]
+    return (cv[buf.vertex[c]], cv[topo.ce_a[e]], cv[topo.ce_b[e]], buf.s[c], buf.normal[c, 0], buf.normal[c, 1],
+            buf.target[c])
+
+
+@njit(cache=True, inline="always")
+def role_weight(role, s):
+    """How vertex ``role`` of a body row moves its distance: 1, -(1 - s), -s."""
+    if role == 0:
+        return 1.0
+    if role == 1:
+        return -(1.0 - s)
+    return -s
+
+
+@njit(cache=True)
+def body_blocks(x, x_n, i, topo, buf, state, start, entry, whole):
+    """Vertex ``i``'s share of its body rows: ``(gx, gy, hxx, hxy, hyy)`` (``whole``: the
+    normal stiffness of rows that do not push now too, and the frozen friction bounds)."""
+    gx = gy = hxx = hxy = hyy = 0.0
+    for p in range(start[i], start[i + 1]):
+        c = entry[p] // 3
+        role = entry[p] - 3 * c
+        ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
+        w = role_weight(role, s)
+        fn, ft, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
+        kn, kt = state[c, K_N], state[c, K_T]
+        if fn <= 0.0:
+            if whole:
+                hxx += w * w * kn * nx * nx
+                hxy += w * w * kn * nx * ny
+                hyy += w * w * kn * ny * ny
+            continue
+        bound = state[c, BOUND] if whole else mu * fn
+        if abs(ft) >= bound:
+            ft = bound if ft > 0.0 else -bound
+            kt = 0.0
+        tx, ty = -ny, nx
+        gx -= w * (fn * nx + ft * tx)
+        gy -= w * (fn * ny + ft * ty)
+        hxx += w * w * (kn * nx * nx + kt * tx * tx)
+        hxy += w * w * (kn * nx * ny + kt * tx * ty)
+        hyy += w * w * (kn * ny * ny + kt * ty * ty)
+    return gx, gy, hxx, hxy, hyy
+
+
+@njit(cache=True, inline="always")
+def row_energy(fn, ft, kn, kt, bound):
+    """A row's energy from its normal and (unclamped) friction force: ``f_n^2 / 2 k_n`` and
+    the friction's ``f_t^2 / 2 k_t`` continued linearly beyond ``bound``."""
+    e = 0.5 * fn * fn / kn
+    if fn <= 0.0:
+        return e
+    if abs(ft) <= bound:
+        return e + 0.5 * ft * ft / kt
+    return e + 0.5 * bound * bound / kt + bound * (abs(ft) - bound) / kt
+
+
+@njit(cache=True)
+def freeze_body_bounds(x, x_n, topo, buf, state, count):
+    """Each body row's friction bound ``mu f_n`` at the iterate ``x``, into ``state[:, BOUND]``."""
+    for c in range(count):
+        ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
+        fn, _, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
+        state[c, BOUND] = mu * fn
+
+
+@njit(cache=True)
+def update_body_rows(x, x_n, topo, buf, state, count, beta, k_max):
+    """The body rows' dual step, as :func:`update_rows`'s."""
+    for c in range(count):
+        ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
+        fn, ft, gap, slip, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
+        state[c, LAM_N] = fn
+        if fn > 0.0:
+            state[c, K_N] = min(state[c, K_N] + beta * abs(gap), k_max)
+        bound = mu * fn
+        if abs(ft) < bound:
+            state[c, LAM_T] = ft
+            state[c, K_T] = min(state[c, K_T] + beta * abs(slip), k_max)
+        else:
+            state[c, LAM_T] = bound if ft > 0.0 else -bound
+
+
+@njit(cache=True, inline="always")
+def row_blocks(x, x_n, i, rs, whole):
+    """Vertex ``i``'s share of all its contact rows, collider and body: ``(gx, gy, hxx, hxy,
+    hyy)``."""
+    gx, gy, hxx, hxy, hyy = body_blocks(x, x_n, i, rs.topo, rs.buf, rs.bstate, rs.b_start, rs.b_entry, whole)
+    k = rs.vertex_row[i]
+    if k >= 0:
+        cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, rs.planes, rs.rows, k, whole)
+        gx += cgx
+        gy += cgy
+        hxx += cxx
+        hxy += cxy
+        hyy += cyy
+    return gx, gy, hxx, hxy, hyy
+
+
+@njit(cache=True, inline="always")
+def on_rows(i, rs):
+    """Whether vertex ``i`` takes part in any contact row this step."""
+    return rs.vertex_row[i] >= 0 or rs.b_start[i + 1] > rs.b_start[i]

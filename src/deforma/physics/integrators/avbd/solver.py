@@ -31,9 +31,10 @@ affine motions (:mod:`~deforma.physics.integrators.avbd.clusters`, a coarse leve
 correction a patch per visit), and every body without a pin one over its rigid motions
 (:func:`rigid_correction`).
 
-Collider contacts and their Coulomb friction are rows inside the sweep
-(:mod:`~deforma.physics.integrators.avbd.rows`); contacts between and within bodies are met
-after it by the shared contact stage, as for the other position-based integrators. Pins stay
+Contacts are found once, before the solve, for the predicted motion: a vertex against a
+collider, and a vertex against an outline edge of another body or its own. Each is a row
+inside the sweep with Coulomb friction (:mod:`~deforma.physics.integrators.avbd.rows`),
+warm-started by its pair; the shared contact stage after the sweep stays as the fail-safe. Pins stay
 put (infinite mass); a grab is a zero-length spring of its strength to its target.
 
 Units: m, s, kg, N, N/m.
@@ -49,14 +50,18 @@ from numba import njit
 from ...colliders.geometry import advance_colliders
 from ...colliders.response import contact_planes
 from ...contact.broad_phase import gather_start
+from ...contact.contacts import SPECULATIVE, make_buffer, make_scratch
+from ...contact.narrow_phase import detect_contacts
+from ...contact.response import hold_start_distance
 from ..base import Integrator, Option, StepReport, contact_epilogue, finish_position_step, register_integrator
 from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
 from .blocks import incidence
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
-from .rows import (MEMORY_COLUMNS, ROW_COLUMNS, close_rows, contact_block, contact_energy, freeze_bounds, start_rows,
-                   update_rows)
+from .rows import (BOUND, K_N, K_T, LAM_N, LAM_T, MEMORY_COLUMNS, ROW_COLUMNS, RowSet, body_row_incidence,
+                   body_row_parts, close_body_rows, close_rows, contact_energy, freeze_body_bounds, freeze_bounds,
+                   row_blocks, row_energy, start_body_rows, start_rows, update_body_rows, update_rows)
 
 
 @njit(cache=True)
@@ -93,7 +98,7 @@ def predict(x, v, x_n, y, v_last, has_last, inv_mass, gx, gy, keep, force, has_f
 
 
 @njit(cache=True, inline="always")
-def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, vertex_row, planes, rows):
+def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs):
     """Finish vertex ``i``'s block (its elements' share ``g``, ``H`` given): add the inertia,
     its grab and its contact row, and take the Newton step. Returns the squared move (m^2)."""
     m = mass_h2[i]
@@ -107,14 +112,12 @@ def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, 
         gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
         hxx += grab_pull[s, 0]
         hyy += grab_pull[s, 0]
-    k = vertex_row[i]
-    if k >= 0:
-        cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, planes, rows, k, False)
-        gx += cgx
-        gy += cgy
-        hxx += cxx
-        hxy += cxy
-        hyy += cyy
+    cgx, cgy, cxx, cxy, cyy = row_blocks(x, x_n, i, rs, False)
+    gx += cgx
+    gy += cgy
+    hxx += cxx
+    hxy += cxy
+    hyy += cyy
     det = hxx * hyy - hxy * hxy
     if not det > 0.0:
         return 0.0
@@ -128,7 +131,7 @@ def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, 
 @njit(cache=True)
 def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_corner, elem, b, area, mu, lam,
           beta, kind, spring_start, spring_item, spring_corner, spring_i, spring_j, rest, ks, kd, grab_slot,
-          grab_pull, vertex_row, planes, rows, inv_h, hf):
+          grab_pull, rs, inv_h, hf):
     """One Gauss-Seidel sweep, colour after colour, over every free vertex's block (the
     built-in element kinds). Returns the largest squared move (m^2)."""
     most = 0.0
@@ -155,16 +158,14 @@ def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_
                 hxx += exx
                 hxy += exy
                 hyy += eyy
-            moved = descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, vertex_row, planes,
-                            rows)
+            moved = descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs)
             if moved > most:
                 most = moved
     return most
 
 
 @njit(cache=True)
-def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, grab_slot, grab_pull, vertex_row,
-                       planes, rows):
+def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, grab_slot, grab_pull, rs):
     """The vertices ``order[start:stop]`` (one colour) with their elements' share of the
     block given (``g`` (N, 2), ``hb`` (N, 3)): the path for element kinds that are not
     built in. Returns the largest squared move (m^2)."""
@@ -174,10 +175,20 @@ def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, 
         if inv_mass[i] == 0.0:
             continue
         moved = descend(x, x_n, y, i, g[i, 0], g[i, 1], hb[i, 0], hb[i, 1], hb[i, 2], mass_h2, grab_slot, grab_pull,
-                        vertex_row, planes, rows)
+                        rs)
         if moved > most:
             most = moved
     return most
+
+
+@njit(cache=True)
+def narrow_targets(topo, buf, count, margin):
+    """Take the margin back off the targets of the contacts between two bodies found with
+    their thickness widened by it (:meth:`AVBD._collide`)."""
+    body = topo.cv_body
+    for c in range(count):
+        if body[buf.vertex[c]] != topo.ce_body[buf.edge[c]]:
+            buf.target[c] = max(buf.target[c] - margin, 0.0)
 
 
 @njit(cache=True)
@@ -194,7 +205,7 @@ def chebyshev(x, x_prev, x_prev2, inv_mass, vertex_row, omega):
 
 
 @njit(cache=True)
-def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_pull, vertex_row, planes, rows):
+def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_pull, rs):
     """Move each body as a whole by the Newton step of the objective over its rigid motions.
 
     A vertex sweep moves a stiff body's rigid modes slowly: each vertex is held by its
@@ -237,17 +248,15 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
                 gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
                 hxx += grab_pull[s, 0]
                 hyy += grab_pull[s, 0]
-            k = vertex_row[i]
-            if k >= 0:
-                # the row's gradient where it is, and its stiffness whether it pushes now or
-                # not: a row that starts to push within the step bounds the step (with only
-                # the active rows a resting block rocked on its warm-started contacts)
-                cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, planes, rows, k, True)
-                gx += cgx
-                gy += cgy
-                hxx += cxx
-                hxy += cxy
-                hyy += cyy
+            # the rows' gradient where they are, and their stiffness whether they push now or
+            # not: a row that starts to push within the step bounds the step (with only the
+            # active rows a resting block rocked on its warm-started contacts)
+            cgx, cgy, cxx, cxy, cyy = row_blocks(x, x_n, i, rs, True)
+            gx += cgx
+            gy += cgy
+            hxx += cxx
+            hxy += cxy
+            hyy += cyy
             # J = [[1, 0, -ry], [0, 1, rx]]
             rx, ry = x[i, 0] - cx, x[i, 1] - cy
             g0 += gx
@@ -279,11 +288,11 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
         slope = g0 * dx + g1 * dy + g2 * th
         if not slope < 0.0:
             continue
-        e0 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, vertex_row, planes, rows, cx, cy,
+        e0 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
                           0.0, 0.0, 0.0)
         t = 1.0
         while t > 1e-3:
-            e1 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, vertex_row, planes, rows, cx, cy,
+            e1 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
                               t * dx, t * dy, t * th)
             if e1 <= e0 + 1e-4 * t * slope + 1e-12 * abs(e0):  # (rounding: a step too small to measure is taken)
                 break
@@ -298,7 +307,7 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
 
 
 @njit(cache=True)
-def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, vertex_row, planes, rows, cx, cy, dx, dy, th):
+def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, dx, dy, th):
     """The objective's inertia, grab and contact-row part (J) over the vertices ``lo:hi`` moved
     as a whole: turned by ``th`` about ``(cx, cy)`` and shifted by ``(dx, dy)``."""
     co, si = np.cos(th), np.sin(th)
@@ -312,9 +321,34 @@ def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, vertex_row, p
         if s >= 0:
             tx, ty = grab_pull[s, 1] / grab_pull[s, 0], grab_pull[s, 2] / grab_pull[s, 0]
             e += 0.5 * grab_pull[s, 0] * ((px - tx) ** 2 + (py - ty) ** 2)
-        k = vertex_row[i]
+        k = rs.vertex_row[i]
         if k >= 0:
-            e += contact_energy(px, py, x_n, i, planes, rows, k)
+            e += contact_energy(px, py, x_n, i, rs.planes, rs.rows, k)
+        # body rows, each once (at its first vertex in the body), with its vertices in the
+        # body moved and the others where they are
+        for p in range(rs.b_start[i], rs.b_start[i + 1]):
+            c = rs.b_entry[p] // 3
+            ip, ia, ib, s, nx, ny, target = body_row_parts(rs.topo, rs.buf, c)
+            first = ip if lo <= ip < hi else (ia if lo <= ia < hi else ib)
+            if first != i:
+                continue
+            q = np.empty((3, 2))
+            for r in range(3):
+                v = ip if r == 0 else (ia if r == 1 else ib)
+                if lo <= v < hi:
+                    ux, uy = x[v, 0] - cx, x[v, 1] - cy
+                    q[r, 0] = cx + dx + co * ux - si * uy
+                    q[r, 1] = cy + dy + si * ux + co * uy
+                else:
+                    q[r, 0], q[r, 1] = x[v, 0], x[v, 1]
+            ca = 1.0 - s
+            gap = (q[0, 0] - ca * q[1, 0] - s * q[2, 0]) * nx + (q[0, 1] - ca * q[1, 1] - s * q[2, 1]) * ny - target
+            st = rs.bstate
+            fn = max(0.0, st[c, LAM_N] - st[c, K_N] * gap)
+            rx = (q[0, 0] - x_n[ip, 0]) - ca * (q[1, 0] - x_n[ia, 0]) - s * (q[2, 0] - x_n[ib, 0])
+            ry = (q[0, 1] - x_n[ip, 1]) - ca * (q[1, 1] - x_n[ia, 1]) - s * (q[2, 1] - x_n[ib, 1])
+            ft = st[c, LAM_T] - st[c, K_T] * (-rx * ny + ry * nx)
+            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
     return e
 
 
@@ -386,6 +420,10 @@ class AVBD(Integrator):
         self._topology = (None,)
         self._stiff = None
         self._patches = None
+        self._body_memory = None
+        self._search = None
+        self._bstate = np.empty((0, ROW_COLUMNS))
+        self._b_entry = np.empty(0, np.int64)
         self._n = -1
         self.iterations_run = 0
         self.unconverged = 0
@@ -466,6 +504,7 @@ class AVBD(Integrator):
             self._rows = np.empty((n, ROW_COLUMNS))
             self._memory = np.full((n, MEMORY_COLUMNS), -1.0)
             self._hf = np.empty((4, 4))
+            self._b_start = np.zeros(n + 1, np.int64)
             self._n = n
 
     def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
@@ -493,13 +532,16 @@ class AVBD(Integrator):
                     control.force, control.has_force, h)
             self._has_last = True
             x_n = self._x_n
-            count = contact_planes(x_n, self._y, rects, self._planes, self._touch, self._plane_rows, False, h)
-            gather_start(x_n, ctopo, scr)  # for the contact stage after the sweep
+            # collide once, before the solve: the collider contacts and the body contacts of
+            # the predicted motion (each held no closer than its pair began the step)
+            count, n_body, found = self._collide(x_n, rects, ctopo, scr, buf, h)
             start_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows, k_start,
                        self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, h)
-            self._solve(model, topo, control, x, x_n, mass_h2, inv_mass, count, h, tol)
+            rs = self._body_rows(model, ctopo, found, n_body, k_start, v)
+            self._solve(model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol)
             close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
-            self.active_contacts = count
+            close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
+            self.active_contacts = count + n_body
             bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, h, vmax2)
             if bad:
                 return StepReport(int(bad), contacts.complete)
@@ -507,7 +549,59 @@ class AVBD(Integrator):
                 return StepReport(0, False)
         return StepReport(0, contacts.complete)
 
-    def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, h, tol):
+    def _collide(self, x_n, rects, ctopo, scr, buf, h):
+        """Collide once, before the solve: the collider contacts of the predicted motion and
+        the body contacts within a margin of it, ``(count, n_body, buffer)``.
+
+        Between bodies the margin is how far any vertex is predicted to move: a contact the
+        sweeps make (a box landing on another, whose support shifts its prediction by
+        millimetres) is then a row from the start, inactive while its gap stays open. Found
+        only at the prediction itself, a box at 1/60 s sank through the one below it.
+        Contacts of a body with itself keep its contact thickness."""
+        y = self._y
+        count = contact_planes(x_n, y, rects, self._planes, self._touch, self._plane_rows, False, h)
+        gather_start(x_n, ctopo, scr)  # for the contact stage after the sweep
+        # the rows' own search, in scratch of its own: the widened one left candidate pairs
+        # the stage after the sweep then tested (a block sliding at 1.5 m/s was braked by
+        # its own outline there)
+        margin = float(np.sqrt(((y - x_n) ** 2).sum(axis=1).max())) if len(y) else 0.0
+        wide = ctopo._replace(thick_other=ctopo.thick_other + margin, body_thickness=ctopo.body_thickness + margin,
+                              margin=ctopo.margin + SPECULATIVE * margin)
+        if self._search is None or self._search[0] is not ctopo:
+            self._search = (ctopo, make_scratch(len(ctopo.cv_vertex), len(ctopo.ce_a), len(ctopo.body_thickness)),
+                            make_buffer(64, 64))
+        _, mine, found = self._search
+        while True:
+            gather_start(x_n, ctopo, mine)
+            n_body = detect_contacts(y, wide, mine, found)
+            if n_body >= 0:
+                break
+            found = make_buffer(2 * max(mine.status["needed"][0], len(found.vertex)),
+                                2 * max(mine.status["pairs_needed"][0], len(found.pair_vertex)))
+            mine.status["needed"][0] = 0
+            mine.status["pairs_needed"][0] = 0
+            self._search = (ctopo, mine, found)
+        narrow_targets(ctopo, found, n_body, margin)
+        hold_start_distance(x_n, ctopo, found, n_body)
+        return count, n_body, found
+
+    def _body_rows(self, model, ctopo, buf, n_body, k_start, v):
+        """The step's body rows, warm-started (:func:`~deforma.physics.integrators.avbd.rows.start_body_rows`),
+        with the collider rows as one :class:`~deforma.physics.integrators.avbd.rows.RowSet`."""
+        n_cv = len(ctopo.cv_vertex)
+        if self._body_memory is None or self._body_memory[1] is not model:
+            self._body_memory = (np.full((n_cv, MEMORY_COLUMNS), -1.0), model)
+        if len(self._bstate) < n_body:
+            self._bstate = np.empty((2 * n_body, ROW_COLUMNS))
+            self._b_entry = np.empty(6 * n_body, np.int64)
+        opts = self._options
+        start_body_rows(ctopo, buf, n_body, self._body_memory[0], self._bstate, k_start, self.CARRY, self.SOFTEN,
+                        opts["penalty_max"], v)
+        body_row_incidence(ctopo, buf, n_body, model.n_vertices, self._b_start, self._b_entry)
+        return RowSet(self._vertex_row, self._planes, self._rows, ctopo, buf, self._bstate, self._b_start,
+                      self._b_entry)
+
+    def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
         opts = self._options
         rho = opts["chebyshev"]
@@ -529,16 +623,17 @@ class AVBD(Integrator):
                 most = sweep(x, x_n, y, mass_h2, inv_mass, order, starts, t_start, t_item, t_corner, tris.elem,
                              tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start, s_item, s_corner,
                              springs.i, springs.j, springs.rest, springs.ks, springs.kd, control.grab_slot,
-                             control.grab_pull, self._vertex_row, self._planes, self._rows, inv_h, self._hf)
+                             control.grab_pull, rs, inv_h, self._hf)
             else:
-                most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h)
+                most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs)
             freeze_bounds(x, x_n, self._touch, self._planes, self._rows, count)
+            freeze_body_bounds(x, x_n, rs.topo, rs.buf, rs.bstate, n_body)
             if patches is not None:
                 cluster_sweep(x, x_n, y, mass_h2, *patches, tris.elem, tris.b, tris.area, tris.mu, tris.lam,
                               tris.beta, tris.kind, springs.i, springs.j, springs.rest, springs.ks, springs.kd,
-                              control.grab_slot, control.grab_pull, self._vertex_row, self._planes, self._rows, inv_h)
+                              control.grab_slot, control.grab_pull, rs, inv_h)
             rigid_correction(x, x_n, y, mass_h2, inv_mass, model.body_vertex_offsets, control.grab_slot,
-                             control.grab_pull, self._vertex_row, self._planes, self._rows)
+                             control.grab_pull, rs)
             if rho > 0.0:
                 omega = chebyshev_omega(it, rho, omega)
                 chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)
@@ -548,12 +643,13 @@ class AVBD(Integrator):
         # stiff body's contacts chased its unconverged sweeps (a 1e5 Pa block's support jumped
         # between its corners from sweep to sweep and it slid off a slope it should stand on)
         update_rows(x, x_n, self._touch, self._planes, self._rows, count, opts["penalty_ramp"], opts["penalty_max"])
+        update_body_rows(x, x_n, rs.topo, rs.buf, rs.bstate, n_body, opts["penalty_ramp"], opts["penalty_max"])
         self.iterations_run += it + 1
         self.residual = math.sqrt(most) * inv_h
         if tol > 0.0 and most > tol * tol:
             self.unconverged += 1
 
-    def _sweep_kinds(self, model, control, x, x_n, mass_h2, inv_mass, order, starts, h):
+    def _sweep_kinds(self, model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs):
         """One sweep with the elements' share of each colour's blocks from the kinds'
         :meth:`~deforma.physics.elements.kind.ElementKind.vertex_blocks` (every kind, once per
         colour: exact, since a colour's vertices share no element, and slow)."""
@@ -566,8 +662,7 @@ class AVBD(Integrator):
             for kind in model.elements:
                 kind.vertex_blocks(x, x_n, h, g, hb)
             most = max(most, sweep_colour_given(x, x_n, self._y, mass_h2, inv_mass, order, starts[c], starts[c + 1],
-                                                g, hb, control.grab_slot, control.grab_pull, self._vertex_row,
-                                                self._planes, self._rows))
+                                                g, hb, control.grab_slot, control.grab_pull, rs))
         return most
 
 
