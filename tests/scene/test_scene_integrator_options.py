@@ -98,7 +98,7 @@ BAD = [
     ("xpbd", "contact_weight = 5.0", "contact_weight",
      "'contact_weight' is an option of implicit-euler and implicit-bdf2, not of xpbd (xpbd takes iterations)"),
     ("symplectic-euler", "iterations = 5", "iterations",
-     "'iterations' is an option of implicit-euler, xpbd and implicit-bdf2, not of symplectic-euler "
+     "'iterations' is an option of implicit-euler, xpbd, implicit-bdf2 and avbd, not of symplectic-euler "
      "(symplectic-euler takes mode)"),
     ("implicit-euler", "iterations = 0", "iterations",
      "implicit-euler option iterations must be an integer in [1, 10000], got 0"),

@@ -18,13 +18,17 @@ ROWS = {"symplectic-euler": ["integrator_mode"],
                            "integrator_contact_weight"],
         "xpbd": ["integrator_iterations"],
         "implicit-bdf2": ["integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
-                          "integrator_contact_weight"]}
+                          "integrator_contact_weight"],
+        "avbd": ["integrator_iterations", "integrator_tolerance", "integrator_cluster_size", "integrator_chebyshev",
+                 "integrator_penalty_start", "integrator_penalty_ramp", "integrator_penalty_max"]}
 
 
 def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
     rows = {p.name: p for p in integrator_params()}
     assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_tolerance",
-                          "integrator_max_iterations", "integrator_contact_weight"]
+                          "integrator_max_iterations", "integrator_contact_weight", "integrator_cluster_size",
+                          "integrator_chebyshev", "integrator_penalty_start", "integrator_penalty_ramp",
+                          "integrator_penalty_max"]
     assert not set(rows) & set(PARAMS)
     mode = rows["integrator_mode"]
     assert mode.kind == "choice" and mode.choices == ("auto", "serial", "parallel")
