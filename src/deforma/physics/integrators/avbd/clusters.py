@@ -72,14 +72,14 @@ def cluster_members(cluster, count, items):
 
 
 @njit(cache=True, inline="always")
-def _add_jacobian_terms(g, hm, jac, pvec, hf, a):
-    """``g += a jac^T pvec``, ``hm += a jac^T hf jac`` for a (4, 6) ``jac`` over vec F."""
+def _add_jacobian_terms(g, hm, jac, pvec, hf, a, tmp):
+    """``g += a jac^T pvec``, ``hm += a jac^T hf jac`` for a (4, 6) ``jac`` over vec F
+    (``tmp``: (4, 6) scratch)."""
     for p in range(6):
         s = 0.0
         for m in range(4):
             s += jac[m, p] * pvec[m]
         g[p] += a * s
-    tmp = np.empty((4, 6))
     for m in range(4):
         for q in range(6):
             s = 0.0
@@ -104,6 +104,10 @@ def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_lis
     pvec = np.empty(4)
     g = np.empty(6)
     hm = np.empty((6, 6))
+    jv = np.empty(3)
+    ix = np.array([0, 2, 3])
+    iy = np.array([1, 4, 5])
+    tmp = np.empty((4, 6))
     n_clusters = v_start.shape[0] - 1
     for cl in range(n_clusters):
         lo, hi = v_start[cl], v_start[cl + 1]
@@ -211,7 +215,7 @@ def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_lis
                 for mm in range(4):
                     for kk in range(4):
                         hf[mm, kk] += be * inv_h * 0.5 * (cf[mm, kk] + cf[kk, mm])
-            _add_jacobian_terms(g, hm, jac, pvec, hf, area[e])
+            _add_jacobian_terms(g, hm, jac, pvec, hf, area[e], tmp)
         # springs with an end in the cluster
         for q in range(se_start[cl], se_start[cl + 1]):
             e = se_list[q]
@@ -231,26 +235,29 @@ def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_lis
             kxx = kk * ux * ux + ks[e] * tt * (1.0 - ux * ux)
             kxy = kk * ux * uy - ks[e] * tt * ux * uy
             kyy = kk * uy * uy + ks[e] * tt * (1.0 - uy * uy)
-            # J of (x_j - x_i) in the unknowns: the moving ends' +-(d + A r)
-            jx = np.zeros(6)
-            jy = np.zeros(6)
+            # J of (x_j - x_i) in the unknowns: the moving ends' +-(d + A r), as (sign, rx, ry)
+            # sums: jx = (sg, 0, srx, sry, 0, 0), jy = (0, sg, 0, 0, srx, sry)
+            sg = srx = sry = 0.0
             for end in range(2):
                 v = j if end == 1 else i
                 if cluster[v] != cl:
                     continue
-                sg = 1.0 if end == 1 else -1.0
-                rx, ry = x[v, 0] - cx, x[v, 1] - cy
-                jx[0] += sg
-                jx[2] += sg * rx
-                jx[3] += sg * ry
-                jy[1] += sg
-                jy[4] += sg * rx
-                jy[5] += sg * ry
+                w = 1.0 if end == 1 else -1.0
+                sg += w
+                srx += w * (x[v, 0] - cx)
+                sry += w * (x[v, 1] - cy)
+            jv[0], jv[1], jv[2] = sg, srx, sry
             fx, fy = f * ux, f * uy
-            for a in range(6):
-                g[a] += jx[a] * fx + jy[a] * fy
-                for c in range(6):
-                    hm[a, c] += jx[a] * (kxx * jx[c] + kxy * jy[c]) + jy[a] * (kxy * jx[c] + kyy * jy[c])
+            # x rows use unknowns (0, 2, 3), y rows (1, 4, 5)
+            for a in range(3):
+                g[ix[a]] += jv[a] * fx
+                g[iy[a]] += jv[a] * fy
+                for c in range(3):
+                    jj = jv[a] * jv[c]
+                    hm[ix[a], ix[c]] += jj * kxx
+                    hm[ix[a], iy[c]] += jj * kxy
+                    hm[iy[a], ix[c]] += jj * kxy
+                    hm[iy[a], iy[c]] += jj * kyy
         # the Newton step: H delta = -g, H projected to be positive definite (eigenvalues
         # below a small share of the inertia's raised to it)
         w, vec = np.linalg.eigh(hm)

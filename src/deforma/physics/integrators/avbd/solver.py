@@ -306,6 +306,15 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
             x[i, 1] = cy + t * dy + si * rx + co * ry
 
 
+@njit(cache=True, inline="always")
+def _moved(x, v, lo, hi, cx, cy, dx, dy, co, si):
+    """Vertex ``v`` turned about ``(cx, cy)`` and shifted if it is one of ``lo:hi``."""
+    if lo <= v < hi:
+        ux, uy = x[v, 0] - cx, x[v, 1] - cy
+        return cx + dx + co * ux - si * uy, cy + dy + si * ux + co * uy
+    return x[v, 0], x[v, 1]
+
+
 @njit(cache=True)
 def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, dx, dy, th):
     """The objective's inertia, grab and contact-row part (J) over the vertices ``lo:hi`` moved
@@ -332,21 +341,15 @@ def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, d
             first = ip if lo <= ip < hi else (ia if lo <= ia < hi else ib)
             if first != i:
                 continue
-            q = np.empty((3, 2))
-            for r in range(3):
-                v = ip if r == 0 else (ia if r == 1 else ib)
-                if lo <= v < hi:
-                    ux, uy = x[v, 0] - cx, x[v, 1] - cy
-                    q[r, 0] = cx + dx + co * ux - si * uy
-                    q[r, 1] = cy + dy + si * ux + co * uy
-                else:
-                    q[r, 0], q[r, 1] = x[v, 0], x[v, 1]
+            p0x, p0y = _moved(x, ip, lo, hi, cx, cy, dx, dy, co, si)
+            p1x, p1y = _moved(x, ia, lo, hi, cx, cy, dx, dy, co, si)
+            p2x, p2y = _moved(x, ib, lo, hi, cx, cy, dx, dy, co, si)
             ca = 1.0 - s
-            gap = (q[0, 0] - ca * q[1, 0] - s * q[2, 0]) * nx + (q[0, 1] - ca * q[1, 1] - s * q[2, 1]) * ny - target
+            gap = (p0x - ca * p1x - s * p2x) * nx + (p0y - ca * p1y - s * p2y) * ny - target
             st = rs.bstate
             fn = max(0.0, st[c, LAM_N] - st[c, K_N] * gap)
-            rx = (q[0, 0] - x_n[ip, 0]) - ca * (q[1, 0] - x_n[ia, 0]) - s * (q[2, 0] - x_n[ib, 0])
-            ry = (q[0, 1] - x_n[ip, 1]) - ca * (q[1, 1] - x_n[ia, 1]) - s * (q[2, 1] - x_n[ib, 1])
+            rx = (p0x - x_n[ip, 0]) - ca * (p1x - x_n[ia, 0]) - s * (p2x - x_n[ib, 0])
+            ry = (p0y - x_n[ip, 1]) - ca * (p1y - x_n[ia, 1]) - s * (p2y - x_n[ib, 1])
             ft = st[c, LAM_T] - st[c, K_T] * (-rx * ny + ry * nx)
             e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
     return e
