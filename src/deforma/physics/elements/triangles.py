@@ -541,7 +541,7 @@ def triangle_vertex_block(x, x_n, e, corner, elem, b, area, mu, lam, beta, kind,
         gx += a * be * (s00 * d0 + s01 * d1)
         gy += a * be * (s10 * d0 + s11 * d1)
         w = a * be * inv_h
-        u00, u01, u10, u11 = rate_stress(f00, f01, f10, f11, d0, d1, 0.0, 0.0, mu[e], lam[e])  # x moves
+        u00, u01, _, _ = rate_stress(f00, f01, f10, f11, d0, d1, 0.0, 0.0, mu[e], lam[e])  # x moves
         v00, v01, v10, v11 = rate_stress(f00, f01, f10, f11, 0.0, 0.0, d0, d1, mu[e], lam[e])  # y moves
         hxx += w * (u00 * d0 + u01 * d1)
         hxy += w * (v00 * d0 + v01 * d1)

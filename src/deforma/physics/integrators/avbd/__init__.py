@@ -7,6 +7,6 @@ blocks with contacts as augmented-Lagrangian rows.
 - :mod:`~deforma.physics.integrators.avbd.solver`: the step, registered as ``"avbd"``.
 """
 
-from .solver import AVBD  # noqa: F401  (registers "avbd")
+from .solver import AVBD
 
 __all__ = ["AVBD"]

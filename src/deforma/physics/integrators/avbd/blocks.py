@@ -37,6 +37,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .rows import row_blocks
+
 
 @njit(cache=True)
 def incidence(items, n_vertices):
@@ -68,3 +70,25 @@ def incidence(items, n_vertices):
             corner[fill[v]] = c
             fill[v] += 1
     return start, item, corner
+
+
+@njit(cache=True, inline="always")
+def outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, whole):
+    """Vertex ``i``'s block from all but its elements: the inertia ``M / h^2 (x - y)``, its
+    grab (a zero-length spring of strength S to the target: ``S (x - t)``) and its contact
+    rows (``rs``, :class:`~deforma.physics.integrators.avbd.rows.RowSet`; ``whole``: as
+    :func:`~deforma.physics.integrators.avbd.rows.row_blocks` takes it). Returns ``(gx, gy,
+    hxx, hxy, hyy)``."""
+    m = mass_h2[i]
+    gx = m * (x[i, 0] - y[i, 0])
+    gy = m * (x[i, 1] - y[i, 1])
+    hxx = hyy = m
+    hxy = 0.0
+    s = grab_slot[i]
+    if s >= 0:
+        gx += grab_pull[s, 0] * x[i, 0] - grab_pull[s, 1]
+        gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
+        hxx += grab_pull[s, 0]
+        hyy += grab_pull[s, 0]
+    cgx, cgy, cxx, cxy, cyy = row_blocks(x, x_n, i, rs, whole)
+    return gx + cgx, gy + cgy, hxx + cxx, hxy + cxy, hyy + cyy

@@ -26,6 +26,7 @@ from numba import njit
 from ...elements import corotated, neo_hookean
 from ...elements.triangles import deformation_gradient, rate_stress, stress
 from ...material import KIND_COROTATED
+from .blocks import outer_block
 from .rows import on_rows
 
 
@@ -137,17 +138,7 @@ def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_lis
         # unknowns: (d0, d1, A00, A01, A10, A11); dx_v = (d0 + A00 rx + A01 ry, d1 + A10 rx + A11 ry)
         for p in range(lo, hi):
             i = v_list[p]
-            m = mass_h2[i]
-            gx = m * (x[i, 0] - y[i, 0])
-            gy = m * (x[i, 1] - y[i, 1])
-            hxx = hyy = m
-            hxy = 0.0
-            s = grab_slot[i]
-            if s >= 0:
-                gx += grab_pull[s, 0] * x[i, 0] - grab_pull[s, 1]
-                gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
-                hxx += grab_pull[s, 0]
-                hyy += grab_pull[s, 0]
+            gx, gy, hxx, hxy, hyy = outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, True)
             rx, ry = x[i, 0] - cx, x[i, 1] - cy
             # J_v: row x = (1, 0, rx, ry, 0, 0), row y = (0, 1, 0, 0, rx, ry)
             jx = (1.0, 0.0, rx, ry, 0.0, 0.0)

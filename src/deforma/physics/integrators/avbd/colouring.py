@@ -51,8 +51,7 @@ def colour_vertices(n_vertices, tri_start, tri_item, elem, spring_start, spring_
         while mark[c] == v:
             c += 1
         colour[v] = c
-        if c + 1 > n_colours:
-            n_colours = c + 1
+        n_colours = max(n_colours, c + 1)
     starts = np.zeros(n_colours + 1, np.int64)
     for v in range(n_vertices):
         starts[colour[v] + 1] += 1

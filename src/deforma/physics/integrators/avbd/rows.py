@@ -33,7 +33,6 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-import numpy as np
 from numba import njit
 
 #: A step's contact rows as the sweeps read them: the collider rows (``vertex_row`` (N,),

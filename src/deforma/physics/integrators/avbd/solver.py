@@ -53,15 +53,41 @@ from ...contact.broad_phase import gather_start
 from ...contact.contacts import SPECULATIVE, make_buffer, make_scratch
 from ...contact.narrow_phase import detect_contacts
 from ...contact.response import hold_start_distance
-from ..base import Integrator, Option, StepReport, contact_epilogue, finish_position_step, register_integrator
 from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
-from .blocks import incidence
+from ..base import (
+    Integrator,
+    Option,
+    StepReport,
+    contact_epilogue,
+    finish_position_step,
+    register_integrator,
+)
+from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
-from .rows import (BOUND, K_N, K_T, LAM_N, LAM_T, MEMORY_COLUMNS, ROW_COLUMNS, RowSet, body_row_incidence,
-                   body_row_parts, close_body_rows, close_rows, contact_energy, freeze_body_bounds, freeze_bounds,
-                   row_blocks, row_energy, start_body_rows, start_rows, update_body_rows, update_rows)
+from .rows import (
+    BOUND,
+    K_N,
+    K_T,
+    LAM_N,
+    LAM_T,
+    MEMORY_COLUMNS,
+    ROW_COLUMNS,
+    RowSet,
+    body_row_incidence,
+    body_row_parts,
+    close_body_rows,
+    close_rows,
+    contact_energy,
+    freeze_body_bounds,
+    freeze_bounds,
+    row_energy,
+    start_body_rows,
+    start_rows,
+    update_body_rows,
+    update_rows,
+)
 
 
 @njit(cache=True)
@@ -101,23 +127,12 @@ def predict(x, v, x_n, y, v_last, has_last, inv_mass, gx, gy, keep, force, has_f
 def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs):
     """Finish vertex ``i``'s block (its elements' share ``g``, ``H`` given): add the inertia,
     its grab and its contact row, and take the Newton step. Returns the squared move (m^2)."""
-    m = mass_h2[i]
-    gx += m * (x[i, 0] - y[i, 0])
-    gy += m * (x[i, 1] - y[i, 1])
-    hxx += m
-    hyy += m
-    s = grab_slot[i]
-    if s >= 0:  # a zero-length spring of strength S to the target: S (x - t)
-        gx += grab_pull[s, 0] * x[i, 0] - grab_pull[s, 1]
-        gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
-        hxx += grab_pull[s, 0]
-        hyy += grab_pull[s, 0]
-    cgx, cgy, cxx, cxy, cyy = row_blocks(x, x_n, i, rs, False)
-    gx += cgx
-    gy += cgy
-    hxx += cxx
-    hxy += cxy
-    hyy += cyy
+    ogx, ogy, oxx, oxy, oyy = outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, False)
+    gx += ogx
+    gy += ogy
+    hxx += oxx
+    hxy += oxy
+    hyy += oyy
     det = hxx * hyy - hxy * hxy
     if not det > 0.0:
         return 0.0
@@ -159,8 +174,7 @@ def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_
                 hxy += exy
                 hyy += eyy
             moved = descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs)
-            if moved > most:
-                most = moved
+            most = max(most, moved)
     return most
 
 
@@ -176,8 +190,7 @@ def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, 
             continue
         moved = descend(x, x_n, y, i, g[i, 0], g[i, 1], hb[i, 0], hb[i, 1], hb[i, 2], mass_h2, grab_slot, grab_pull,
                         rs)
-        if moved > most:
-            most = moved
+        most = max(most, moved)
     return most
 
 
@@ -237,26 +250,10 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
         g0 = g1 = g2 = 0.0
         a00 = a01 = a02 = a11 = a12 = a22 = 0.0
         for i in range(lo, hi):
-            m = mass_h2[i]
-            gx = m * (x[i, 0] - y[i, 0])
-            gy = m * (x[i, 1] - y[i, 1])
-            hxx = hyy = m
-            hxy = 0.0
-            s = grab_slot[i]
-            if s >= 0:
-                gx += grab_pull[s, 0] * x[i, 0] - grab_pull[s, 1]
-                gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
-                hxx += grab_pull[s, 0]
-                hyy += grab_pull[s, 0]
             # the rows' gradient where they are, and their stiffness whether they push now or
             # not: a row that starts to push within the step bounds the step (with only the
             # active rows a resting block rocked on its warm-started contacts)
-            cgx, cgy, cxx, cxy, cyy = row_blocks(x, x_n, i, rs, True)
-            gx += cgx
-            gy += cgy
-            hxx += cxx
-            hxy += cxy
-            hyy += cyy
+            gx, gy, hxx, hxy, hyy = outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, True)
             # J = [[1, 0, -ry], [0, 1, rx]]
             rx, ry = x[i, 0] - cx, x[i, 1] - cy
             g0 += gx
