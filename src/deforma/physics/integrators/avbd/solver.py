@@ -3,7 +3,7 @@ SIGGRAPH 2024; Giles, Diaz, Yuksel, "Augmented Vertex Block Descent", SIGGRAPH 2
 
 One step of ``h`` (per substep)::
 
-    collide: the collider contacts of the predicted motion, as rows (rows.py), warm-started
+    collide: collider and body contacts of the predicted motion, as rows (rows.py), warm-started
     y = x_n + h v_n + h^2 (g + f / m)                    # the inertial target
     x = x_n + h v_n + h^2 a~                             # adaptive start (a~: last step's
                                                          #   acceleration along g, in [0, g])
@@ -23,8 +23,9 @@ Each vertex block is one Newton step on backward Euler's objective restricted to
 (:mod:`~deforma.physics.integrators.avbd.blocks`), so any iteration budget is stable, and run
 to a tolerance the step is backward Euler's. A plain sweep carries information about one ring
 of vertices per colour pass, so a large stiff body is softer than its material at a small
-budget; Chebyshev's semi-iterative acceleration (VBD's, ``chebyshev`` the spectral radius it
-assumes) speeds that up.
+budget: the coarse level below takes most of that. Chebyshev's semi-iterative acceleration
+(VBD's, ``chebyshev`` the spectral radius it assumes) is an option, off by default: with
+contacts it made them chatter.
 
 Between sweeps, patches of about ``cluster_size`` vertices each take a Newton step over their
 affine motions (:mod:`~deforma.physics.integrators.avbd.clusters`, a coarse level that moves a
@@ -34,8 +35,9 @@ correction a patch per visit), and every body without a pin one over its rigid m
 Contacts are found once, before the solve, for the predicted motion: a vertex against a
 collider, and a vertex against an outline edge of another body or its own. Each is a row
 inside the sweep with Coulomb friction (:mod:`~deforma.physics.integrators.avbd.rows`),
-warm-started by its pair; the shared contact stage after the sweep stays as the fail-safe. Pins stay
-put (infinite mass); a grab is a zero-length spring of its strength to its target.
+warm-started by its pair; the shared contact stage after the sweep stays as the fail-safe.
+Pins stay put (infinite mass); a grab is a zero-length spring of its strength to its target.
+The sweep is serial: the colours are ready for a parallel one.
 
 Units: m, s, kg, N, N/m.
 """
