@@ -12,7 +12,7 @@ vertex meets it, :func:`~deforma.physics.colliders.response.contact_planes`) is 
   lambda_n`` (the normal multiplier, steadier than the force at an iterate): ``mu`` is the static coefficient while the contact sticks and the dynamic one once
   it slides. The gradient is ``-f_t t`` and, while it sticks, the Hessian ``k_t t t^T``.
 
-After every sweep the multipliers take the rows' forces (``lambda_n = f_n``; ``lambda_t =
+Once a step, after the sweeps, the multipliers take the rows' forces (``lambda_n = f_n``; ``lambda_t =
 f_t`` clamped to ``mu lambda_n``) and a row inside its bounds stiffens by ``beta |C|`` up to ``k_max``: the
 penalty ramp, so a row ends up enforced as tightly as the iterations allow while its force
 is carried by ``lambda``, not by a penetration. A contact that began the step at rest on its

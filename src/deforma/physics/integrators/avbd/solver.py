@@ -386,7 +386,7 @@ class AVBD(Integrator):
         A contact row's first stiffness, as a multiple of its vertex's ``m / h^2`` plus its
         elements' stiffness (> 0).
     penalty_ramp : float
-        ``beta``, N/m per m of violation: how fast a row's penalty stiffens (>= 0).
+        ``beta``, N/m per m of violation: how fast a row's penalty stiffens, once a step (>= 0).
     penalty_max : float
         The stiffest a row gets (N/m).
 
@@ -410,7 +410,7 @@ class AVBD(Integrator):
                Option("penalty_start", 1.0, "float", low=0.0, high=1e12,
                       doc="a contact row's first stiffness, in its vertex's m / h^2 plus its elements' stiffness"),
                Option("penalty_ramp", 1e5, "float", low=0.0, high=1e15, closed_low=True,
-                      doc="penalty growth per metre of violation per sweep (N/m^2)"),
+                      doc="penalty growth per metre of violation, once a step (N/m^2)"),
                Option("penalty_max", 1e10, "float", low=0.0, high=1e18, doc="the stiffest a contact row gets (N/m)"))
 
     #: a row's multiplier and penalty carried into the next step: lambda * CARRY, k * SOFTEN
