@@ -172,6 +172,23 @@ def freeze_bounds(x, x_n, touch, planes, state, count):
         state[k, BOUND] = mu * fn
 
 
+@njit(cache=True, inline="always")
+def dual_step(state, k, fn, ft, gap, slip, mu, beta, k_max):
+    """Row ``k``'s dual step from its forces at the iterate (``f_n``, unclamped ``f_t``, the
+    violations ``C_n``, ``C_t`` and the friction coefficient ``mu``): the normal multiplier
+    takes ``f_n``, the friction multiplier ``f_t`` clamped to ``mu f_n``, and a row inside its
+    bounds stiffens by ``beta |C|`` up to ``k_max``."""
+    state[k, LAM_N] = fn
+    if fn > 0.0:
+        state[k, K_N] = min(state[k, K_N] + beta * abs(gap), k_max)
+    bound = mu * fn
+    if abs(ft) < bound:
+        state[k, LAM_T] = ft
+        state[k, K_T] = min(state[k, K_T] + beta * abs(slip), k_max)
+    else:
+        state[k, LAM_T] = bound if ft > 0.0 else -bound
+
+
 @njit(cache=True)
 def update_rows(x, x_n, touch, planes, state, count, beta, k_max):
     """The dual step after a sweep: the normal multiplier takes its force (``lambda_n = max(0,
@@ -180,15 +197,7 @@ def update_rows(x, x_n, touch, planes, state, count, beta, k_max):
     for k in range(count):
         i = touch[k]
         fn, ft, gap, slip, mu = contact_forces(x, x_n, i, planes, state, k)
-        state[k, LAM_N] = fn
-        if fn > 0.0:
-            state[k, K_N] = min(state[k, K_N] + beta * abs(gap), k_max)
-        bound = mu * fn
-        if abs(ft) < bound:
-            state[k, LAM_T] = ft
-            state[k, K_T] = min(state[k, K_T] + beta * abs(slip), k_max)
-        else:
-            state[k, LAM_T] = bound if ft > 0.0 else -bound
+        dual_step(state, k, fn, ft, gap, slip, mu, beta, k_max)
 
 
 # -- body contacts: a vertex against an outline edge of another body or its own ---------------
@@ -379,15 +388,7 @@ def update_body_rows(x, x_n, topo, buf, state, count, beta, k_max):
     for c in range(count):
         ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
         fn, ft, gap, slip, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
-        state[c, LAM_N] = fn
-        if fn > 0.0:
-            state[c, K_N] = min(state[c, K_N] + beta * abs(gap), k_max)
-        bound = mu * fn
-        if abs(ft) < bound:
-            state[c, LAM_T] = ft
-            state[c, K_T] = min(state[c, K_T] + beta * abs(slip), k_max)
-        else:
-            state[c, LAM_T] = bound if ft > 0.0 else -bound
+        dual_step(state, c, fn, ft, gap, slip, mu, beta, k_max)
 
 
 @njit(cache=True, inline="always")
