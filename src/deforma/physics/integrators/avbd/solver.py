@@ -363,6 +363,11 @@ def chebyshev_omega(k: int, rho: float, previous: float) -> float:
     return 4.0 / (4.0 - rho * rho * previous)
 
 
+#: The contact stage after the solve, the fail-safe, acts on pairs closer than this share of
+#: their contact thickness (:meth:`AVBD._failsafe_topology`).
+FAILSAFE_SHARE = 0.5
+
+
 @register_integrator("avbd")
 class AVBD(Integrator):
     """Augmented Vertex Block Descent: backward Euler by Gauss-Seidel over per-vertex blocks,
@@ -431,13 +436,18 @@ class AVBD(Integrator):
         self.unconverged = 0
         self.residual = 0.0
         self.active_contacts = 0
+        self.failsafe = 0
 
     def stats(self) -> dict:
-        """``{"iterations", "unconverged", "residual", "contacts"}``: sweeps run so far,
-        substeps that stopped at the budget short of a tolerance, the last sweep's largest
-        vertex speed change (m/s) and the collider contacts of the last step."""
+        """``{"iterations", "unconverged", "residual", "contacts", "failsafe"}``: sweeps run
+        so far, substeps that stopped at the budget short of a tolerance, the last sweep's
+        largest vertex speed change (m/s), the contact rows of the last step, and the
+        substeps so far in which the contact stage after the solve moved a vertex (it acts on
+        outlines closer than :data:`FAILSAFE_SHARE` of their thickness and on vertices in
+        rigid bodies: the rows should keep both from happening, and this counts their
+        misses)."""
         return {"iterations": self.iterations_run, "unconverged": self.unconverged, "residual": self.residual,
-                "contacts": self.active_contacts}
+                "contacts": self.active_contacts, "failsafe": self.failsafe}
 
     def _prepare(self, model):
         """Incidence and colouring, once per Model (its elements never change in place)."""
@@ -536,7 +546,7 @@ class AVBD(Integrator):
             x_n = self._x_n
             # collide once, before the solve: the collider contacts and the body contacts of
             # the predicted motion (each held no closer than its pair began the step)
-            count, n_body, found = self._collide(x_n, rects, ctopo, scr, buf, h)
+            count, n_body, found = self._collide(x_n, self._y, rects, ctopo, scr, h)
             start_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows, k_start,
                        self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, h)
             rs = self._body_rows(model, ctopo, found, n_body, k_start, v)
@@ -547,20 +557,37 @@ class AVBD(Integrator):
             bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, h, vmax2)
             if bad:
                 return StepReport(int(bad), contacts.complete)
-            if contact_epilogue(x, v, inv_mass, x_n, ctopo, scr, buf, rects, hits, h, True) < 0:
+            solved = x.copy()
+            if contact_epilogue(x, v, inv_mass, x_n, self._failsafe_topology(ctopo), scr, buf, rects, hits, h,
+                                True) < 0:
                 return StepReport(0, False)
+            self.failsafe += not np.array_equal(x, solved)
         return StepReport(0, contacts.complete)
 
-    def _collide(self, x_n, rects, ctopo, scr, buf, h):
-        """Collide once, before the solve: the collider contacts of the predicted motion and
-        the body contacts within a margin of it, ``(count, n_body, buffer)``.
+    @staticmethod
+    def _failsafe_topology(ctopo):
+        """The contact topology the contact stage after the solve sees: every thickness
+        at :data:`FAILSAFE_SHARE` of the rows'. The rows hold a pair at its thickness (to
+        their penalty's tolerance); the stage, an inelastic response, takes away every
+        approach of a pair it finds within its thickness, and at the rows' own it undid
+        their work (two outlines the elements drew together by 5 mm in a step were put
+        back where they began, step after step: the resting ``jelly`` stack buzzed)."""
+        # made every step (three products of outline-length arrays): the thicknesses change
+        # in place when a body's are set
+        share = FAILSAFE_SHARE
+        return ctopo._replace(thick_other=ctopo.thick_other * share, thick_self=ctopo.thick_self * share,
+                              body_thickness=ctopo.body_thickness * share)
+
+    def _collide(self, x_n, y, rects, ctopo, scr, h):
+        """Collide once, before the solve: the collider contacts of the predicted motion
+        from ``x_n`` to ``y`` and the body contacts within a margin of it, ``(count, n_body,
+        buffer)``.
 
         Between bodies the margin is how far any vertex is predicted to move: a contact the
         sweeps make (a box landing on another, whose support shifts its prediction by
         millimetres) is then a row from the start, inactive while its gap stays open. Found
         only at the prediction itself, a box at 1/60 s sank through the one below it.
         Contacts of a body with itself keep its contact thickness."""
-        y = self._y
         count = contact_planes(x_n, y, rects, self._planes, self._touch, self._plane_rows, False, h)
         gather_start(x_n, ctopo, scr)  # for the contact stage after the sweep
         # the rows' own search, in scratch of its own: the widened one left candidate pairs
