@@ -16,8 +16,8 @@ def bunny():
     return deforma.mesh.from_image("bunny", resolution=4, detect_edges=True, edge_step=2, scale=0.01)
 
 
-def test_the_readme_bunny_runs_under_the_default_world():
-    w = deforma.World()  # substeps = "auto" by default
+def test_the_readme_bunny_runs_under_symplectic_euler_with_auto_substeps():
+    w = deforma.World(dt=1 / 600, integrator="symplectic-euler")  # substeps = "auto" by default
     w.add_collider(deforma.Rect((0.0, -0.25), (6.0, 0.5), 0.0))
     m = bunny()
     with warnings.catch_warnings():
@@ -33,10 +33,11 @@ def test_the_readme_bunny_runs_under_the_default_world():
 
 
 def test_one_substep_beyond_the_limit_warns_at_add_body():
-    w = deforma.World(substeps=1)
+    w = deforma.World(dt=1 / 600, integrator="symplectic-euler", substeps=1)
     with pytest.warns(RuntimeWarning, match=r"exceeds the stable estimate .* set substeps = 40 \(or \"auto\"\)"):
         w.add_body(bunny())
-    w = deforma.World(dt=0.1)  # "auto" would need 2380 substeps: said at once, in one line
+    # "auto" would need 2380 substeps: said at once, in one line
+    w = deforma.World(integrator="symplectic-euler", dt=0.1)
     with pytest.warns(RuntimeWarning, match=r"would need 2375 substeps .* more than 1000") as caught:
         w.add_body(bunny())
     assert "\n" not in str(caught[0].message)
@@ -46,7 +47,7 @@ def test_one_substep_beyond_the_limit_warns_at_add_body():
 
 
 def test_auto_follows_the_bodies_and_the_integrator():
-    w = deforma.World(dt=1 / 60, stiffness=2000.0, substeps="auto")
+    w = deforma.World(integrator="symplectic-euler", dt=1 / 60, stiffness=2000.0, substeps="auto")
     assert w.substeps == 1  # no body
     w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=4), position=(0, 3))
     w.step()
@@ -63,7 +64,7 @@ def test_auto_follows_the_bodies_and_the_integrator():
 
 
 def test_auto_past_1000_substeps_is_refused_in_one_line_and_changes_nothing():
-    w = deforma.World(dt=0.1, substeps=1)  # the bunny needs 2375 substeps of it
+    w = deforma.World(integrator="symplectic-euler", dt=0.1, substeps=1)  # the bunny needs 2375 substeps of it
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         w.add_body(bunny())
@@ -73,7 +74,7 @@ def test_auto_past_1000_substeps_is_refused_in_one_line_and_changes_nothing():
     assert "\n" not in text and "more than 1000" in text and 'integrator="implicit-euler"' in text
     assert w.substeps == 1 and not w.auto_substeps
     # set while it was fine, then made stiffer: the step says so and changes nothing
-    w = deforma.World(dt=0.05, stiffness=100.0, substeps="auto", gravity=(0.0, 0.0))
+    w = deforma.World(integrator="symplectic-euler", dt=0.05, stiffness=100.0, substeps="auto", gravity=(0.0, 0.0))
     b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=4), position=(0, 3))
     w.step()
     before = b.positions.copy()

@@ -108,7 +108,8 @@ def plank_and_block(angle, *, mu_s, mu_d, damping):
     Both bodies use the coefficients given, so their contact does too (sqrt(mu mu) = mu)."""
     a = math.radians(angle)
     n, t = np.array([-math.sin(a), math.cos(a)]), np.array([math.cos(a), math.sin(a)])
-    w = deforma.World(dt=1 / 2000, substeps=3, stiffness=2e4, damping=damping, friction=mu_d, static_friction=mu_s)
+    w = deforma.World(integrator="symplectic-euler", dt=1 / 2000, substeps=3, stiffness=2e4, damping=damping,
+                      friction=mu_d, static_friction=mu_s)
     w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle, friction=2.0, static_friction=3.0))
     plank = w.add_body(grid_mesh(2.0, 0.1, 41, 3, angle=angle, center=tuple(0.05 * n + 0.5 * t)), mass=4.0)
     gap = 1.01 * max(plank.contact_thickness, 0.0)
@@ -252,7 +253,7 @@ def test_dragging_one_body_into_another_pushes_it_rather_than_passing_through():
 
 def test_a_contact_buffer_too_small_grows_and_the_step_runs_again_from_its_start():
     def world():
-        w = deforma.World(dt=1 / 600, substeps=4, stiffness=3000.0, damping=2.0)
+        w = deforma.World(integrator="symplectic-euler", dt=1 / 600, substeps=4, stiffness=3000.0, damping=2.0)
         w.add_collider(deforma.Rect((0, -0.5), (6, 1.0), 0.0))
         for k in range(3):
             w.add_body(grid_mesh(0.6, 0.3, 9, 5), position=(0.05 * k, 0.16 + 0.32 * k))
@@ -268,7 +269,7 @@ def test_a_contact_buffer_too_small_grows_and_the_step_runs_again_from_its_start
 
 # -- switches and bad input ---------------------------------------------------------------------
 def test_collide_off_lets_a_body_pass_through_others():
-    w = deforma.World(dt=1 / 600, gravity=(0, 0))
+    w = deforma.World(integrator="symplectic-euler", dt=1 / 600, gravity=(0, 0))
     a = w.add_body(grid_mesh(0.5, 0.5, 5, 5), position=(0.0, 0.0))
     ghost = w.add_body(grid_mesh(0.3, 0.3, 4, 4), position=(-1.0, 0.0), collide=False)
     ghost.velocities = (3.0, 0.0)

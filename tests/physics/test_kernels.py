@@ -24,7 +24,7 @@ def numpy_forces(x, v, mass, si, sj, rest, ks, kd, g):
 
 
 def perturbed_world(n=12):
-    w = deforma.World(stiffness=300.0, damping=0.7, mass=2.0)
+    w = deforma.World(dt=1 / 600, integrator="symplectic-euler", stiffness=300.0, damping=0.7, mass=2.0)
     b = w.add_body(grid_mesh(1.0, 0.5, n, n // 2), position=(0, 0))
     rng = np.random.default_rng(0)
     b.positions = b.positions + rng.normal(scale=0.02, size=b.positions.shape)

@@ -19,7 +19,7 @@ SIZE = 0.5
 
 def block(material, drop=0.0, integrator="symplectic-euler"):
     """A 0.5 m block (detail 8) on a floor, ``drop`` m above it, under the default World."""
-    w = deforma.World(material=material, integrator=integrator)
+    w = deforma.World(dt=1 / 600, material=material, integrator=integrator)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     h = SIZE / 2
     b = w.add_body(deforma.mesh.box(((-h, -h), (h, -h), (h, h), (-h, h)), detail=8), position=(0.0, h + drop + 1e-6))

@@ -330,7 +330,7 @@ class Body:
         Examples
         --------
         >>> import deforma
-        >>> w = deforma.World(gravity=(0, 0))
+        >>> w = deforma.World(gravity=(0, 0), dt=1 / 600, integrator="symplectic-euler")
         >>> b = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=2), angle=10)
         >>> b.angular_velocity = 90.0
         >>> for _ in range(60):  # a tenth of a second at 90 deg/s

@@ -210,7 +210,7 @@ class World:
         Examples
         --------
         >>> import deforma
-        >>> w = deforma.World(dt=1 / 60, stiffness=2000.0)
+        >>> w = deforma.World(dt=1 / 60, stiffness=2000.0, integrator="symplectic-euler")
         >>> _ = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=4))
         >>> w.substeps = "auto"
         >>> w.substeps, w.auto_substeps  # ceil(dt / stable_dt())
@@ -1077,7 +1077,7 @@ class World:
         Examples
         --------
         >>> import deforma
-        >>> w = deforma.World(mass=2.0, stiffness=100.0, damping=0.0)
+        >>> w = deforma.World(mass=2.0, stiffness=100.0, damping=0.0, integrator="symplectic-euler")
         >>> _ = w.add_body(deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]]))
         >>> round(w.stable_dt(), 4)  # 2 / sqrt(2 * 200 / (2 / 3))
         0.0816
