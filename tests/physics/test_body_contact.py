@@ -103,12 +103,12 @@ def test_head_on_collision_keeps_momentum_and_never_gains_energy(name):
 
 
 # -- friction between bodies ---------------------------------------------------------------------
-def plank_and_block(angle, *, mu_s, mu_d, damping):
+def plank_and_block(angle, *, mu_s, mu_d, damping, integrator="symplectic-euler", dt=1 / 2000, substeps=3):
     """A 2 m plank held on a slope by a grippy collider, and a 20 x 10 cm block on the plank.
     Both bodies use the coefficients given, so their contact does too (sqrt(mu mu) = mu)."""
     a = math.radians(angle)
     n, t = np.array([-math.sin(a), math.cos(a)]), np.array([math.cos(a), math.sin(a)])
-    w = deforma.World(integrator="symplectic-euler", dt=1 / 2000, substeps=3, stiffness=2e4, damping=damping,
+    w = deforma.World(integrator=integrator, dt=dt, substeps=substeps, stiffness=2e4, damping=damping,
                       friction=mu_d, static_friction=mu_s)
     w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle, friction=2.0, static_friction=3.0))
     plank = w.add_body(grid_mesh(2.0, 0.1, 41, 3, angle=angle, center=tuple(0.05 * n + 0.5 * t)), mass=4.0)
