@@ -60,6 +60,8 @@ def number(value, name: str) -> float:
         raise ValueError(f"{name} must be a real number, got {value!r}")
     try:
         v = float(value)
+    except OverflowError:  # an integer beyond any float (10**400)
+        raise ValueError(f"{name} must be finite, got an integer of {len(str(abs(int(value))))} digits") from None
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number, got {value!r}") from None
     if not math.isfinite(v):
@@ -90,6 +92,8 @@ def pair(value, name: str, *, positive: bool = False, limit: float = MAX_COORDIN
     """A pair of finite numbers of magnitude at most ``limit`` (both > 0 with ``positive``)."""
     try:
         a = np.asarray(value, dtype=np.float64)
+    except OverflowError:  # an integer beyond any float (10**400)
+        raise ValueError(f"{name} must be a pair of finite numbers, got a number too large for a float") from None
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a pair of numbers, got {value!r}") from None
     if a.shape != (2,) or not np.all(np.isfinite(a)):

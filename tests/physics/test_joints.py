@@ -166,6 +166,10 @@ def test_removing_a_joint_or_a_body_lets_go():
     (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), motor_speed=10.0, max_torque=-1.0),
      "max_torque must be"),
     (lambda w, a, b, s: w.join(a, None), "at must be the point"),
+    (lambda w, a, b, s: w.join(a, None, at=(10**400, 0)),
+     "at must be a pair of finite numbers, got a number too large"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="spring", stiffness=10**400),
+     "stiffness must be finite, got an integer of 401 digits"),
 ])
 def test_bad_joints_are_refused_in_one_line_changing_nothing(call, message):
     w = deforma.World(dt=1 / 60)
