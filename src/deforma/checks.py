@@ -60,8 +60,9 @@ def number(value, name: str) -> float:
         raise ValueError(f"{name} must be a real number, got {value!r}")
     try:
         v = float(value)
-    except OverflowError:  # an integer beyond any float (10**400)
-        raise ValueError(f"{name} must be finite, got an integer of {len(str(abs(int(value))))} digits") from None
+    except OverflowError:  # a number beyond any float: an integer like 10**400, or a Fraction of one
+        got = f"an integer of {len(str(abs(value)))} digits" if isinstance(value, int) else "a number"
+        raise ValueError(f"{name} must be finite, got {got}, too large for a float") from None
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number, got {value!r}") from None
     if not math.isfinite(v):
