@@ -19,14 +19,16 @@ ROWS = {"symplectic-euler": ["integrator_mode"],
         "xpbd": ["integrator_iterations"],
         "implicit-bdf2": ["integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
                           "integrator_contact_weight"],
-        "avbd": ["integrator_iterations", "integrator_tolerance", "integrator_cluster_size", "integrator_chebyshev",
+        "avbd": ["integrator_iterations", "integrator_tolerance", "integrator_reach", "integrator_cluster_size",
+                 "integrator_chebyshev",
                  "integrator_penalty_start", "integrator_penalty_ramp", "integrator_penalty_max"]}
 
 
 def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
     rows = {p.name: p for p in integrator_params()}
     assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_tolerance",
-                          "integrator_max_iterations", "integrator_contact_weight", "integrator_cluster_size",
+                          "integrator_max_iterations", "integrator_contact_weight", "integrator_reach",
+                          "integrator_cluster_size",
                           "integrator_chebyshev", "integrator_penalty_start", "integrator_penalty_ramp",
                           "integrator_penalty_max"]
     assert not set(rows) & set(PARAMS)
