@@ -58,6 +58,8 @@ from ...contact.narrow_phase import detect_contacts
 from ...contact.response import hold_start_distance
 from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
+from ...rigid_motion import linear_and_angular_velocity, rigid_velocities
+from ...topology import lengths
 from ..base import (
     Integrator,
     Option,
@@ -237,40 +239,6 @@ def deepest_reach(y, v, planes, touch, count, topo, buf, n_body, size, h):
 
 
 @njit(cache=True)
-def deepest_strain_reach(x, v, mass, body_start, size, h):
-    """How far the bodies' deformation moves a vertex in ``h`` s, as a multiple of its
-    ``size`` (m), at most over the vertices: its velocity less its body's rigid motion (the
-    mass-weighted mean velocity and spin about the centre of mass). A body that falls, slides
-    or turns as a whole reaches nothing; one crushed by an impact does."""
-    most = 0.0
-    for body in range(body_start.shape[0] - 1):
-        lo, hi = body_start[body], body_start[body + 1]
-        sm = cx = cy = vx = vy = 0.0
-        for i in range(lo, hi):
-            m = mass[i]
-            sm += m
-            cx += m * x[i, 0]
-            cy += m * x[i, 1]
-            vx += m * v[i, 0]
-            vy += m * v[i, 1]
-        if sm <= 0.0:
-            continue
-        cx, cy, vx, vy = cx / sm, cy / sm, vx / sm, vy / sm
-        ang = inertia = 0.0
-        for i in range(lo, hi):
-            rx, ry = x[i, 0] - cx, x[i, 1] - cy
-            ang += mass[i] * (rx * (v[i, 1] - vy) - ry * (v[i, 0] - vx))
-            inertia += mass[i] * (rx * rx + ry * ry)
-        w = ang / inertia if inertia > 0.0 else 0.0
-        for i in range(lo, hi):
-            rx, ry = x[i, 0] - cx, x[i, 1] - cy
-            dx = v[i, 0] - vx + w * ry
-            dy = v[i, 1] - vy - w * rx
-            most = max(most, math.sqrt(dx * dx + dy * dy) * h / size[i])
-    return most
-
-
-@njit(cache=True)
 def chebyshev(x, x_prev, x_prev2, inv_mass, vertex_row, omega):
     """VBD's Chebyshev step ``x = omega (x - x'') + x''`` (``x''`` the iterate two sweeps back),
     then the history shifts (``x'' = x'``, ``x' = x``). Vertices on a contact row are left
@@ -416,6 +384,21 @@ def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, d
             ft = st[c, LAM_T] - st[c, K_T] * (-rx * ny + ry * nx)
             e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
     return e
+
+
+def deepest_strain_reach(x, v, mass, body_start, size, h) -> float:
+    """How far the bodies' deformation moves a vertex in ``h`` s, as a multiple of its
+    ``size`` (m), at most over the vertices: its velocity less its body's rigid motion
+    (:func:`~deforma.physics.rigid_motion.linear_and_angular_velocity`). A body that falls,
+    slides or turns as a whole reaches nothing; one crushed by an impact does."""
+    most = 0.0
+    for lo, hi in zip(body_start[:-1], body_start[1:]):
+        xb, vb, mb = x[lo:hi], v[lo:hi], mass[lo:hi]
+        if hi <= lo or not mb.sum() > 0.0:
+            continue
+        own = vb - rigid_velocities(xb, mb, *linear_and_angular_velocity(xb, vb, mb))
+        most = max(most, float((np.sqrt((own * own).sum(axis=1)) / size[lo:hi]).max()) * h)
+    return most
 
 
 def chebyshev_omega(k: int, rho: float, previous: float) -> float:
@@ -572,16 +555,18 @@ class AVBD(Integrator):
 
     def _stiffness(self, model, h):
         """Per vertex, the stiffness of its elements (N/m: the kinds' row sums, damping's
-        ``1 / h`` share included), once per Model version and ``h``: a contact row starts as
-        stiff as the material around its vertex, so its multiplier's force is not carried by
-        a gap (a row as soft as the inertia, ``m / h^2``, held a resting block's bottom
-        vertices millimetres above the floor, and the block hopped)."""
-        key = (model, model.version, h)
-        if self._stiff is None or self._stiff[0] is not model or self._stiff[1:3] != key[1:]:
+        ``1 / h`` share included): a contact row starts as stiff as the material around its
+        vertex, so its multiplier's force is not carried by a gap (a row as soft as the
+        inertia, ``m / h^2``, held a resting block's bottom vertices millimetres above the
+        floor, and the block hopped). The kinds' rows are summed once per Model version; a
+        step split into parts asks for another ``h``."""
+        key = (model, model.version)
+        if self._stiff is None or self._stiff[0] is not model or self._stiff[1] != key[1]:
             n = model.n_vertices
-            rows = sum((k.stiffness_rows(n) + k.damping_rows(n) / h for k in model.elements), np.zeros(n))
-            self._stiff = (*key, rows)
-        return self._stiff[3]
+            elastic = sum((k.stiffness_rows(n) for k in model.elements), np.zeros(n))
+            damping = sum((k.damping_rows(n) for k in model.elements), np.zeros(n))
+            self._stiff = (*key, elastic, damping)
+        return self._stiff[2] + self._stiff[3] / h
 
     def _scratch(self, n):
         if self._n != n:
@@ -606,9 +591,8 @@ class AVBD(Integrator):
         """Advance by ``substeps`` substeps of ``h`` s. Each is first predicted and collided
         whole; where that motion reaches deeper than ``reach`` shortest edges into a contact,
         or ``STRAIN_SHARE`` times that within a body (:func:`deepest_reach`,
-        :func:`deepest_strain_reach`), the
-        prediction is undone and the substep is taken in that many equal parts, each
-        collided and solved on its own."""
+        :func:`deepest_strain_reach`), the prediction is undone and the substep is taken in
+        that many equal parts, each collided and solved on its own."""
         n = model.n_vertices
         if self._n != n or self._topology[0] is not model:
             self._memory = None  # vertices renumbered: no warm start
@@ -686,7 +670,7 @@ class AVBD(Integrator):
                 if len(e):
                     p = t.rest_positions
                     v0 = int(model.body_vertex_offsets[body])
-                    length = np.linalg.norm(p[e[:, 0]] - p[e[:, 1]], axis=1)
+                    length = lengths(p, e[:, 0], e[:, 1])
                     np.minimum.at(size, v0 + e[:, 0], length)
                     np.minimum.at(size, v0 + e[:, 1], length)
             self._size = (model, size)
