@@ -25,12 +25,12 @@ def bdf2_root(h_lambda: complex) -> complex:
     return roots[np.argmax(np.abs(roots))]
 
 
-def ring(per_period, periods, damping=0.0):
+def ring(per_period, periods, damping=0.0, integrator="implicit-bdf2", options=None):
     """The column of test_fem_validation (0.2 x 2 m, 1e5 Pa, 100 kg/m^2) clamped at its top,
     set ringing in its first longitudinal mode without gravity, at ``per_period`` steps per
     period of c / 4L: (frequency / (c / 4L), amplitude of the last period / of the first)."""
     f = math.sqrt(E / RHO) / (4 * L)
-    w = deforma.World(gravity=(0.0, 0.0), dt=1 / (f * per_period), integrator="implicit-bdf2")
+    w = deforma.World(gravity=(0.0, 0.0), dt=1 / (f * per_period), integrator=integrator, integrator_options=options)
     m = column(4)
     b = w.add_body(m, material=deforma.Material("corotated", youngs_modulus=E, poisson_ratio=0.3, density=RHO,
                                                 damping=damping), position=None)

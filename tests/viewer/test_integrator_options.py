@@ -19,7 +19,8 @@ ROWS = {"symplectic-euler": ["integrator_mode"],
         "xpbd": ["integrator_iterations"],
         "implicit-bdf2": ["integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
                           "integrator_contact_weight"],
-        "avbd": ["integrator_iterations", "integrator_tolerance", "integrator_reach", "integrator_cluster_size",
+        "avbd": ["integrator_iterations", "integrator_tolerance", "integrator_reach", "integrator_order",
+                 "integrator_cluster_size",
                  "integrator_chebyshev",
                  "integrator_penalty_start", "integrator_penalty_ramp", "integrator_penalty_max"]}
 
@@ -28,7 +29,7 @@ def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
     rows = {p.name: p for p in integrator_params()}
     assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_tolerance",
                           "integrator_max_iterations", "integrator_contact_weight", "integrator_reach",
-                          "integrator_cluster_size",
+                          "integrator_order", "integrator_cluster_size",
                           "integrator_chebyshev", "integrator_penalty_start", "integrator_penalty_ramp",
                           "integrator_penalty_max"]
     assert not set(rows) & set(PARAMS)

@@ -128,6 +128,69 @@ def predict(x, v, x_n, y, v_last, has_last, inv_mass, gx, gy, keep, force, has_f
         x[i, 1] = x[i, 1] + h * vy + h2 * keep * (share * gy + ay - gy)
 
 
+@njit(cache=True)
+def second_order_targets(x_n, y, v_n, x_prev, v_prev, x_end, v_end, anchor, mass_h2, vertex_mass, inv_mass, held,
+                         held_before, gx, gy, drag, force, has_force, h):
+    """Make every free vertex that is in no contact row (``held``) a BDF2 vertex: its
+    ``anchor`` ``(4 x_n - x_prev) / 3``, its target ``y`` that plus ``h' (4 v_n - v_prev) / 3
+    + h'^2 a`` and its inertia ``mass_h2`` ``m / h'^2``, with ``h' = 2 h / 3``: backward
+    Euler's objective around that anchor with that step is BDF2's step, and its velocity is
+    ``(x - anchor) / h'``. The others keep backward Euler's (``anchor = x_n``; ``y`` and
+    ``mass_h2`` as :func:`predict` made them). A vertex moved or given a velocity since the
+    last step ended (``x_end``, ``v_end``) starts a history of its own, as if it had moved
+    at ``v_n`` (a velocity set between steps was otherwise taken for a jump in speed).
+    Returns how many are BDF2 vertices."""
+    hb = 2.0 * h / 3.0
+    hb2 = hb * hb
+    keep = 1.0 / (1.0 + hb * drag)
+    free = 0
+    for i in range(x_n.shape[0]):
+        if inv_mass[i] == 0.0 or held[i]:
+            anchor[i, 0], anchor[i, 1] = x_n[i, 0], x_n[i, 1]
+            continue
+        ax, ay = gx, gy
+        if has_force:
+            ax += force[i, 0] * inv_mass[i]
+            ay += force[i, 1] * inv_mass[i]
+        same = (not held_before[i] and x_n[i, 0] == x_end[i, 0] and x_n[i, 1] == x_end[i, 1]
+                and v_n[i, 0] == v_end[i, 0] and v_n[i, 1] == v_end[i, 1])
+        for d in range(2):
+            xp, vp = (x_prev[i, d], v_prev[i, d]) if same else (x_n[i, d] - h * v_n[i, d], v_n[i, d])
+            a = (4.0 * x_n[i, d] - xp) / 3.0
+            anchor[i, d] = a
+            y[i, d] = a + keep * (hb * (4.0 * v_n[i, d] - vp) / 3.0 + hb2 * (ax if d == 0 else ay))
+        mass_h2[i] = vertex_mass[i] / (keep * hb2)
+        free += 1
+    return free
+
+
+@njit(cache=True)
+def rows_held(held, touch, count, topo, buf, n_body):
+    """Mark the vertices of this step's contact rows (the collider rows' and each body row's
+    vertex and edge ends): they step by backward Euler (:func:`second_order_targets`)."""
+    held[:] = False
+    for k in range(count):
+        held[touch[k]] = True
+    cv = topo.cv_vertex
+    for c in range(n_body):
+        held[cv[buf.vertex[c]]] = True
+        held[cv[topo.ce_a[buf.edge[c]]]] = True
+        held[cv[topo.ce_b[buf.edge[c]]]] = True
+
+
+@njit(cache=True)
+def second_order_velocities(x, v, anchor, solved, held, inv_mass, h):
+    """BDF2's velocity ``(x - anchor) / h'`` (``h' = 2 h / 3``) for the BDF2 vertices the
+    contact stage after the solve left where the solve put them (``solved``); the others
+    keep backward Euler's, which that stage set."""
+    inv = 1.5 / h
+    for i in range(x.shape[0]):
+        if inv_mass[i] == 0.0 or held[i] or x[i, 0] != solved[i, 0] or x[i, 1] != solved[i, 1]:
+            continue
+        v[i, 0] = (x[i, 0] - anchor[i, 0]) * inv
+        v[i, 1] = (x[i, 1] - anchor[i, 1]) * inv
+
+
 @njit(cache=True, inline="always")
 def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs):
     """Finish vertex ``i``'s block (its elements' share ``g``, ``H`` given): add the inertia,
@@ -431,6 +494,12 @@ class AVBD(Integrator):
         times as far within its body (its speed less the body's rigid motion). Ten sweeps
         spread an impact's load only about ten rings into a body: a soft box met at 5 m/s
         crushed the one below it in one step. 0: never split.
+    order : int
+        1 (the default): backward Euler, which damps a vibration of period ``T`` by about
+        ``(2 pi h / T)^2 / 2`` of its amplitude a step. 2: BDF2 (second order; by about
+        ``(2 pi h / T)^4 / 4``) for every vertex outside this step's contact rows, whose
+        vertices keep backward Euler (BDF2's velocity history at a stop threw them back out,
+        a bounce the material did not make). A step split into parts is backward Euler's.
     tolerance : float
         Stop once no vertex moves faster than this in a sweep (m/s; 0, the default: run the
         budget). Run to a tight tolerance the step is backward Euler's.
@@ -463,6 +532,8 @@ class AVBD(Integrator):
                Option("reach", 0.5, "float", low=0.0, high=1e6, closed_low=True,
                       doc="split a step into parts where it moves a vertex into a contact further than this "
                           "many of its shortest edges, or within its body twice as far (0: never)"),
+               Option("order", 1, "int", low=1, high=2,
+                      doc="1: backward Euler; 2: BDF2 for every vertex outside a contact (keeps vibrations)"),
                Option("tolerance", 0.0, "float", low=0.0, high=math.inf, closed_low=True,
                       doc="stop when no vertex moves faster than this in a sweep (m/s; 0: run every sweep)"),
                Option("cluster_size", 64, "int", low=0, high=1_000_000,
@@ -496,6 +567,7 @@ class AVBD(Integrator):
         self._b_entry = np.empty(0, np.int64)
         self._n = -1
         self._size = None
+        self._history = False  # BDF2's: the length of the last step if whole, else False
         self.split = 0
         self.iterations_run = 0
         self.unconverged = 0
@@ -585,6 +657,15 @@ class AVBD(Integrator):
             self._memory = np.full((n, MEMORY_COLUMNS), -1.0)
             self._hf = np.empty((4, 4))
             self._b_start = np.zeros(n + 1, np.int64)
+            self._x_prev = np.empty((n, 2))  # the last step's start, for BDF2
+            self._v_prev = np.empty((n, 2))
+            self._v_n = np.empty((n, 2))
+            self._x_end = np.empty((n, 2))  # where the last step ended: a change since resets BDF2's history
+            self._v_end = np.empty((n, 2))
+            self._anchor = np.empty((n, 2))
+            self._held = np.zeros(n, np.bool_)
+            self._held_before = np.zeros(n, np.bool_)
+            self._history = False
             self._n = n
 
     def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
@@ -596,6 +677,7 @@ class AVBD(Integrator):
         n = model.n_vertices
         if self._n != n or self._topology[0] is not model:
             self._memory = None  # vertices renumbered: no warm start
+            self._history = False
         self._scratch(n)
         if self._memory is None:
             self._memory = np.full((n, MEMORY_COLUMNS), -1.0)
@@ -614,6 +696,7 @@ class AVBD(Integrator):
                 keep = 1.0 / (1.0 + hs * model.air_drag)
                 mass_h2 = model.vertex_mass * ((1.0 + hs * model.air_drag) / (hs * hs))
                 advance_colliders(rects, hs)
+                np.copyto(self._v_n, v)
                 np.copyto(self._v_saved, self._v_last)
                 had_last = self._has_last
                 predict(x, v, self._x_n, self._y, self._v_last, self._has_last, inv_mass, gx, gy, keep,
@@ -640,22 +723,45 @@ class AVBD(Integrator):
                         self.split += 1
                         continue
                 k += 1
-                k_start = opts["penalty_start"] * (mass_h2 + self._stiffness(model, hs))
+                # BDF2 away from the contact rows where the last step was whole and as long
+                anchor, hd, free = x_n, hs, 0
+                if opts["order"] == 2 and parts == 1 and self._history == hs:
+                    np.copyto(self._held_before, self._held)
+                    rows_held(self._held, self._touch, count, ctopo, found, n_body)
+                    anchor = self._anchor
+                    free = second_order_targets(x_n, self._y, self._v_n, self._x_prev, self._v_prev, self._x_end,
+                                                self._v_end, anchor, mass_h2, model.vertex_mass, inv_mass, self._held,
+                                                self._held_before, gx, gy, model.air_drag, control.force,
+                                                control.has_force, hs)
+                    if free:
+                        hd = 2.0 * hs / 3.0  # the damping's velocity, (x - anchor) / h'
+                k_start = opts["penalty_start"] * (mass_h2 + self._stiffness(model, hd))
                 start_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows, k_start,
                            self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, hs)
                 rs = self._body_rows(model, ctopo, found, n_body, k_start, v)
-                self._solve(model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, hs, opts["tolerance"] * hs)
+                self._solve(model, topo, control, x, anchor, mass_h2, inv_mass, count, n_body, rs, hd,
+                            opts["tolerance"] * hs)
                 close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
                 close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
                 self.active_contacts = count + n_body
+                solved = x.copy()
                 bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, hs, vmax2)
                 if bad:
+                    self._history = False
                     return StepReport(int(bad), contacts.complete)
-                solved = x.copy()
+                collided = x.copy()
                 if contact_epilogue(x, v, inv_mass, x_n, self._failsafe_topology(ctopo), scr, contacts.buffer, rects,
                                     hits, hs, True) < 0:
+                    self._history = False
                     return StepReport(0, False)
-                self.failsafe += not np.array_equal(x, solved)
+                self.failsafe += not np.array_equal(x, collided)
+                if free:
+                    second_order_velocities(x, v, anchor, solved, self._held, inv_mass, hs)
+                np.copyto(self._x_prev, x_n)
+                np.copyto(self._v_prev, self._v_n)
+                np.copyto(self._x_end, x)
+                np.copyto(self._v_end, v)
+                self._history = hs if parts == 1 else False
         return StepReport(0, contacts.complete)
 
     def _edge_size(self, model):
