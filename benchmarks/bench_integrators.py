@@ -49,7 +49,7 @@ SUBSTEPS = {"implicit-euler": 1, "xpbd": 64}
 
 def make_world(n: int, integrator: str, *, substeps: int = 1):
     """The bench_physics body (n*n vertices, touching the floor) under ``integrator``."""
-    w = deforma.World(stiffness=2000.0, damping=0.5, mass=1.0, integrator=integrator)
+    w = deforma.World(dt=1 / 600, stiffness=2000.0, damping=0.5, mass=1.0, integrator=integrator)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     w.add_collider(deforma.Rect((-1.2, 0.5), (0.8, 0.1), 30.0))
     w.add_collider(deforma.Rect((1.0, 0.1), (0.2, 0.2), 10.0))

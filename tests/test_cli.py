@@ -171,6 +171,7 @@ def test_unwritable_output_folder(tmp_path, capsys, monkeypatch):
 
 UNSTABLE = """
 [physics]
+integrator = "symplectic-euler"
 dt = 0.02
 substeps = 1
 stiffness = 50000.0

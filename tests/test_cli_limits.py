@@ -302,7 +302,8 @@ def test_view_runs_at_the_smallest_window_with_an_unstable_scene(tmp_path):
 
     from deforma.viewer.app import MIN_WINDOW_SIZE
 
-    unstable = "[physics]\ndt = 0.02\nstiffness = 50000.0\n[[body]]\ndetail = 4\nposition = [0.0, 1.0]\n" \
+    unstable = "[physics]\nintegrator = \"symplectic-euler\"\ndt = 0.02\nstiffness = 50000.0\n[[body]]\ndetail = 4\n" \
+               "position = [0.0, 1.0]\n" \
                "[[collider]]\ncenter = [0.0, 0.0]\nsize = [5.0, 0.5]\n"
     w, h = MIN_WINDOW_SIZE
     env = dict(os.environ, SDL_VIDEODRIVER="offscreen")

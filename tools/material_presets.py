@@ -2,7 +2,7 @@
 
 Run ``python tools/material_presets.py`` for the table, ``--picture`` for docs/presets.png
 (the six side by side: landing at 0.4 s, at 0.55 s, at rest at 3 s). Per preset, a 0.5 m square (``mesh.box``, detail 8)
-on a floor under the default ``deforma.World()`` (symplectic Euler, ``substeps="auto"``;
+on a floor under ``deforma.World(dt=1 / 600, integrator="symplectic-euler")`` (``substeps="auto"``;
 ``wood`` under ``implicit-bdf2``, since its stable step would need hundreds of substeps):
 
 - sag: how much shorter it stands at rest than its rest shape (``world.solve_static()``), %;
@@ -28,7 +28,7 @@ SIZE, DROP, SECONDS = 0.5, 0.5, 3.0
 def world(name: str, drop: float) -> tuple:
     material = deforma.Material.preset(name)
     integrator = "implicit-bdf2" if name == "wood" else "symplectic-euler"
-    w = deforma.World(material=material, integrator=integrator)
+    w = deforma.World(dt=1 / 600, material=material, integrator=integrator)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     half = SIZE / 2
     body = w.add_body(deforma.mesh.box(((-half, -half), (half, -half), (half, half), (-half, half)), detail=8),

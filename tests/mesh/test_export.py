@@ -144,7 +144,8 @@ def test_bad_export_arguments_are_refused_before_any_work(tmp_path, capsys, setu
 
 def test_an_unstable_run_exports_nothing(tmp_path, capsys):
     scene = tmp_path / "boom.toml"
-    scene.write_text("[physics]\ndt = 0.02\nsubsteps = 1\nstiffness = 50000.0\n[[body]]\ndetail = 4\n"
+    scene.write_text("[physics]\nintegrator = \"symplectic-euler\"\ndt = 0.02\nsubsteps = 1\nstiffness = 50000.0\n"
+                     "[[body]]\ndetail = 4\n"
                      "position = [0.0, 1.0]\n[[collider]]\ncenter = [0.0, 0.0]\nsize = [5.0, 0.5]\n")
     code, _, err = run(capsys, "run", str(scene), "--export", str(tmp_path / "m"), "--quiet")
     assert code == EXIT_UNSTABLE and "nothing was written" in err

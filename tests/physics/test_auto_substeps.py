@@ -101,7 +101,8 @@ def test_bad_substeps_are_one_line(value):
 
 def test_a_scene_file_takes_auto_and_writes_it_back(tmp_path):
     p = tmp_path / "auto.toml"
-    p.write_text('[physics]\ndt = 0.016666666666666666\nsubsteps = "auto"\nstiffness = 2000.0\n'
+    p.write_text('[physics]\nintegrator = "symplectic-euler"\ndt = 0.016666666666666666\nsubsteps = "auto"\n'
+                 'stiffness = 2000.0\n'
                  '[[body]]\nshape = "box"\ncorners = [[-0.5, 0], [0.5, 0], [0.5, 1], [-0.5, 1]]\ndetail = 4\n')
     w = deforma.load_scene(p)
     assert w.auto_substeps and w.substeps == math.ceil(w.dt / w.stable_dt())

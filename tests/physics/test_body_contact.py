@@ -64,7 +64,8 @@ def test_a_box_dropped_on_another_comes_to_rest_on_top(name):
 def test_a_stack_of_five_boxes_rests():
     # Spring damping acts along springs and grows with frequency, so it barely touches the
     # stack's slow sway; air drag (1/s) damps it, as a real tower's material damping would.
-    w = deforma.World(dt=1 / 600, substeps=12, stiffness=6000.0, damping=5.0, air_drag=1.0)
+    w = deforma.World(integrator="symplectic-euler", dt=1 / 600, substeps=12, stiffness=6000.0, damping=5.0,
+                      air_drag=1.0)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
     boxes = [w.add_body(grid_mesh(1.0, 1.0, 9, 9), position=(0.02 * (k % 2), 0.55 + 1.05 * k)) for k in range(5)]
     for k in range(int(5.0 / w.dt)):
@@ -171,7 +172,7 @@ def test_two_bodies_mix_their_coefficients_as_the_geometric_mean():
 def test_a_soft_ring_squashed_flat_does_not_pass_through_itself():
     runs = {}
     for self_collision in (False, True):
-        w = deforma.World(dt=1 / 1000, substeps=4, stiffness=200.0, damping=0.5)
+        w = deforma.World(integrator="symplectic-euler", dt=1 / 1000, substeps=4, stiffness=200.0, damping=0.5)
         w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
         b = w.add_body(ring_mesh(0.4, 0.5, 48), position=(0, 0.6), self_collision=self_collision)
         first = None
@@ -241,7 +242,7 @@ def test_pile_scene_never_crosses_and_no_vertex_enters_another_body():
 
 
 def test_dragging_one_body_into_another_pushes_it_rather_than_passing_through():
-    w = deforma.World(dt=1 / 600, substeps=4, stiffness=3000.0, damping=2.0)
+    w = deforma.World(integrator="symplectic-euler", dt=1 / 600, substeps=4, stiffness=3000.0, damping=2.0)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
     below = w.add_body(grid_mesh(3.0, 0.5, 25, 5), position=(0.0, 0.25))  # too wide to slip off
     held = w.add_body(grid_mesh(0.4, 0.4, 5, 5), position=(0.0, 1.2))

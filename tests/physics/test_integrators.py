@@ -20,9 +20,10 @@ ALL = ["symplectic-euler", "implicit-euler", "xpbd"]
 STABLE = ["implicit-euler", "xpbd"]
 
 
-def test_all_three_are_registered_default_first():
-    assert deforma.physics.available_integrators()[:3] == ALL
-    assert deforma.World().integrator == "symplectic-euler"
+def test_all_are_registered_and_avbd_at_one_step_a_frame_is_the_default():
+    assert deforma.physics.available_integrators() == ALL + ["implicit-bdf2", "avbd"]
+    w = deforma.World()
+    assert (w.integrator, w.dt, w.substeps) == ("avbd", 1 / 60, 1)
 
 
 @pytest.mark.parametrize("name", ALL)

@@ -59,7 +59,7 @@ class World:
     gravity : (float, float), optional
         Acceleration of gravity in m/s^2.
     dt : float, optional
-        Time advanced by one :meth:`step`, seconds (> 0).
+        Time advanced by one :meth:`step`, seconds (> 0; default 1/60 s, one step a frame).
     substeps : int or "auto", optional
         Integration substeps per step (>= 1); each is ``dt / substeps`` long. ``"auto"`` (the
         default): as many as the explicit integrator's stable step asks (``ceil(dt /
@@ -86,7 +86,8 @@ class World:
         A vertex faster than this (m/s) means the simulation ran away (> 0; ``inf`` to
         check only for NaN/inf).
     integrator : str, optional
-        Time integrator by name; see ``deforma.physics.available_integrators()``.
+        Time integrator by name (default ``"avbd"``, stable and at rest at 1/60 s; see
+        ``deforma.physics.available_integrators()`` and ``docs/integrators.md``).
     integrator_options : dict, optional
         The integrator's settings by name (see ``docs/integrators.md``; e.g.
         ``{"iterations": 5}`` for ``"implicit-euler"``); the others keep their defaults.
@@ -117,9 +118,9 @@ class World:
     True
     """
 
-    def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 600, substeps="auto", mass=1.0, stiffness=1000.0,
+    def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 60, substeps="auto", mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
-                 integrator="symplectic-euler", contact_thickness=None, air_drag=0.0, material=None,
+                 integrator="avbd", contact_thickness=None, air_drag=0.0, material=None,
                  integrator_options=None):
         self._bodies: list[Body] = []
         self._colliders: list[Collider] = []

@@ -142,7 +142,7 @@ class CameraSettings:
 class PhysicsSettings:
     """``[physics]``: the world's parameters (the original inspector's Physics Settings)."""
 
-    dt: float = spec("float", 1 / 600, lo=0.0, hi=0.1, lo_open=True, unit="s",
+    dt: float = spec("float", 1 / 60, lo=0.0, hi=0.1, lo_open=True, unit="s",
                      doc="Time advanced per step; smaller is more accurate and slower.")
     substeps: int | str = spec("substeps", "auto", lo=1, hi=1000,
                                doc="Integration substeps per step, each dt/substeps long; \"auto\": as many as the "
@@ -160,9 +160,10 @@ class PhysicsSettings:
                                       "each other unless they set their own.")
     max_speed: float = spec("float", 1000.0, lo=0.0, lo_open=True, unit="m/s",
                             doc="A vertex faster than this means the simulation became unstable.")
-    integrator: str = spec("str", "symplectic-euler",
-                           doc="Time integrator by name: symplectic-euler (explicit, the original's), "
-                               "implicit-euler, implicit-bdf2 (second order) or xpbd (all three stable at any dt; "
+    integrator: str = spec("str", "avbd",
+                           doc="Time integrator by name: avbd (augmented vertex block descent, stable and at "
+                               "rest at one step a frame), symplectic-euler (explicit, the original's), "
+                               "implicit-euler, implicit-bdf2 (second order) or xpbd (all four stable at any dt; "
                                "see docs/integrators.md).")
     integrator_options: tuple = spec("options", (),
                                      doc="The integrator's own settings, a sub-table [physics.integrator_options] "

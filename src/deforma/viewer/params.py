@@ -78,7 +78,7 @@ GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
         Param("edge_step", "Edge step", "int", 1, 20, unit="px", tip="every n-th outline pixel", rebuild=True),
     )),
     ("Physics", (
-        Param("dt", "Dt", "float", 1e-4, 1e-2, log=True, unit="s", tip="seconds per step"),
+        Param("dt", "Dt", "float", 1e-4, 0.05, log=True, unit="s", tip="seconds per step"),
         Param("substeps", "Substeps", "int", 1, 20, tip="integration substeps per step"),
         Param("gravity_x", "Gravity x", "float", -20, 20, unit="m/s²"),
         Param("gravity_y", "Gravity y", "float", -20, 20, unit="m/s²"),

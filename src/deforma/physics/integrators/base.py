@@ -317,7 +317,8 @@ def register_integrator(name: str):
 
 
 def available_integrators() -> list[str]:
-    """Names accepted by ``World(integrator=...)``, in registration order (the default first).
+    """Names accepted by ``World(integrator=...)``, in registration order (``"avbd"``, the
+    default, last).
 
     Examples
     --------
