@@ -289,6 +289,27 @@ def test_other_spec_refused_unless_force(done, folder):
     assert len(_rows(out)) == 6  # nothing lost
 
 
+@pytest.mark.parametrize("bounds", ['"physics.friction" = { min = 0, max = inf }',
+                                    '"physics.friction" = { min = -inf, max = 1 }',
+                                    '"physics.friction" = { min = 0, max = nan }',
+                                    '"physics.friction" = { min = -1e308, max = 1e308 }',
+                                    '"physics.friction" = { min = 0, max = 100000000000000000000000000000000000000000'
+                                    '0000000000000000000000000000000000000000000000000000000000000000000000000000000000'
+                                    '0000000000000000000000000000000000000000000000000000000000000000000000000000000000'
+                                    '0000000000000000000000000000000000000000000000000000000000000000000000000000000000'
+                                    '000000000000000000000000000000000000000000000000000 }',
+                                    '"body[0].position" = { min = [0, 0], max = [1, inf] }'])
+def test_a_range_that_cannot_be_drawn_from_is_named_before_anything_runs(folder, bounds):
+    # random mode draws uniformly in [min, max]: an infinite end or width was a NumPy
+    # OverflowError traceback; now one line, and nothing is written
+    spec = _spec(folder, "inf.toml", f'scene = "tiny.toml"\nseconds = 0.3\nmode = "random"\nsamples = 2\n'
+                                     f'[parameters]\n{bounds}\n')
+    with pytest.raises(sweeps.SweepError, match=r"a range needs finite numbers .* min <= max and a finite width") as e:
+        sweeps.sweep(spec, folder / "never_inf")
+    assert "\n" not in str(e.value)
+    assert not (folder / "never_inf").exists()
+
+
 @pytest.mark.parametrize("parameters, message", [
     ('"physics.stifness" = [1, 2]', r"physics\.stifness: unknown key; did you mean 'stiffness'"),
     ('"phyiscs.stiffness" = [1, 2]', r"phyiscs\.stiffness: unknown table 'phyiscs'; did you mean 'physics'"),

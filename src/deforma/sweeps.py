@@ -139,6 +139,17 @@ def _is_number(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
+def _finite_range(lo, hi) -> bool:
+    """Whether ``[lo, hi]`` can be drawn from uniformly: finite ends in order and a finite
+    width (``{min = 0, max = inf}`` or ``{min = -1e308, max = 1e308}`` overflowed NumPy's
+    draw with a traceback)."""
+    try:
+        lo, hi = float(lo), float(hi)
+    except OverflowError:  # an integer beyond any float
+        return False
+    return math.isfinite(lo) and math.isfinite(hi) and lo <= hi and math.isfinite(hi - lo)
+
+
 def load_spec(path) -> SweepSpec:
     """Read and check a sweep file: its own keys, the base scene, and every key path and value.
 
@@ -204,14 +215,14 @@ def load_spec(path) -> SweepSpec:
                 raise SweepError(f"{where}: a range has exactly the keys min and max, got {', '.join(values)}")
             lo, hi = values["min"], values["max"]
             if _is_number(lo) and _is_number(hi):
-                ok = lo <= hi
+                ok = _finite_range(lo, hi)
             elif isinstance(lo, list) and isinstance(hi, list) and len(lo) == len(hi) and lo:
-                ok = all(_is_number(a) and _is_number(b) and a <= b for a, b in zip(lo, hi))
+                ok = all(_is_number(a) and _is_number(b) and _finite_range(a, b) for a, b in zip(lo, hi))
             else:
                 ok = False
             if not ok:
-                raise SweepError(f"{where}: a range needs numbers (or equally long lists of numbers) with "
-                                 f"min <= max, got min = {lo!r}, max = {hi!r}")
+                raise SweepError(f"{where}: a range needs finite numbers (or equally long lists of them) with "
+                                 f"min <= max and a finite width, got min = {lo!r}, max = {hi!r}")
         elif isinstance(values, list):
             if not values:
                 raise SweepError(f"{where}: empty list; give at least one value")
