@@ -89,6 +89,27 @@ def test_bad_files_are_one_line_errors(tmp_path):
         write_meshes([m], tmp_path / "x.ply")
 
 
+def test_json_nested_too_deep_is_a_one_line_error(tmp_path):
+    (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(ValueError, match=r"deep.json: not a mesh file deforma wrote \(RecursionError") as e:
+        read_meshes(tmp_path / "deep.json")
+    assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".json", ".svg"])
+def test_names_not_one_per_mesh_are_refused_and_nothing_is_written(tmp_path, suffix):
+    # two meshes and one name: every body was written but the second was dropped, silently
+    m = deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]])
+    for names in (["one"], ["one", "two", "three"]):
+        with pytest.raises(ValueError, match=r"names has \d entries for 2 meshes; give one name per mesh") as e:
+            write_meshes([m, m], tmp_path / f"x{suffix}", names=names)
+        assert "\n" not in str(e.value)
+    assert not list(tmp_path.iterdir())
+    write_meshes([m, m], tmp_path / f"x{suffix}", names=["one", "two"])
+    if suffix != ".svg":
+        assert len(read_meshes(tmp_path / f"x{suffix}")) == 2
+
+
 def run(capsys, *args):
     code = main(list(args))
     out, err = capsys.readouterr()

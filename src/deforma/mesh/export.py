@@ -115,10 +115,15 @@ def write_meshes(meshes: Sequence[Mesh], path, *, names: Sequence[str] | None = 
     Raises
     ------
     ValueError
-        A suffix other than those of :data:`FORMATS`.
+        A suffix other than those of :data:`FORMATS`, or ``names`` not one per mesh
+        (nothing is written).
     """
     path = Path(path)
     fmt = path.suffix[1:].lower()
+    if names is not None and len(list(names)) != len(meshes):
+        # zip() would drop the meshes past the last name without a word
+        raise ValueError(f"{path}: names has {len(list(names))} entries for {len(meshes)} meshes; give one name "
+                         f"per mesh, or none (body0, body1, ...)")
     names = list(names) if names is not None else [f"body{k}" for k in range(len(meshes))]
     if fmt == "obj":
         text = obj_text(meshes, names, materials, [m.texture is not None for m in meshes])
@@ -170,7 +175,8 @@ def read_meshes(path) -> list[Mesh]:
             return [_as_written(b["vertices"], b["triangles"], b["uv"]) for b in data["bodies"]]
         if fmt == "obj":
             return _read_obj(path.read_text())
-    except (KeyError, TypeError, IndexError, ValueError, UnicodeDecodeError) as e:
+    except (KeyError, TypeError, IndexError, ValueError, UnicodeDecodeError, RecursionError) as e:
+        # RecursionError: JSON nested deeper than Python's parser goes is no mesh file either
         raise ValueError(f"{path}: not a mesh file deforma wrote ({type(e).__name__}: {e})") from None
     raise ValueError(f"{path}: meshes are read from .obj or .json; got {path.suffix!r}")
 
