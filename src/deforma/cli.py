@@ -297,6 +297,17 @@ class _MeshExport:
             self.tmp = None
 
 
+def _check_distinct_outputs(a) -> None:
+    """Refuse two of ``-o``, ``--states`` and ``--export`` naming one path: the second to be
+    put in place failed on the first (``--export o.mp4 -o o.mp4`` left a folder o.mp4 behind,
+    ``--export s.npz --states s.npz`` the states and a hidden temporary folder's name)."""
+    given = [(flag, Path(p)) for flag, p in (("-o", a.output), ("--states", a.states), ("--export", a.export)) if p]
+    for i, (flag, path) in enumerate(given):
+        for other, path2 in given[i + 1:]:
+            if path.resolve() == path2.resolve():
+                raise CliError(f"{flag} and {other} both name {path}: give each output a path of its own")
+
+
 def cmd_run(a) -> int:
     from .startup import COMPILE_MESSAGE, CompileWatch, warn
 
@@ -329,6 +340,7 @@ def _run_scene(a, watch, shown: dict) -> int:
     fps = a.fps if a.fps is not None else scene.run.fps
     scene = replace(scene, run=replace(scene.run, seconds=float(seconds), fps=float(fps)))
     # check every output before any work, so a typo does not cost a whole simulation
+    _check_distinct_outputs(a)
     if a.output:
         from .render.video import check_output
 

@@ -149,6 +149,9 @@ def test_run_exports_json_with_frame_and_time(tmp_path, capsys):
     ("full", ["--export", "{p}"], "--export writes a new folder, and this is a folder that is not empty"),
     ("none", ["--export", "{p}/a/b"], "does not exist"),
     ("none", ["--format", "svg"], "--format says how --export writes the meshes: give --export DIR too"),
+    ("none", ["--export", "{p}.mp4", "-o", "{p}.mp4"], "-o and --export both name"),
+    ("none", ["--export", "{p}.npz", "--states", "{p}.npz"], "--states and --export both name"),
+    ("none", ["-o", "{p}.npz", "--states", "{p}/../target.npz"], "-o and --states both name"),
 ])
 def test_bad_export_arguments_are_refused_before_any_work(tmp_path, capsys, setup, args, message):
     p = tmp_path / "target"
