@@ -120,11 +120,12 @@ def write_meshes(meshes: Sequence[Mesh], path, *, names: Sequence[str] | None = 
     """
     path = Path(path)
     fmt = path.suffix[1:].lower()
-    if names is not None and len(list(names)) != len(meshes):
-        # zip() would drop the meshes past the last name without a word
-        raise ValueError(f"{path}: names has {len(list(names))} entries for {len(meshes)} meshes; give one name "
-                         f"per mesh, or none (body0, body1, ...)")
+    # a list once: a generator would be used up by the count
     names = list(names) if names is not None else [f"body{k}" for k in range(len(meshes))]
+    if len(names) != len(meshes):
+        # zip() would drop the meshes past the last name without a word
+        raise ValueError(f"{path}: names has {len(names)} entries for {len(meshes)} meshes; give one name "
+                         f"per mesh, or none (body0, body1, ...)")
     if fmt == "obj":
         text = obj_text(meshes, names, materials, [m.texture is not None for m in meshes])
     elif fmt == "json":

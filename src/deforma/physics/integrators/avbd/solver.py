@@ -696,7 +696,9 @@ class AVBD(Integrator):
                 keep = 1.0 / (1.0 + hs * model.air_drag)
                 mass_h2 = model.vertex_mass * ((1.0 + hs * model.air_drag) / (hs * hs))
                 advance_colliders(rects, hs)
-                np.copyto(self._v_n, v)
+                second = opts["order"] == 2
+                if second:
+                    np.copyto(self._v_n, v)
                 np.copyto(self._v_saved, self._v_last)
                 had_last = self._has_last
                 predict(x, v, self._x_n, self._y, self._v_last, self._has_last, inv_mass, gx, gy, keep,
@@ -725,7 +727,7 @@ class AVBD(Integrator):
                 k += 1
                 # BDF2 away from the contact rows where the last step was whole and as long
                 anchor, hd, free = x_n, hs, 0
-                if opts["order"] == 2 and parts == 1 and self._history == hs:
+                if second and parts == 1 and self._history == hs:
                     np.copyto(self._held_before, self._held)
                     rows_held(self._held, self._touch, count, ctopo, found, n_body)
                     anchor = self._anchor
@@ -744,7 +746,7 @@ class AVBD(Integrator):
                 close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
                 close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
                 self.active_contacts = count + n_body
-                solved = x.copy()
+                solved = x.copy() if free else None
                 bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, hs, vmax2)
                 if bad:
                     self._history = False
@@ -757,11 +759,12 @@ class AVBD(Integrator):
                 self.failsafe += not np.array_equal(x, collided)
                 if free:
                     second_order_velocities(x, v, anchor, solved, self._held, inv_mass, hs)
-                np.copyto(self._x_prev, x_n)
-                np.copyto(self._v_prev, self._v_n)
-                np.copyto(self._x_end, x)
-                np.copyto(self._v_end, v)
-                self._history = hs if parts == 1 else False
+                if second:
+                    np.copyto(self._x_prev, x_n)
+                    np.copyto(self._v_prev, self._v_n)
+                    np.copyto(self._x_end, x)
+                    np.copyto(self._v_end, v)
+                    self._history = hs if parts == 1 else False
         return StepReport(0, contacts.complete)
 
     def _edge_size(self, model):
