@@ -183,6 +183,41 @@ def test_a_block_dropped_on_the_floor_comes_to_rest():
     assert 0.0 < b.positions[:, 1].min() < 1e-6
 
 
+def test_a_block_rests_on_a_colliders_corner_held_by_a_row():
+    """A 60 x 30 cm block (E = 1e5 Pa) whose outline has a vertex every 15 cm dropped on a
+    diamond's corner 5 cm off its centre: it tips onto its left end and rests on the corner,
+    which pokes between two outline vertices, with no vertex faster than 1 mm/s after 3 s,
+    no inverted triangle, and no fail-safe: the corner is a row of the solve. (Met only by
+    the contact stage after it, the sweeps pulled the edge back onto the corner every step:
+    one triangle inverted and a vertex at 0.94 m/s for good.)"""
+    w = deforma.World(dt=H, integrator="avbd", material=FEM, friction=0.5, static_friction=0.6)
+    w.add_collider(deforma.Rect((0, -0.25), (6, 0.5), 0))
+    w.add_collider(deforma.Rect((0.05, 0.0), (0.1, 0.1), 45.0))
+    tip = np.array([0.05, 0.1 / math.sqrt(2)])
+    b = w.add_body(deforma.mesh.box(((-0.3, 0), (0.3, 0), (0.3, 0.3), (-0.3, 0.3)), detail=3), position=(0.0, 0.25))
+    worst = 0
+    for _ in range(180):
+        w.step()
+        worst = max(worst, inverted_triangles(w))
+    assert worst == 0 and w.integrator_stats["failsafe"] == 0
+    assert fastest([b]) < 1e-3
+    x, tri = b.positions, b.triangles
+    p, q, r = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
+
+    def side(u, v):
+        return (v[:, 0] - u[:, 0]) * (tip[1] - u[:, 1]) - (v[:, 1] - u[:, 1]) * (tip[0] - u[:, 0])
+
+    assert not ((side(p, q) > 0) & (side(q, r) > 0) & (side(r, p) > 0)).any()  # in no triangle
+    # resting on it: the outline (the edges of one triangle) passes within 0.1 mm of the
+    # corner, and the left end is down
+    edges, count = np.unique(np.sort(np.r_[tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]], axis=1), axis=0,
+                             return_counts=True)
+    a, c = x[edges[count == 1, 0]], x[edges[count == 1, 1]]
+    t = np.clip(((tip - a) * (c - a)).sum(1) / ((c - a) ** 2).sum(1), 0.0, 1.0)
+    assert np.hypot(*(a + t[:, None] * (c - a) - tip).T).min() < 1e-4
+    assert b.positions[:, 1].min() < 1e-6
+
+
 def fastest(bodies):
     """The fastest vertex's speed (m/s)."""
     return max(float(np.hypot(*b.velocities.T).max()) for b in bodies)

@@ -442,6 +442,146 @@ def collide_dynamic(x, v, inv_mass, x_start, rects, hits, stamp, h):
     return moved
 
 
+@njit(cache=True, inline="always")
+def collider_corner(rects, r, k):
+    """Corner ``k`` of collider ``r`` (a rectangle's four counter-clockwise from its local (+x,
+    -y) corner, or a polygon's edges' first ends), in metres."""
+    if rects[r, KIND] == RECT:
+        cx, cy = rects[r, RECT_CX], rects[r, RECT_CY]
+        ux, uy = rects[r, RECT_UX], rects[r, RECT_UY]
+        sx = rects[r, RECT_HX] if k == 0 or k == 3 else -rects[r, RECT_HX]
+        sy = rects[r, RECT_HY] if k < 2 else -rects[r, RECT_HY]
+        return cx + sx * ux - sy * uy, cy + sx * uy + sy * ux
+    e = np.int64(rects[r, RECT_HX]) + k
+    return rects[e, EDGE_AX], rects[e, EDGE_AY]
+
+
+@njit(cache=True, inline="always")
+def corner_count(rects, r):
+    """How many corners collider ``r`` has (0: a round shape, which has none)."""
+    kind = rects[r, KIND]
+    if kind == RECT:
+        return 4
+    if kind == POLYGON:
+        return np.int64(rects[r, RECT_HY])
+    return 0
+
+
+#: Columns of :func:`corner_contacts`' float output: the edge point's parameter ``s``, the
+#: edge's unit normal into the body, the corner at the end of the substep, how far it moved
+#: in the substep, the static and dynamic friction coefficients and the gap to hold (m).
+CORNER_S, CORNER_NX, CORNER_NY, CORNER_PX, CORNER_PY, CORNER_MX, CORNER_MY = 0, 1, 2, 3, 4, 5, 6
+CORNER_STATIC, CORNER_DYNAMIC, CORNER_TARGET = 7, 8, 9
+CORNER_COLUMNS = 10
+
+
+@njit(cache=True)
+def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out):
+    """Collider corners an outline edge may meet in a substep, for a solver that holds them
+    as rows (the stable solvers' counterpart of :func:`push_edges_off_corners`).
+
+    Per outline edge ``(a, b)`` (directed with the body on its left) and fixed or moving
+    collider (not a rigid body's outline), the corner that reaches furthest toward the body
+    across the edge at the predicted end ``y``, if it lies beside the edge (``0 < s < 1``),
+    within ``margin`` of it or through it by less than its length, and was outside the body
+    across this edge at the start, ``x0`` (seen from the collider, by under 1 % of the edge's
+    length): a corner already through an edge, or one behind the body's far side, is no
+    contact of this edge's.
+
+    Parameters
+    ----------
+    x0, y : (N, 2) float64
+        Positions at the start of the substep and predicted at its end (m).
+    rects : (R, RECT_COLUMNS) float64
+        From :func:`~deforma.physics.colliders.shapes.pack_colliders`, at the end of the substep.
+    edge_a, edge_b : (E,) int32
+        Outline edges as collision-vertex indices (``ContactTopology.ce_a`` / ``ce_b``).
+    vertex : (V,) int32
+        Collision vertex -> row of ``x`` (``ContactTopology.cv_vertex``).
+    margin : float
+        How far a corner may be outside the edge and still be listed (m).
+    h : float
+        Substep (s).
+    pairs : (K, 4) int64
+        Output: the edge's two vertices (rows of ``x``), the edge and the collider.
+    out : (K, CORNER_COLUMNS) float64
+        Output: per contact, the columns ``CORNER_*``.
+
+    Returns
+    -------
+    int
+        The number of contacts, or ``-needed`` if ``pairs`` holds fewer.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from deforma.physics.colliders.shapes import Rect, pack_colliders
+    >>> r = pack_colliders([Rect((0, 0), (2, 2), 45.0)], friction=0.3, static_friction=0.5)
+    >>> x0 = np.array([[-1.0, 1.5], [1.0, 1.5]])  # an edge above the diamond's top corner, body above
+    >>> pairs, out = np.zeros((4, 4), np.int64), np.zeros((4, CORNER_COLUMNS))
+    >>> corner_contacts(x0, x0 - [0.0, 0.2], r, np.array([0], np.int32), np.array([1], np.int32),
+    ...                 np.arange(2, dtype=np.int32), 0.3, 0.01, pairs, out)
+    1
+    >>> out[0, [CORNER_S, CORNER_NY, CORNER_PY]].round(6).tolist()  # beside the middle, the body above
+    [0.5, 1.0, 1.414214]
+    """
+    count = 0
+    n_rects = n_colliders(rects)
+    for e in range(edge_a.shape[0]):
+        ia = vertex[edge_a[e]]
+        ib = vertex[edge_b[e]]
+        ax, ay, bx, by = y[ia, 0], y[ia, 1], y[ib, 0], y[ib, 1]
+        dx, dy = bx - ax, by - ay
+        length2 = dx * dx + dy * dy
+        if length2 == 0.0:
+            continue
+        inv_len = 1.0 / np.sqrt(length2)
+        nx, ny = -dy * inv_len, dx * inv_len  # toward the body
+        a0x, a0y, b0x, b0y = x0[ia, 0], x0[ia, 1], x0[ib, 0], x0[ib, 1]
+        d0x, d0y = b0x - a0x, b0y - a0y
+        len0 = np.sqrt(d0x * d0x + d0y * d0y)
+        if len0 == 0.0:
+            continue
+        n0x, n0y = -d0y / len0, d0x / len0
+        for r in range(n_rects):
+            if rects[r, INV_MASS] != 0.0:
+                continue
+            if min(ax, bx) - margin >= rects[r, RECT_XMAX] or max(ax, bx) + margin <= rects[r, RECT_XMIN] \
+                    or min(ay, by) - margin >= rects[r, RECT_YMAX] or max(ay, by) + margin <= rects[r, RECT_YMIN]:
+                continue
+            best, best_s, best_k = -margin, 0.0, -1
+            w = rects[r, OMEGA]
+            for k in range(corner_count(rects, r)):
+                px, py = collider_corner(rects, r, k)
+                t = ((px - ax) * dx + (py - ay) * dy) / length2
+                depth = (px - ax) * nx + (py - ay) * ny
+                if not (0.0 < t < 1.0 and depth > best and depth * depth < length2):
+                    continue
+                # where the corner was at the start, against where the edge was
+                qx = px - h * (rects[r, VEL_X] - w * (py - rects[r, RECT_CY]))
+                qy = py - h * (rects[r, VEL_Y] + w * (px - rects[r, RECT_CX]))
+                if (qx - a0x) * n0x + (qy - a0y) * n0y > 0.01 * len0:
+                    continue
+                best, best_s, best_k = depth, t, k
+            if best_k < 0:
+                continue
+            if count >= pairs.shape[0]:
+                count += 1
+                continue
+            px, py = collider_corner(rects, r, best_k)
+            pairs[count, 0], pairs[count, 1], pairs[count, 2], pairs[count, 3] = ia, ib, e, r
+            out[count, CORNER_S] = best_s
+            out[count, CORNER_NX], out[count, CORNER_NY] = nx, ny
+            out[count, CORNER_PX], out[count, CORNER_PY] = px, py
+            out[count, CORNER_MX] = h * (rects[r, VEL_X] - w * (py - rects[r, RECT_CY]))
+            out[count, CORNER_MY] = h * (rects[r, VEL_Y] + w * (px - rects[r, RECT_CX]))
+            out[count, CORNER_STATIC] = rects[r, RECT_STATIC_FRICTION]
+            out[count, CORNER_DYNAMIC] = rects[r, RECT_FRICTION]
+            out[count, CORNER_TARGET] = rects[r, RECT_SKIN]
+            count += 1
+    return count if count <= pairs.shape[0] else -count
+
+
 @njit(cache=True)
 def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects, hits):
     """Collider corners against body outlines: push every outline edge a corner pokes through
@@ -529,14 +669,7 @@ def push_edges_off_corners(x, v, inv_mass, edge_a, edge_b, vertex, rects, hits):
                 n_corners = np.int64(hy)  # a polygon's corners: the first ends of its edges
             best, best_s = 0.0, 0.0
             for k in range(n_corners):
-                if kind == RECT:
-                    sx = hx if k == 0 or k == 3 else -hx
-                    sy = hy if k < 2 else -hy
-                    px = cx + sx * ux - sy * uy
-                    py = cy + sx * uy + sy * ux
-                else:
-                    e = np.int64(hx) + k
-                    px, py = rects[e, EDGE_AX], rects[e, EDGE_AY]
+                px, py = collider_corner(rects, r, k)
                 t = ((px - ax) * dx + (py - ay) * dy) / length2
                 depth = (px - ax) * nx + (py - ay) * ny
                 # a corner poking through this edge: beside it, on the body's side, and not

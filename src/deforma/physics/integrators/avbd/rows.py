@@ -33,14 +33,29 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-import numpy as np
 from numba import njit
+
+from ...colliders.response import (
+    CORNER_DYNAMIC,
+    CORNER_MX,
+    CORNER_MY,
+    CORNER_NX,
+    CORNER_NY,
+    CORNER_PX,
+    CORNER_PY,
+    CORNER_S,
+    CORNER_STATIC,
+    CORNER_TARGET,
+)
 
 #: A step's contact rows as the sweeps read them: the collider rows (``vertex_row`` (N,),
 #: ``planes`` (N, 7), ``rows`` (N, ROW_COLUMNS)) and the body rows (the contact stage's
 #: topology ``topo`` and buffer ``buf``, their state ``bstate`` (C, ROW_COLUMNS), and which
-#: rows each vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``).
-RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "topo", "buf", "bstate", "b_start", "b_entry"])
+#: rows each vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``) and the corner rows
+#: (:func:`~deforma.physics.colliders.response.corner_contacts`' ``cpairs`` and ``cf``, their
+#: state ``cstate`` and incidence ``c_start``, ``c_entry``).
+RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "topo", "buf", "bstate", "b_start", "b_entry",
+                               "cpairs", "cf", "cstate", "c_start", "c_entry"])
 
 #: Columns of a step's contact rows (K, ROW_COLUMNS).
 LAM_N, LAM_T, K_N, K_T, STICK, BOUND = 0, 1, 2, 3, 4, 5
@@ -135,31 +150,38 @@ def contact_energy(px, py, x_n, i, planes, state, k):
 
 
 @njit(cache=True, inline="always")
-def contact_block(x, x_n, i, planes, state, k, whole):
-    """Row ``k``'s share of vertex ``i``'s block: ``(gx, gy, hxx, hxy, hyy)``. With ``whole``
-    the normal stiffness is in the block even where the row does not push now (for a step of
-    the body as a whole, which a row that starts to push within it must bound)."""
-    fn, ft, _, _, mu = contact_forces(x, x_n, i, planes, state, k)
+def weighted_row(w, fn, ft, kn, kt, nx, ny, bound, whole):
+    """A row's share of the block of a vertex that moves its distance with weight ``w``, from
+    the row's normal force ``fn``, unclamped friction ``ft`` (bounded by ``bound``) and
+    penalties: ``(gx, gy, hxx, hxy, hyy)``. With ``whole`` the normal stiffness is in the
+    block even where the row does not push now (for a step of the body as a whole, which a
+    row that starts to push within it must bound)."""
     if fn <= 0.0:
         if not whole:
             return 0.0, 0.0, 0.0, 0.0, 0.0
-        nx, ny = planes[k, 0], planes[k, 1]
-        kn = state[k, K_N]
-        return 0.0, 0.0, kn * nx * nx, kn * nx * ny, kn * ny * ny
-    # bounded by the normal force at this iterate (for a step of the whole body, by the
-    # bound frozen before it, so that the line search sees one potential)
-    bound = state[k, BOUND] if whole else mu * fn
-    kn, kt = state[k, K_N], state[k, K_T]
+        kw = w * w * kn
+        return 0.0, 0.0, kw * nx * nx, kw * nx * ny, kw * ny * ny
     if abs(ft) >= bound:
         # sliding: the friction force is mu f_n whatever the slip, so it adds no stiffness
         # (with k_t in the block the sweep crept along the surface: a frictionless block on
         # a slope fell at 2 % of g sin a in ten sweeps)
         ft = bound if ft > 0.0 else -bound
         kt = 0.0
-    nx, ny = planes[k, 0], planes[k, 1]
     tx, ty = -ny, nx
-    return (-fn * nx - ft * tx, -fn * ny - ft * ty, kn * nx * nx + kt * tx * tx, kn * nx * ny + kt * tx * ty,
-            kn * ny * ny + kt * ty * ty)
+    ww = w * w
+    return (-w * (fn * nx + ft * tx), -w * (fn * ny + ft * ty), ww * (kn * nx * nx + kt * tx * tx),
+            ww * (kn * nx * ny + kt * tx * ty), ww * (kn * ny * ny + kt * ty * ty))
+
+
+@njit(cache=True, inline="always")
+def contact_block(x, x_n, i, planes, state, k, whole):
+    """Row ``k``'s share of vertex ``i``'s block: ``(gx, gy, hxx, hxy, hyy)`` (``whole``: as
+    :func:`weighted_row` takes it)."""
+    fn, ft, _, _, mu = contact_forces(x, x_n, i, planes, state, k)
+    # bounded by the normal force at this iterate (for a step of the whole body, by the
+    # bound frozen before it, so that the line search sees one potential)
+    bound = state[k, BOUND] if whole else mu * fn
+    return weighted_row(1.0, fn, ft, state[k, K_N], state[k, K_T], planes[k, 0], planes[k, 1], bound, whole)
 
 
 @njit(cache=True)
@@ -329,23 +351,13 @@ def body_blocks(x, x_n, i, topo, buf, state, start, entry, whole):
         ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
         w = role_weight(role, s)
         fn, ft, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
-        kn, kt = state[c, K_N], state[c, K_T]
-        if fn <= 0.0:
-            if whole:
-                hxx += w * w * kn * nx * nx
-                hxy += w * w * kn * nx * ny
-                hyy += w * w * kn * ny * ny
-            continue
         bound = state[c, BOUND] if whole else mu * fn
-        if abs(ft) >= bound:
-            ft = bound if ft > 0.0 else -bound
-            kt = 0.0
-        tx, ty = -ny, nx
-        gx -= w * (fn * nx + ft * tx)
-        gy -= w * (fn * ny + ft * ty)
-        hxx += w * w * (kn * nx * nx + kt * tx * tx)
-        hxy += w * w * (kn * nx * ny + kt * tx * ty)
-        hyy += w * w * (kn * ny * ny + kt * ty * ty)
+        a, b, c0, c1, c2 = weighted_row(w, fn, ft, state[c, K_N], state[c, K_T], nx, ny, bound, whole)
+        gx += a
+        gy += b
+        hxx += c0
+        hxy += c1
+        hyy += c2
     return gx, gy, hxx, hxy, hyy
 
 
@@ -379,11 +391,154 @@ def update_body_rows(x, x_n, topo, buf, state, count, beta, k_max):
         dual_step(state, c, fn, ft, gap, slip, mu, beta, k_max)
 
 
+# -- collider corners against outline edges --------------------------------------------------
+#
+# Row c holds the edge point (1 - s) x_a + s x_b off a collider's corner p (which moves by m
+# in the step): C_n = n . ((1 - s) x_a + s x_b - p) - target, n the edge's normal into the
+# body, fixed for the step, and the slip C_t along t = (-n_y, n_x) of the edge point
+# relative to the corner since the step began. The forces are a body row's with the corner
+# as an immovable vertex: the edge's ends take them with the weights (1 - s, s). Warm start
+# by the pair (edge, collider). Without these rows a corner poking between two outline
+# vertices was met only by the contact stage after the solve, which the sweeps then undid:
+# the ``demo`` bunny's ear rested on a ramp's corner with three triangles inverted.
+
+
+@njit(cache=True, inline="always")
+def corner_row_forces_at(ax, ay, bx, by, a0x, a0y, b0x, b0y, cf, state, c):
+    """Corner row ``c``'s normal and friction force with its edge's ends at ``(ax, ay)`` and
+    ``(bx, by)``, which began the step at ``(a0x, a0y)`` and ``(b0x, b0y)``: ``(f_n, f_t, C_n,
+    C_t, mu)`` (friction unclamped)."""
+    s = cf[c, CORNER_S]
+    ca = 1.0 - s
+    nx, ny = cf[c, CORNER_NX], cf[c, CORNER_NY]
+    ex, ey = ca * ax + s * bx, ca * ay + s * by
+    gap = (ex - cf[c, CORNER_PX]) * nx + (ey - cf[c, CORNER_PY]) * ny - cf[c, CORNER_TARGET]
+    fn = max(0.0, state[c, LAM_N] - state[c, K_N] * gap)
+    rx = ex - ca * a0x - s * b0x - cf[c, CORNER_MX]
+    ry = ey - ca * a0y - s * b0y - cf[c, CORNER_MY]
+    slip = -rx * ny + ry * nx
+    ft = state[c, LAM_T] - state[c, K_T] * slip
+    m = cf[c, CORNER_STATIC] if state[c, STICK] > 0.0 else cf[c, CORNER_DYNAMIC]
+    return fn, ft, gap, slip, m
+
+
+@njit(cache=True, inline="always")
+def corner_row_forces(x, x_n, ia, ib, cf, state, c):
+    """Corner row ``c``'s forces at the iterate ``x`` (:func:`corner_row_forces_at`)."""
+    return corner_row_forces_at(x[ia, 0], x[ia, 1], x[ib, 0], x[ib, 1], x_n[ia, 0], x_n[ia, 1], x_n[ib, 0],
+                                x_n[ib, 1], cf, state, c)
+
+
+@njit(cache=True)
+def start_corner_rows(pairs, cf, count, memory, state, k_start, carry, soften, k_max, v):
+    """Open the step's corner rows, warm-started from ``memory`` (per edge: collider,
+    ``lambda_n``, ``lambda_t``, ``k_n``, ``k_t``) when the same edge met the same collider last
+    step; static friction for the step when the edge point slid over the corner slower than
+    :data:`STICK_SPEED` as it began."""
+    for c in range(count):
+        ia, ib, e, r = pairs[c, 0], pairs[c, 1], pairs[c, 2], pairs[c, 3]
+        k0 = max(k_start[ia], k_start[ib])
+        if memory[e, MEM_ROW] == r:
+            state[c, LAM_N] = memory[e, 1] * carry
+            state[c, LAM_T] = memory[e, 2] * carry
+            state[c, K_N] = min(max(memory[e, 3] * soften, k0), k_max)
+            state[c, K_T] = min(max(memory[e, 4] * soften, k0), k_max)
+        else:
+            state[c, LAM_N] = 0.0
+            state[c, LAM_T] = 0.0
+            state[c, K_N] = k0
+            state[c, K_T] = k0
+        s = cf[c, CORNER_S]
+        rvx = (1.0 - s) * v[ia, 0] + s * v[ib, 0]
+        rvy = (1.0 - s) * v[ia, 1] + s * v[ib, 1]
+        state[c, STICK] = 1.0 if abs(-rvx * cf[c, CORNER_NY] + rvy * cf[c, CORNER_NX]) <= STICK_SPEED else 0.0
+
+
+@njit(cache=True)
+def close_corner_rows(pairs, count, memory, state):
+    """Keep the corner rows' multipliers and penalties by (edge, collider) for the next step."""
+    memory[:, MEM_ROW] = -1.0
+    for c in range(count):
+        e = pairs[c, 2]
+        if memory[e, MEM_ROW] >= 0.0 and state[c, LAM_N] <= memory[e, 1]:
+            continue  # an edge on two colliders' corners keeps the one that pushes more
+        memory[e, MEM_ROW] = pairs[c, 3]
+        memory[e, 1] = state[c, LAM_N]
+        memory[e, 2] = state[c, LAM_T]
+        memory[e, 3] = state[c, K_N]
+        memory[e, 4] = state[c, K_T]
+
+
+@njit(cache=True)
+def corner_row_incidence(pairs, count, n_vertices, start, entry):
+    """Which corner rows each vertex takes part in, as CSR into ``start`` (N + 1) and ``entry``
+    (2 count,): ``entry`` holds ``2 c + role`` (role 0: the edge's first end, 1: its second)."""
+    for i in range(n_vertices + 1):
+        start[i] = 0
+    for c in range(count):
+        start[pairs[c, 0] + 1] += 1
+        start[pairs[c, 1] + 1] += 1
+    for i in range(n_vertices):
+        start[i + 1] += start[i]
+    fill = start[:n_vertices].copy()
+    for c in range(count):
+        for role in range(2):
+            i = pairs[c, role]
+            entry[fill[i]] = 2 * c + role
+            fill[i] += 1
+
+
+@njit(cache=True)
+def corner_blocks(x, x_n, i, rs, whole):
+    """Vertex ``i``'s share of its corner rows: ``(gx, gy, hxx, hxy, hyy)`` (``whole`` as in
+    :func:`body_blocks`)."""
+    gx = gy = hxx = hxy = hyy = 0.0
+    cf, state = rs.cf, rs.cstate
+    for p in range(rs.c_start[i], rs.c_start[i + 1]):
+        c = rs.c_entry[p] // 2
+        role = rs.c_entry[p] - 2 * c
+        s = cf[c, CORNER_S]
+        w = s if role == 1 else 1.0 - s
+        fn, ft, _, _, mu = corner_row_forces(x, x_n, rs.cpairs[c, 0], rs.cpairs[c, 1], cf, state, c)
+        bound = state[c, BOUND] if whole else mu * fn
+        a, b, c0, c1, c2 = weighted_row(w, fn, ft, state[c, K_N], state[c, K_T], cf[c, CORNER_NX], cf[c, CORNER_NY],
+                                        bound, whole)
+        gx += a
+        gy += b
+        hxx += c0
+        hxy += c1
+        hyy += c2
+    return gx, gy, hxx, hxy, hyy
+
+
+@njit(cache=True)
+def freeze_corner_bounds(x, x_n, pairs, cf, state, count):
+    """Each corner row's friction bound ``mu f_n`` at the iterate ``x``."""
+    for c in range(count):
+        fn, _, _, _, mu = corner_row_forces(x, x_n, pairs[c, 0], pairs[c, 1], cf, state, c)
+        state[c, BOUND] = mu * fn
+
+
+@njit(cache=True)
+def update_corner_rows(x, x_n, pairs, cf, state, count, beta, k_max):
+    """The corner rows' dual step, as :func:`update_rows`'s."""
+    for c in range(count):
+        fn, ft, gap, slip, mu = corner_row_forces(x, x_n, pairs[c, 0], pairs[c, 1], cf, state, c)
+        dual_step(state, c, fn, ft, gap, slip, mu, beta, k_max)
+
+
 @njit(cache=True, inline="always")
 def row_blocks(x, x_n, i, rs, whole):
-    """Vertex ``i``'s share of all its contact rows, collider and body: ``(gx, gy, hxx, hxy,
-    hyy)``."""
+    """Vertex ``i``'s share of all its contact rows, collider, corner and body: ``(gx, gy,
+    hxx, hxy, hyy)``."""
     gx, gy, hxx, hxy, hyy = body_blocks(x, x_n, i, rs.topo, rs.buf, rs.bstate, rs.b_start, rs.b_entry, whole)
+    if rs.c_start[i + 1] > rs.c_start[i]:
+        cgx, cgy, cxx, cxy, cyy = corner_blocks(x, x_n, i, rs, whole)
+        gx += cgx
+        gy += cgy
+        hxx += cxx
+        hxy += cxy
+        hyy += cyy
     k = rs.vertex_row[i]
     if k >= 0:
         cgx, cgy, cxx, cxy, cyy = contact_block(x, x_n, i, rs.planes, rs.rows, k, whole)
@@ -398,4 +553,4 @@ def row_blocks(x, x_n, i, rs, whole):
 @njit(cache=True, inline="always")
 def on_rows(i, rs):
     """Whether vertex ``i`` takes part in any contact row this step."""
-    return rs.vertex_row[i] >= 0 or rs.b_start[i + 1] > rs.b_start[i]
+    return rs.vertex_row[i] >= 0 or rs.b_start[i + 1] > rs.b_start[i] or rs.c_start[i + 1] > rs.c_start[i]

@@ -51,7 +51,7 @@ import numpy as np
 from numba import njit
 
 from ...colliders.geometry import advance_colliders
-from ...colliders.response import contact_planes
+from ...colliders.response import CORNER_COLUMNS, contact_planes, corner_contacts, push_edges_off_corners
 from ...contact.broad_phase import gather_start
 from ...contact.contacts import SPECULATIVE, make_buffer, make_scratch
 from ...contact.narrow_phase import detect_contacts
@@ -83,14 +83,20 @@ from .rows import (
     body_row_incidence,
     body_row_parts,
     close_body_rows,
+    close_corner_rows,
     close_rows,
     contact_energy,
+    corner_row_forces_at,
+    corner_row_incidence,
     freeze_body_bounds,
     freeze_bounds,
+    freeze_corner_bounds,
     row_energy,
     start_body_rows,
+    start_corner_rows,
     start_rows,
     update_body_rows,
+    update_corner_rows,
     update_rows,
 )
 
@@ -446,6 +452,18 @@ def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, d
             ry = (p0y - x_n[ip, 1]) - ca * (p1y - x_n[ia, 1]) - s * (p2y - x_n[ib, 1])
             ft = st[c, LAM_T] - st[c, K_T] * (-rx * ny + ry * nx)
             e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
+        # corner rows, each once (at its first end in the body)
+        for p in range(rs.c_start[i], rs.c_start[i + 1]):
+            c = rs.c_entry[p] // 2
+            ia, ib = rs.cpairs[c, 0], rs.cpairs[c, 1]
+            if ia != i and lo <= ia < hi:
+                continue
+            pax, pay = _moved(x, ia, lo, hi, cx, cy, dx, dy, co, si)
+            pbx, pby = _moved(x, ib, lo, hi, cx, cy, dx, dy, co, si)
+            st = rs.cstate
+            fn, ft, _, _, _ = corner_row_forces_at(pax, pay, pbx, pby, x_n[ia, 0], x_n[ia, 1], x_n[ib, 0], x_n[ib, 1],
+                                                   rs.cf, st, c)
+            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
     return e
 
 
@@ -565,6 +583,12 @@ class AVBD(Integrator):
         self._search = None
         self._bstate = np.empty((0, ROW_COLUMNS))
         self._b_entry = np.empty(0, np.int64)
+        self._cpairs = np.empty((64, 4), np.int64)  # the corner rows (corner_contacts)
+        self._cf = np.empty((64, CORNER_COLUMNS))
+        self._cstate = np.empty((64, ROW_COLUMNS))
+        self._c_entry = np.empty(128, np.int64)
+        self._corner_memory = None
+        self._n_corner = 0
         self._n = -1
         self._size = None
         self._history = False  # BDF2's: the length of the last step if whole, else False
@@ -657,6 +681,7 @@ class AVBD(Integrator):
             self._memory = np.full((n, MEMORY_COLUMNS), -1.0)
             self._hf = np.empty((4, 4))
             self._b_start = np.zeros(n + 1, np.int64)
+            self._c_start = np.zeros(n + 1, np.int64)
             self._x_prev = np.empty((n, 2))  # the last step's start, for BDF2
             self._v_prev = np.empty((n, 2))
             self._v_n = np.empty((n, 2))
@@ -730,6 +755,7 @@ class AVBD(Integrator):
                 if second and parts == 1 and self._history == hs:
                     np.copyto(self._held_before, self._held)
                     rows_held(self._held, self._touch, count, ctopo, found, n_body)
+                    self._held[self._cpairs[:self._n_corner, :2].ravel()] = True
                     anchor = self._anchor
                     free = second_order_targets(x_n, self._y, self._v_n, self._x_prev, self._v_prev, self._x_end,
                                                 self._v_end, anchor, mass_h2, model.vertex_mass, inv_mass, self._held,
@@ -745,12 +771,21 @@ class AVBD(Integrator):
                             opts["tolerance"] * hs)
                 close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
                 close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
-                self.active_contacts = count + n_body
+                close_corner_rows(self._cpairs, self._n_corner, self._corner_memory[0], self._cstate)
+                self.active_contacts = count + n_body + self._n_corner
                 solved = x.copy() if free else None
                 bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, hs, vmax2)
                 if bad:
                     self._history = False
                     return StepReport(int(bad), contacts.complete)
+                if self._n_corner:
+                    # the corner rows' last word, as finish_position_step's projection is the
+                    # collider rows': their penalty leaves a corner tens of micrometres through
+                    # a loaded edge, put back here on the edges that have a row (the contact
+                    # stage below still counts a corner no row held)
+                    edges = self._cpairs[:self._n_corner, 2]
+                    push_edges_off_corners(x, v, inv_mass, ctopo.ce_a[edges], ctopo.ce_b[edges], ctopo.cv_vertex,
+                                           rects, hits)
                 collided = x.copy()
                 if contact_epilogue(x, v, inv_mass, x_n, self._failsafe_topology(ctopo), scr, contacts.buffer, rects,
                                     hits, hs, True) < 0:
@@ -833,6 +868,15 @@ class AVBD(Integrator):
             self._search = (ctopo, mine, found)
         narrow_targets(ctopo, found, n_body, margin)
         hold_start_distance(x_n, ctopo, found, n_body)
+        # collider corners an outline edge may meet, within the same margin
+        while True:
+            n_corner = corner_contacts(x_n, y, rects, ctopo.ce_a, ctopo.ce_b, ctopo.cv_vertex, margin, h,
+                                       self._cpairs, self._cf)
+            if n_corner >= 0:
+                break
+            self._cpairs = np.empty((-2 * n_corner, 4), np.int64)
+            self._cf = np.empty((-2 * n_corner, CORNER_COLUMNS))
+        self._n_corner = n_corner
         return count, n_body, found
 
     def _body_rows(self, model, ctopo, buf, n_body, k_start, v):
@@ -848,8 +892,18 @@ class AVBD(Integrator):
         start_body_rows(ctopo, buf, n_body, self._body_memory[0], self._bstate, k_start, self.CARRY, self.SOFTEN,
                         opts["penalty_max"], v)
         body_row_incidence(ctopo, buf, n_body, model.n_vertices, self._b_start, self._b_entry)
+        nc = self._n_corner
+        n_edges = len(ctopo.ce_a)
+        if self._corner_memory is None or self._corner_memory[1] is not model or len(self._corner_memory[0]) != n_edges:
+            self._corner_memory = (np.full((n_edges, MEMORY_COLUMNS), -1.0), model)
+        if len(self._cstate) < nc:
+            self._cstate = np.empty((2 * nc, ROW_COLUMNS))
+            self._c_entry = np.empty(4 * nc, np.int64)
+        start_corner_rows(self._cpairs, self._cf, nc, self._corner_memory[0], self._cstate, k_start, self.CARRY,
+                          self.SOFTEN, opts["penalty_max"], v)
+        corner_row_incidence(self._cpairs, nc, model.n_vertices, self._c_start, self._c_entry)
         return RowSet(self._vertex_row, self._planes, self._rows, ctopo, buf, self._bstate, self._b_start,
-                      self._b_entry)
+                      self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry)
 
     def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
@@ -878,6 +932,7 @@ class AVBD(Integrator):
                 most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs)
             freeze_bounds(x, x_n, self._touch, self._planes, self._rows, count)
             freeze_body_bounds(x, x_n, rs.topo, rs.buf, rs.bstate, n_body)
+            freeze_corner_bounds(x, x_n, rs.cpairs, rs.cf, rs.cstate, self._n_corner)
             if patches is not None:
                 cluster_sweep(x, x_n, y, mass_h2, *patches, tris.elem, tris.b, tris.area, tris.mu, tris.lam,
                               tris.beta, tris.kind, springs.i, springs.j, springs.rest, springs.ks, springs.kd,
@@ -894,6 +949,8 @@ class AVBD(Integrator):
         # between its corners from sweep to sweep and it slid off a slope it should stand on)
         update_rows(x, x_n, self._touch, self._planes, self._rows, count, opts["penalty_ramp"], opts["penalty_max"])
         update_body_rows(x, x_n, rs.topo, rs.buf, rs.bstate, n_body, opts["penalty_ramp"], opts["penalty_max"])
+        update_corner_rows(x, x_n, rs.cpairs, rs.cf, rs.cstate, self._n_corner, opts["penalty_ramp"],
+                           opts["penalty_max"])
         self.iterations_run += it + 1
         self.residual = math.sqrt(most) * inv_h
         if tol > 0.0 and most > tol * tol:
