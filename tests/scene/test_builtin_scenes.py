@@ -33,7 +33,7 @@ def test_demo_tumbles_a_textured_body_down_rotated_rectangles():
 _AFTER_THE_FIRST_SECOND = {}
 
 
-# the pile: tests/physics/test_body_contact.py steps it for 6 s with this check every 20 steps
+# the pile: tests/physics/test_body_contact.py steps it for 10 s with this check every 20 steps
 @pytest.mark.parametrize("name", [n for n in NAMES if n != "pile"])
 def test_builtin_scene_runs_finite_with_no_vertex_inside_a_collider(name):
     world = scenes.load_scene(name)

@@ -43,8 +43,15 @@ def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
         == (0.0, 1.0, False)
 
 
+def implicit_demo():
+    """The demo in a session, switched to implicit Euler (whose options these tests set)."""
+    s = Session("demo")
+    s.set_integrator("implicit-euler")
+    return s
+
+
 def test_the_session_sets_an_option_by_name_and_keeps_the_others(tmp_path):
-    s = Session("demo")  # implicit Euler
+    s = implicit_demo()
     world = s.world
     s.set_param("integrator_contact_weight", 20.0)
     s.set_param("integrator_iterations", 6.0)  # a whole float, as a slider gives it
@@ -77,7 +84,7 @@ BAD = [
 
 @pytest.mark.parametrize("name, value, message", BAD, ids=[f"{n}={v!r}" for n, v, _ in BAD])
 def test_a_bad_option_is_refused_in_one_line_and_changes_nothing(name, value, message):
-    s = Session("demo")
+    s = implicit_demo()
     s.set_param("integrator_iterations", 5)
     before = s.world.integrator_options
     with pytest.raises(ValueError) as e:
@@ -87,7 +94,7 @@ def test_a_bad_option_is_refused_in_one_line_and_changes_nothing(name, value, me
 
 
 def test_a_misspelt_option_says_what_was_meant():
-    s = Session("demo")
+    s = implicit_demo()
     with pytest.raises(ValueError, match=r"^unknown implicit-euler option 'iteratons' \(did you mean 'iterations'\?\)"):
         s.set_integrator_option("iteratons", 4)
     with pytest.raises(KeyError):

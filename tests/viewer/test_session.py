@@ -168,7 +168,7 @@ def test_integrator_switches_on_the_running_world_and_is_saved(tmp_path):
 
 
 def test_xpbd_with_too_few_substeps_says_how_many_hold_the_bodies():
-    s = Session("pile")  # 1/60 s x 2: the heap's bodies need about 14 under XPBD
+    s = Session("pile")  # 1/60 s: the heap's bodies need about 14 substeps under XPBD
     s.set_integrator("xpbd")
     assert s.note_is_warning and "raise substeps to 14 (world.xpbd_substeps()) or use implicit-euler" in s.note
     s.world.substeps = 14

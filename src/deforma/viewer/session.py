@@ -569,13 +569,13 @@ class Session:
 
         Examples
         --------
-        >>> s = Session("demo")
-        >>> s.set_integrator_option("iterations", 5); s.integrator_options
-        {'iterations': 5, 'tolerance': 0.0, 'max_iterations': 500, 'contact_weight': 10.0}
+        >>> s = Session("demo")  # avbd, the default
+        >>> s.set_integrator_option("order", 2); s.integrator_options["order"]
+        2
         >>> s.set_integrator_option("iterations", 0)
         Traceback (most recent call last):
         ...
-        ValueError: implicit-euler option iterations must be an integer in [1, 10000], got 0
+        ValueError: avbd option iterations must be an integer in [1, 10000], got 0
         """
         w = self.world
         options = w.integrator_options
