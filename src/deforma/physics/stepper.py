@@ -2,7 +2,8 @@
 
 1. **inputs**: pack the colliders if they changed, set the grabs and applied forces in the
    :class:`~deforma.physics.control.Control`, copy the State into the step's start;
-2. **gas**: the pressure kick (:func:`~deforma.physics.behaviours.apply_pressure`);
+2. **gas**: the pressure kick (:func:`~deforma.physics.behaviours.apply_pressure`), unless the
+   integrator holds the gas in its solve (``solves_pressure``: avbd);
 3. **integrate**: ``integrator.step(model, start, state, control, contacts, h)``, run again
    from the start with a larger contact buffer if it ran out of room; with rigid bodies,
    one substep at a time, each followed by the rigid stage
@@ -161,7 +162,7 @@ def _integrate(w, start, moving: bool, substeps: int) -> None:
     h = w.dt / w._substeps  # the count in force (the public getter would check "auto" again)
     rects = w._control.colliders.copy() if moving else None  # where the packed colliders start
     while True:
-        if w._model.has_pressure:
+        if w._model.has_pressure and not integrator.solves_pressure:
             behaviours.apply_pressure(w._model, state, h * substeps)
         contacts.clear_needed()
         if w._model.rigid.any():  # the impulses the rigid bodies take are this run's alone

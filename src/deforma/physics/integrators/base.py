@@ -226,8 +226,10 @@ class Integrator:
     A subclass sets :attr:`name`, its :attr:`OPTIONS` and :meth:`step`; it is made available
     as ``World(integrator=name)`` by :func:`register_integrator`. Its options are read as
     ``self.options[name]``. ``unconditionally_stable = True`` tells ``World.stable_dt`` that
-    it has no explicit step limit. :meth:`stats` gives counters a user may want to see
-    (``world.integrator_stats``).
+    it has no explicit step limit. ``solves_pressure = True`` says that its step holds the
+    bodies' gas itself (else the stepper kicks the velocities by the gas force first,
+    :mod:`deforma.physics.behaviours.pressure`). :meth:`stats` gives counters a user may want
+    to see (``world.integrator_stats``).
 
     Examples
     --------
@@ -238,6 +240,7 @@ class Integrator:
     name: str = ""
     OPTIONS: tuple[Option, ...] = ()
     unconditionally_stable = False
+    solves_pressure = False
 
     def __init__(self, **options):
         self._options = {o.name: o.default for o in self.OPTIONS}

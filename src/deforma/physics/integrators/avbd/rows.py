@@ -53,9 +53,10 @@ from ...colliders.response import (
 #: topology ``topo`` and buffer ``buf``, their state ``bstate`` (C, ROW_COLUMNS), and which
 #: rows each vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``) and the corner rows
 #: (:func:`~deforma.physics.colliders.response.corner_contacts`' ``cpairs`` and ``cf``, their
-#: state ``cstate`` and incidence ``c_start``, ``c_entry``).
+#: state ``cstate`` and incidence ``c_start``, ``c_entry``), and the bodies' gas (``gas``,
+#: :class:`~deforma.physics.integrators.avbd.gas.GasSet`: not a row, read by the vertex blocks).
 RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "topo", "buf", "bstate", "b_start", "b_entry",
-                               "cpairs", "cf", "cstate", "c_start", "c_entry"])
+                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas"])
 
 #: Columns of a step's contact rows (K, ROW_COLUMNS).
 LAM_N, LAM_T, K_N, K_T, STICK, BOUND = 0, 1, 2, 3, 4, 5
@@ -552,5 +553,6 @@ def row_blocks(x, x_n, i, rs, whole):
 
 @njit(cache=True, inline="always")
 def on_rows(i, rs):
-    """Whether vertex ``i`` takes part in any contact row this step."""
-    return rs.vertex_row[i] >= 0 or rs.b_start[i + 1] > rs.b_start[i] or rs.c_start[i + 1] > rs.c_start[i]
+    """Whether vertex ``i`` takes part in any contact row this step, or holds a gas."""
+    return (rs.vertex_row[i] >= 0 or rs.b_start[i + 1] > rs.b_start[i] or rs.c_start[i + 1] > rs.c_start[i]
+            or rs.gas.start[i + 1] > rs.gas.start[i])

@@ -71,6 +71,7 @@ from ..base import (
 from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
+from .gas import gas_areas, gas_block, gas_moved, gas_set
 from .rows import (
     BOUND,
     K_N,
@@ -207,6 +208,15 @@ def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, 
     hxx += oxx
     hxy += oxy
     hyy += oyy
+    gas = rs.gas
+    on_gas = gas.start[i + 1] > gas.start[i]
+    if on_gas:
+        ggx, ggy, gxx, gxy, gyy = gas_block(x, i, gas)
+        gx += ggx
+        gy += ggy
+        hxx += gxx
+        hxy += gxy
+        hyy += gyy
     det = hxx * hyy - hxy * hxy
     if not det > 0.0:
         return 0.0
@@ -214,6 +224,8 @@ def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, 
     dy = (hxx * gy - hxy * gx) / det
     x[i, 0] -= dx
     x[i, 1] -= dy
+    if on_gas:
+        gas_moved(x, i, gas, -dx, -dy)
     return dx * dx + dy * dy
 
 
@@ -546,6 +558,7 @@ class AVBD(Integrator):
 
     name = "avbd"
     unconditionally_stable = True
+    solves_pressure = True  # the gas's energy is in the vertex blocks (avbd.gas)
     OPTIONS = (Option("iterations", 10, "int", low=1, high=10_000, doc="sweeps per step (the most, with tolerance)"),
                Option("reach", 0.5, "float", low=0.0, high=1e6, closed_low=True,
                       doc="split a step into parts where it moves a vertex into a contact further than this "
@@ -589,6 +602,7 @@ class AVBD(Integrator):
         self._c_entry = np.empty(128, np.int64)
         self._corner_memory = None
         self._n_corner = 0
+        self._gas = None  # (model, GasSet)
         self._n = -1
         self._size = None
         self._history = False  # BDF2's: the length of the last step if whole, else False
@@ -902,8 +916,12 @@ class AVBD(Integrator):
         start_corner_rows(self._cpairs, self._cf, nc, self._corner_memory[0], self._cstate, k_start, self.CARRY,
                           self.SOFTEN, opts["penalty_max"], v)
         corner_row_incidence(self._cpairs, nc, model.n_vertices, self._c_start, self._c_entry)
+        if self._gas is None or self._gas[0] is not model:
+            self._gas = (model, gas_set(model))
+        gas = self._gas[1]
+        np.multiply(model.body_pressure, model.body_pressure_area, out=gas.load)  # settable live
         return RowSet(self._vertex_row, self._planes, self._rows, ctopo, buf, self._bstate, self._b_start,
-                      self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry)
+                      self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas)
 
     def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
@@ -922,7 +940,10 @@ class AVBD(Integrator):
         most = 0.0
         sweeps = opts["iterations"]
         it = 0
+        gas = model.has_pressure
         for it in range(sweeps):
+            if gas:
+                gas_areas(x, rs.gas)  # the whole-body step and the patches moved vertices too
             if model.fused:
                 most = sweep(x, x_n, y, mass_h2, inv_mass, order, starts, t_start, t_item, t_corner, tris.elem,
                              tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start, s_item, s_corner,
