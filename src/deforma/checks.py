@@ -19,6 +19,7 @@ ValueError: dt must be in [1e-06, 0.1] s, got 1e-300
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
@@ -61,13 +62,21 @@ def number(value, name: str) -> float:
     try:
         v = float(value)
     except OverflowError:  # a number beyond any float: an integer like 10**400, or a Fraction of one
-        got = f"an integer of {len(str(abs(value)))} digits" if isinstance(value, int) else "a number"
+        got = f"an integer of {digit_count(value)} digits" if isinstance(value, int) else "a number"
         raise ValueError(f"{name} must be finite, got {got}, too large for a float") from None
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number, got {value!r}") from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite, got {value!r}")
     return v
+
+
+def digit_count(value: int) -> str:
+    """How many digits ``value`` has, said without str() failing on one past Python's limit."""
+    try:
+        return str(len(str(abs(value))))
+    except ValueError:  # beyond sys.get_int_max_str_digits() (4300 by default): str() refuses it
+        return f"more than {sys.get_int_max_str_digits()}"
 
 
 def _limited(v: float, value, name: str, unit: str, lo: float, lo_open: bool) -> float:

@@ -170,6 +170,16 @@ def test_removing_a_joint_or_a_body_lets_go():
      "at must be a pair of finite numbers, got a number too large"),
     (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="spring", stiffness=10**400),
      "stiffness must be finite, got an integer of 401 digits"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="spring", stiffness=1.0, damping=10**400),
+     "damping must be finite, got an integer of 401 digits"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), motor_speed=-10**400),
+     "motor_speed must be finite, got an integer of 401 digits"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), motor_speed=10.0, max_torque=10**400),
+     "max_torque must be finite, got an integer of 401 digits"),
+    # past Python's int-to-str limit (4300 digits) the line still names the argument
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="spring", stiffness=10**5000),
+     "stiffness must be finite, got an integer of more than 4300 digits"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 10**5000)), "at must be a pair of finite numbers"),
 ])
 def test_bad_joints_are_refused_in_one_line_changing_nothing(call, message):
     w = deforma.World(dt=1 / 60)
@@ -179,6 +189,15 @@ def test_bad_joints_are_refused_in_one_line_changing_nothing(call, message):
     with pytest.raises(ValueError, match=message) as e:
         call(w, a, b, soft)
     assert "\n" not in str(e.value) and w.joints == []
+
+
+@pytest.mark.parametrize("name", ["motor_speed", "max_torque"])
+def test_a_huge_motor_setting_is_refused_in_one_line_keeping_the_motor(name):
+    w = deforma.World(dt=1 / 60)
+    j = w.join(bar(w, 0.0, 0.0), None, at=(0.1, 0.02), motor_speed=10.0, max_torque=5.0)
+    with pytest.raises(ValueError, match=f"{name} must be finite, got an integer of 401 digits") as e:
+        setattr(j, name, 10**400)
+    assert "\n" not in str(e.value) and (j.motor_speed, j.max_torque) == (10.0, 5.0)
 
 
 SCENE = """
@@ -220,6 +239,13 @@ def test_a_scene_joint_hinges_its_bar_and_saves_with_the_scene(tmp_path):
     ("a = 1\nat = [0, 3]", "joint[0]: joints hold rigid bodies: a (body 1) is soft"),
     ("a = 0\nat = [0, 0]\nkind = \"hinge\"", "joint[0].kind"),
     ("a = 0\nat = [0, 0]\nkind = \"spring\"", "joint[0]: a spring joint needs stiffness"),
+    # TOML integers are unbounded: one beyond any float is refused where it is read, not an OverflowError
+    ("a = 0\nat = [1" + "0" * 400 + ", 0]", "joint[0].at[0]: expected a finite number, got an integer of 401 digits"),
+    ("a = 0\nat = [0, 0]\nkind = \"spring\"\nstiffness = 1" + "0" * 400, "joint[0].stiffness: expected a finite"),
+    ("a = 0\nat = [0, 0]\nkind = \"spring\"\nstiffness = 1\ndamping = -1" + "0" * 400,
+     "joint[0].damping: expected a finite"),
+    ("a = 0\nat = [0, 0]\nmotor_speed = 1" + "0" * 400, "joint[0].motor_speed: expected a finite"),
+    ("a = 0\nat = [0, 0]\nmotor_speed = 1\nmax_torque = 1" + "0" * 400, "joint[0].max_torque: expected a finite"),
 ])
 def test_a_bad_scene_joint_is_refused_in_one_line_naming_it(tmp_path, joint, message):
     p = tmp_path / "bad.toml"

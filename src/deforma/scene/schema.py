@@ -48,11 +48,12 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 # an image body's background: the rule of deforma.mesh.from_image itself
-from ..checks import LIMITS, MAX_COORDINATE
+from ..checks import LIMITS, MAX_COORDINATE, digit_count
 from ..mesh.image import check_background
 from .assets import picture_reference, resolve_picture, resolve_texture, texture_reference
 from .construct import build
@@ -135,6 +136,10 @@ def _number(value, path, *, integer=False):
         if isinstance(value, float) and value.is_integer():
             return int(value)
         raise _Problem(path, f"expected an integer, got {_show(value)}")
+    if isinstance(value, int) and abs(value) > sys.float_info.max:
+        # TOML integers have no bound here: 10**400 overflows math.isfinite, the ranges and the physics
+        raise _Problem(path, f"expected a finite number, got an integer of {digit_count(value)} digits, "
+                             f"too large for a float")
     if not math.isfinite(value):
         raise _Problem(path, f"expected a finite number, got {_show(value)}")
     return value if integer else float(value)
