@@ -374,6 +374,34 @@ def test_unreachable_address_fails_fast():
     assert time.perf_counter() - t0 < 30
 
 
+@pytest.mark.parametrize("address", ["garbage", "unreachable"])
+@pytest.mark.parametrize("existed", [False, True])
+def test_a_failed_address_leaves_nothing_behind(folder, tmp_path, address, existed):
+    """`deforma sweep --address` that cannot connect: one line, exit 1, and no folder made (the
+    table's folder was made before the connection and left behind); a folder that was there
+    stays, as it was. In a process of its own: this one may hold the module's cluster, and then
+    an address is not looked at."""
+    import os
+    import subprocess
+    import sys
+
+    address = f"127.0.0.1:{_free_port()}" if address == "unreachable" else address
+    spec = _spec(folder, "address.toml", SWEEP)
+    if existed:
+        (tmp_path / "out").mkdir()
+    out = tmp_path / "out" / "res"
+    env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "deforma.cli", "sweep", str(spec), "-o", str(out), "--address", address,
+                        "--states", "--video", "gif", "--quiet"], capture_output=True, text=True, env=env, timeout=120)
+    assert time.perf_counter() - t0 < 60
+    assert r.returncode == 1 and r.stdout == "", (r.stdout, r.stderr)
+    assert r.stderr.startswith("deforma: error: ") and r.stderr.count("\n") == 1, r.stderr
+    assert ("expected HOST:PORT" if address == "garbage" else f"cannot reach a Ray cluster at {address}") in r.stderr
+    assert sorted(os.listdir(tmp_path)) == (["out"] if existed else [])
+    assert not existed or os.listdir(tmp_path / "out") == []
+
+
 def test_cli(done, folder, capsys):
     spec, out, _ = done
     assert main(["sweep", str(spec), "-o", str(out), "--quiet", "--video", "gif", "--video-size", "160x90"]) == 0

@@ -688,11 +688,7 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
         import pyarrow  # noqa: F401 - checked before the cluster starts
     except ImportError:
         raise SweepError("sweeps need Ray and pyarrow: pip install 'deforma[sweep]'") from None
-    (outdir / RESULTS_NAME).mkdir(parents=True, exist_ok=True)
-    if states:
-        (outdir / STATES_FOLDER).mkdir(exist_ok=True)
-    if video is not None:
-        (outdir / VIDEOS_FOLDER).mkdir(exist_ok=True)
+    # the cluster before any folder: a bad or unreachable --address leaves nothing behind
     started = connect(workers=workers, address=address)
     import pyarrow.parquet as pq
     import ray
@@ -700,9 +696,14 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
     from .files import write_atomic
 
     remote = ray.remote(num_cpus=1, max_retries=0)(_worker_run)
-    kept = str((outdir / STATES_FOLDER).resolve()) if states else False  # where the NPZs go
     pending = {}
-    try:
+    try:  # a folder that cannot be made still shuts down a cluster this call started
+        (outdir / RESULTS_NAME).mkdir(parents=True, exist_ok=True)
+        if states:
+            (outdir / STATES_FOLDER).mkdir(exist_ok=True)
+        if video is not None:
+            (outdir / VIDEOS_FOLDER).mkdir(exist_ok=True)
+        kept = str((outdir / STATES_FOLDER).resolve()) if states else False  # where the NPZs go
         for run in todo:
             scene = scene_for(spec, run.parameters, source=f"{spec.path.name}: run {run.index} ({run.run_id})")
             pending[remote.remote(scene, kept, video, tuple(video_size))] = run
