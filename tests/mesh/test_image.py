@@ -272,6 +272,92 @@ def test_missing_and_unreadable_files(tmp_path):
     one_line_value_error("source must be", from_image, np.zeros((4, 4, 2)))
 
 
+def lying_png(path, width, height):
+    """A PNG whose header says ``width x height`` and whose data holds one white row: the
+    compressed stream ends cleanly after it, so Pillow decodes it without a word."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+                     + chunk(b"IDAT", zlib.compress(b"\x00" + b"\xff" * 3 * width)) + chunk(b"IEND", b""))
+    return path
+
+
+def test_a_png_whose_header_lies_about_its_size_is_refused_at_once(tmp_path, capsys):
+    # it was meshed as a 6000 x 6000 picture (the missing rows black): about 2 GB and 6-19 s
+    import subprocess
+    import sys
+    import time
+
+    from deforma.cli import main
+
+    liar = lying_png(tmp_path / "liar.png", 6000, 6000)
+    truncated = r"cannot read image .*liar.png' \(image file is truncated: its header says 6000x6000 pixels"
+    t0 = time.perf_counter()
+    one_line_value_error(truncated, from_image, liar)
+    one_line_value_error(truncated, deforma.mesh.image.read_rgba, liar)
+    assert time.perf_counter() - t0 < 5
+    # the command line: one line, exit 1, no picture written
+    assert main(["mesh", str(liar), "-o", str(tmp_path / "m.png")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("deforma: error: cannot read image") and err.count("\n") == 1 and "truncated" in err
+    # a rigid image body of a scene file
+    (tmp_path / "s.toml").write_text('[[body]]\nshape = "image"\nsource = "liar.png"\nmaterial = "rigid"\n')
+    with pytest.raises(deforma.scene.SceneError, match=r"body\[0\]\.source: cannot read image .*truncated") as e:
+        deforma.load_scene(tmp_path / "s.toml")
+    assert "\n" not in str(e.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["liar.png", "s.toml"]
+    # the peak memory, in a process of its own: far below one 6000 x 6000 RGB picture (108 MB)
+    code = ("import resource, sys, deforma\n"
+            "before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+            "try:\n    deforma.mesh.from_image(sys.argv[1])\nexcept ValueError:\n    pass\n"
+            "print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024)")
+    r = subprocess.run([sys.executable, "-c", code, str(liar)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert float(r.stdout) < 50, f"peak memory grew by {r.stdout.strip()} MB"
+
+
+def test_a_png_cut_at_a_row_or_interlaced_is_judged_by_its_rows(tmp_path):
+    """The rows a PNG's header promises are counted the way they are stored: a file one row
+    short is refused, whole ones (any colour type, bit depth, palette or interlaced) are read."""
+    import struct
+    import zlib
+
+    adam7 = ((0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2))
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    def png(w, h, depth, colour, interlaced, rows, piece):
+        """The rows of each pass (up to ``rows`` of them), in IDAT chunks of ``piece`` bytes."""
+        bits = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}[colour] * depth
+        raw = []
+        for x0, y0, dx, dy in adam7 if interlaced else ((0, 0, 1, 1),):
+            pw, ph = -(-(w - x0) // dx), -(-(h - y0) // dy)
+            raw += [b"\x00" + b"\x55" * ((pw * bits + 7) // 8)] * (ph if pw > 0 else 0)
+        head = struct.pack(">IIBBBBB", w, h, depth, colour, 0, 0, int(interlaced))
+        plte = chunk(b"PLTE", b"\x00\x00\x00\xff\xff\xff" * 128) if colour == 3 else b""
+        data = zlib.compress(b"".join(raw[:rows]))
+        p = tmp_path / "p.png"
+        p.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", head) + plte
+                      + b"".join(chunk(b"IDAT", data[i:i + piece]) for i in range(0, len(data), piece))
+                      + chunk(b"IEND", b""))
+        return p, len(raw)
+
+    # one IDAT chunk (what Pillow read short without a word), and 5-byte ones (as some writers split it)
+    for piece in (1 << 20, 5):
+        for w, h, depth, colour, interlaced in [(37, 29, 8, 2, False), (37, 29, 8, 2, True), (5, 3, 1, 0, True),
+                                                (33, 17, 16, 6, True), (9, 4, 2, 3, False), (1, 1, 8, 4, True)]:
+            p, rows = png(w, h, depth, colour, interlaced, None, piece)
+            assert deforma.mesh.image.read_rgba(p).shape == (h, w, 4)
+            if rows > 1:
+                p, _ = png(w, h, depth, colour, interlaced, rows - 1, piece)
+                one_line_value_error("image file is truncated", deforma.mesh.image.read_rgba, p)
+
+
 def test_no_foreground():
     one_line_value_error("no foreground", from_image, np.zeros((50, 50, 3), np.uint8))
     one_line_value_error("no foreground", from_image, np.zeros((50, 50, 4), np.uint8))

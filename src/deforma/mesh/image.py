@@ -52,7 +52,9 @@ from __future__ import annotations
 
 import operator
 import os
+import struct
 import warnings
+import zlib
 from importlib import resources
 from pathlib import Path
 
@@ -614,12 +616,84 @@ def _from_pil(im, label):
     if w == 0 or h == 0:
         raise ValueError(f"image {label!r} is empty ({w}x{h}); it needs at least one pixel")
     try:
+        if im.format == "PNG" and getattr(im, "filename", ""):
+            _check_png_data(im.filename, label)  # before a pixel is decoded: the full image is never made
         if im.mode in _WIDE_GREY_MODES:
             return _from_array(_wide_grey_to_8bit(np.asarray(im), im.mode, label))
         rgba = np.asarray(im.convert("RGBA"), dtype=np.uint8)
     except OSError as exc:  # truncated or corrupt data surfaces when pixels are decoded
         raise ValueError(f"cannot read image {label!r} ({exc}); a PNG or JPEG file is needed") from None
     return np.ascontiguousarray(rgba)
+
+
+#: PNG colour type -> samples per pixel (grey, RGB, palette, grey and alpha, RGBA).
+_PNG_SAMPLES = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}
+#: Adam7's seven passes: (first column, first row, column step, row step).
+_ADAM7 = ((0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2))
+#: Bytes inflated (and read) at a time when a PNG's data is counted.
+_PNG_PIECE = 1 << 20
+
+
+def _png_data_size(width: int, height: int, bit_depth: int, colour_type: int, interlaced: bool) -> int:
+    """Bytes a PNG of this header inflates to: its rows of samples, each after a filter byte
+    (the rows of each of Adam7's passes when interlaced)."""
+    bits = _PNG_SAMPLES.get(colour_type, 4) * bit_depth
+    total = 0
+    for x0, y0, dx, dy in _ADAM7 if interlaced else ((0, 0, 1, 1),):
+        w, h = -(-(width - x0) // dx), -(-(height - y0) // dy)
+        if w > 0 and h > 0:
+            total += h * (1 + (w * bits + 7) // 8)
+    return total
+
+
+def _check_png_data(path, label) -> None:
+    """Refuse a PNG whose data ends before the rows its header promises.
+
+    Pillow decodes such a file without a word when its compressed stream ends cleanly at the
+    end of a row, and the missing rows come out black: a 97-byte file whose header said 6000 x
+    6000 became a 36-megapixel picture that took gigabytes and tens of seconds to mesh. Here
+    the IDAT chunks are inflated a megabyte at a time and the bytes counted, not kept, only
+    until the header's size is reached (so a zip bomb costs no more than an honest file).
+    A file that does not start as a PNG does is left to Pillow.
+    """
+    with open(path, "rb") as f:
+        head = f.read(33)
+        if len(head) < 33 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+            return
+        width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", head[16:29])
+        need = _png_data_size(width, height, depth, colour, interlace == 1)
+        inflate, got = zlib.decompressobj(), 0
+        try:
+            f.seek(8)
+            while got < need and not inflate.eof:
+                top = f.read(8)
+                if len(top) < 8:
+                    break
+                length, kind = struct.unpack(">I4s", top)
+                if kind == b"IEND":
+                    break
+                if kind != b"IDAT":
+                    f.seek(length + 4, os.SEEK_CUR)  # another chunk, and its CRC
+                    continue
+                left = length
+                while left and got < need and not inflate.eof:
+                    data = f.read(min(left, _PNG_PIECE))
+                    if not data:
+                        break
+                    left -= len(data)
+                    while data and got < need and not inflate.eof:
+                        got += len(inflate.decompress(data, _PNG_PIECE))
+                        data = inflate.unconsumed_tail
+                f.seek(left + 4, os.SEEK_CUR)  # what was not needed, and the CRC
+            if got < need and not inflate.eof:
+                got += len(inflate.flush())  # what the last piece still held
+        except zlib.error as exc:
+            raise ValueError(f"cannot read image {label!r} (corrupt compressed data: {exc}); a whole PNG or JPEG "
+                             f"file is needed") from None
+    if got < need:
+        raise ValueError(f"cannot read image {label!r} (image file is truncated: its header says {width}x{height} "
+                         f"pixels, its data ends {100 * got / need:.2g} % of the way through them); a whole PNG or "
+                         f"JPEG file is needed")
 
 
 # Pillow's convert("RGBA") clips these to 0..255, so a 16-bit disc (say 60000 on 20000)
