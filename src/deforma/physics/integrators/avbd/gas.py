@@ -73,7 +73,7 @@ def gas_share(x, i, gas, e, role):
     return -0.5 * x[j, 1], 0.5 * x[j, 0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def gas_block(x, i, gas):
     """Vertex ``i``'s share of its body's gas energy: ``(gx, gy, hxx, hxy, hyy)`` (zeros off
     every gas outline). A vertex is of one body, so all its entries are of one gas."""
@@ -94,7 +94,7 @@ def gas_block(x, i, gas):
     return -pressure * ax, -pressure * ay, k * ax * ax, k * ax * ay, k * ay * ay
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def gas_moved(x, i, gas, dx, dy):
     """Vertex ``i`` moved by ``(dx, dy)`` (the others held): every area it encloses changes by
     ``dA/dx_i . (dx, dy)`` (exact: ``A`` is linear in ``x_i``). ``x`` holds the others'

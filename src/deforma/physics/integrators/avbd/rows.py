@@ -53,10 +53,11 @@ from ...colliders.response import (
 #: topology ``topo`` and buffer ``buf``, their state ``bstate`` (C, ROW_COLUMNS), and which
 #: rows each vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``) and the corner rows
 #: (:func:`~deforma.physics.colliders.response.corner_contacts`' ``cpairs`` and ``cf``, their
-#: state ``cstate`` and incidence ``c_start``, ``c_entry``), and the bodies' gas (``gas``,
-#: :class:`~deforma.physics.integrators.avbd.gas.GasSet`: not a row, read by the vertex blocks).
+#: state ``cstate`` and incidence ``c_start``, ``c_entry``), and which vertices hold a gas
+#: (``gas_start``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`'s ``start``: flat, since a
+#: namedtuple nested here slowed every kernel that takes the rows by a fifth).
 RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "topo", "buf", "bstate", "b_start", "b_entry",
-                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas"])
+                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas_start"])
 
 #: Columns of a step's contact rows (K, ROW_COLUMNS).
 LAM_N, LAM_T, K_N, K_T, STICK, BOUND = 0, 1, 2, 3, 4, 5
@@ -489,7 +490,7 @@ def corner_row_incidence(pairs, count, n_vertices, start, entry):
             fill[i] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def corner_blocks(x, x_n, i, rs, whole):
     """Vertex ``i``'s share of its corner rows: ``(gx, gy, hxx, hxy, hyy)`` (``whole`` as in
     :func:`body_blocks`)."""
@@ -555,4 +556,4 @@ def row_blocks(x, x_n, i, rs, whole):
 def on_rows(i, rs):
     """Whether vertex ``i`` takes part in any contact row this step, or holds a gas."""
     return (rs.vertex_row[i] >= 0 or rs.b_start[i + 1] > rs.b_start[i] or rs.c_start[i + 1] > rs.c_start[i]
-            or rs.gas.start[i + 1] > rs.gas.start[i])
+            or rs.gas_start[i + 1] > rs.gas_start[i])

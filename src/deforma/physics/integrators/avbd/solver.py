@@ -208,15 +208,6 @@ def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, 
     hxx += oxx
     hxy += oxy
     hyy += oyy
-    gas = rs.gas
-    on_gas = gas.start[i + 1] > gas.start[i]
-    if on_gas:
-        ggx, ggy, gxx, gxy, gyy = gas_block(x, i, gas)
-        gx += ggx
-        gy += ggy
-        hxx += gxx
-        hxy += gxy
-        hyy += gyy
     det = hxx * hyy - hxy * hxy
     if not det > 0.0:
         return 0.0
@@ -224,8 +215,6 @@ def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, 
     dy = (hxx * gy - hxy * gx) / det
     x[i, 0] -= dx
     x[i, 1] -= dy
-    if on_gas:
-        gas_moved(x, i, gas, -dx, -dy)
     return dx * dx + dy * dy
 
 
@@ -265,17 +254,30 @@ def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_
 
 
 @njit(cache=True)
-def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, grab_slot, grab_pull, rs):
+def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, grab_slot, grab_pull, rs, gas):
     """The vertices ``order[start:stop]`` (one colour) with their elements' share of the
     block given (``g`` (N, 2), ``hb`` (N, 3)): the path for element kinds that are not
-    built in. Returns the largest squared move (m^2)."""
+    built in, and for a world with gas (``gas``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`,
+    whose share each outline vertex adds here; in :func:`sweep`, the gas's code, even never
+    run, cost the built-in path half its speed). Returns the largest squared move (m^2)."""
     most = 0.0
     for p in range(start, stop):
         i = order[p]
         if inv_mass[i] == 0.0:
             continue
-        moved = descend(x, x_n, y, i, g[i, 0], g[i, 1], hb[i, 0], hb[i, 1], hb[i, 2], mass_h2, grab_slot, grab_pull,
-                        rs)
+        gx, gy, hxx, hxy, hyy = g[i, 0], g[i, 1], hb[i, 0], hb[i, 1], hb[i, 2]
+        on_gas = gas.start[i + 1] > gas.start[i]
+        if on_gas:
+            ggx, ggy, gxx, gxy, gyy = gas_block(x, i, gas)
+            gx += ggx
+            gy += ggy
+            hxx += gxx
+            hxy += gxy
+            hyy += gyy
+        x0, y0 = x[i, 0], x[i, 1]
+        moved = descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs)
+        if on_gas:
+            gas_moved(x, i, gas, x[i, 0] - x0, x[i, 1] - y0)
         most = max(most, moved)
     return most
 
@@ -921,7 +923,7 @@ class AVBD(Integrator):
         gas = self._gas[1]
         np.multiply(model.body_pressure, model.body_pressure_area, out=gas.load)  # settable live
         return RowSet(self._vertex_row, self._planes, self._rows, ctopo, buf, self._bstate, self._b_start,
-                      self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas)
+                      self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas.start)
 
     def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
@@ -940,17 +942,18 @@ class AVBD(Integrator):
         most = 0.0
         sweeps = opts["iterations"]
         it = 0
-        gas = model.has_pressure
+        gas = self._gas[1] if model.has_pressure else None
         for it in range(sweeps):
-            if gas:
-                gas_areas(x, rs.gas)  # the whole-body step and the patches moved vertices too
-            if model.fused:
+            if gas is not None:
+                gas_areas(x, gas)  # the whole-body step and the patches moved vertices too
+            if model.fused and gas is None:
                 most = sweep(x, x_n, y, mass_h2, inv_mass, order, starts, t_start, t_item, t_corner, tris.elem,
                              tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start, s_item, s_corner,
                              springs.i, springs.j, springs.rest, springs.ks, springs.kd, control.grab_slot,
                              control.grab_pull, rs, inv_h, self._hf)
             else:
-                most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs)
+                most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs,
+                                         self._gas[1])
             freeze_bounds(x, x_n, self._touch, self._planes, self._rows, count)
             freeze_body_bounds(x, x_n, rs.topo, rs.buf, rs.bstate, n_body)
             freeze_corner_bounds(x, x_n, rs.cpairs, rs.cf, rs.cstate, self._n_corner)
@@ -977,7 +980,7 @@ class AVBD(Integrator):
         if tol > 0.0 and most > tol * tol:
             self.unconverged += 1
 
-    def _sweep_kinds(self, model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs):
+    def _sweep_kinds(self, model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs, gas):
         """One sweep with the elements' share of each colour's blocks from the kinds'
         :meth:`~deforma.physics.elements.kind.ElementKind.vertex_blocks` (every kind, once per
         colour: exact, since a colour's vertices share no element, and slow)."""
@@ -990,7 +993,7 @@ class AVBD(Integrator):
             for kind in model.elements:
                 kind.vertex_blocks(x, x_n, h, g, hb)
             most = max(most, sweep_colour_given(x, x_n, self._y, mass_h2, inv_mass, order, starts[c], starts[c + 1],
-                                                g, hb, control.grab_slot, control.grab_pull, rs))
+                                                g, hb, control.grab_slot, control.grab_pull, rs, gas))
         return most
 
 
