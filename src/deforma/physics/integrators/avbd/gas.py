@@ -13,7 +13,9 @@ vertex does. The force so acts at the end of the step, as backward Euler's elast
 do: a balloon landing at 1/60 s meets a gas that stiffens as it squashes, where a kick from
 the step's start (the other integrators') let it squash to 0.84 of its area. As there, the area
 is floored at 1 % of the rest area. Rigid motions leave ``A`` unchanged, so the whole-body
-step of :mod:`~deforma.physics.integrators.avbd.solver` has no share of it.
+step of :mod:`~deforma.physics.integrators.avbd.solver` has no share of it. A world with gas
+sweeps by the general per-colour path (``sweep_colour_given``), not the built-in sweep: the
+gas's code there, even where it never ran, halved that sweep's speed for every world.
 
 Units: m, N/m (a pressure in 2D), J per metre of depth.
 """

@@ -72,6 +72,23 @@ MEMORY_COLUMNS = 5
 STICK_SPEED = 0.01
 
 
+@njit(cache=True, inline="always")
+def warm_start(state, k, memory, m, same, k0, carry, soften, k_max):
+    """Row ``k``'s multipliers and penalties from ``memory[m]`` when it is the same pair as
+    last step (``same``: ``lambda * carry``, ``k * soften``, within ``[k0, k_max]``), else ``(0,
+    k0)``."""
+    if same:
+        state[k, LAM_N] = memory[m, 1] * carry
+        state[k, LAM_T] = memory[m, 2] * carry
+        state[k, K_N] = min(max(memory[m, 3] * soften, k0), k_max)
+        state[k, K_T] = min(max(memory[m, 4] * soften, k0), k_max)
+    else:
+        state[k, LAM_N] = 0.0
+        state[k, LAM_T] = 0.0
+        state[k, K_N] = k0
+        state[k, K_T] = k0
+
+
 @njit(cache=True)
 def start_rows(touch, rows, count, memory, vertex_row, state, k_start, carry, soften, k_max, planes, v, h):
     """Open the step's collider rows: ``vertex_row[i]`` is vertex ``i``'s row or -1, and each
@@ -83,16 +100,7 @@ def start_rows(touch, rows, count, memory, vertex_row, state, k_start, carry, so
     for k in range(count):
         i = touch[k]
         vertex_row[i] = k
-        if memory[i, MEM_ROW] == rows[k]:
-            state[k, LAM_N] = memory[i, 1] * carry
-            state[k, LAM_T] = memory[i, 2] * carry
-            state[k, K_N] = min(max(memory[i, 3] * soften, k_start[i]), k_max)
-            state[k, K_T] = min(max(memory[i, 4] * soften, k_start[i]), k_max)
-        else:
-            state[k, LAM_N] = 0.0
-            state[k, LAM_T] = 0.0
-            state[k, K_N] = k_start[i]
-            state[k, K_T] = k_start[i]
+        warm_start(state, k, memory, i, memory[i, MEM_ROW] == rows[k], k_start[i], carry, soften, k_max)
         # static or dynamic friction for the whole step, from how the vertex moved over the
         # surface when the step began (deciding it from the sweeps' own slip flipped a block
         # that the first sweep, with no normal force yet, let slip a little into sliding for good)
@@ -263,16 +271,7 @@ def start_body_rows(topo, buf, count, memory, state, k_start, carry, soften, k_m
         q = buf.vertex[c]
         ip, ia, ib = cv[q], cv[ce_a[buf.edge[c]]], cv[ce_b[buf.edge[c]]]
         k0 = max(k_start[ip], k_start[ia], k_start[ib])
-        if memory[q, MEM_ROW] == buf.edge[c]:
-            state[c, LAM_N] = memory[q, 1] * carry
-            state[c, LAM_T] = memory[q, 2] * carry
-            state[c, K_N] = min(max(memory[q, 3] * soften, k0), k_max)
-            state[c, K_T] = min(max(memory[q, 4] * soften, k0), k_max)
-        else:
-            state[c, LAM_N] = 0.0
-            state[c, LAM_T] = 0.0
-            state[c, K_N] = k0
-            state[c, K_T] = k0
+        warm_start(state, c, memory, q, memory[q, MEM_ROW] == buf.edge[c], k0, carry, soften, k_max)
         s = buf.s[c]
         nx, ny = buf.normal[c, 0], buf.normal[c, 1]
         rvx = v[ip, 0] - (1.0 - s) * v[ia, 0] - s * v[ib, 0]
@@ -440,16 +439,7 @@ def start_corner_rows(pairs, cf, count, memory, state, k_start, carry, soften, k
     for c in range(count):
         ia, ib, e, r = pairs[c, 0], pairs[c, 1], pairs[c, 2], pairs[c, 3]
         k0 = max(k_start[ia], k_start[ib])
-        if memory[e, MEM_ROW] == r:
-            state[c, LAM_N] = memory[e, 1] * carry
-            state[c, LAM_T] = memory[e, 2] * carry
-            state[c, K_N] = min(max(memory[e, 3] * soften, k0), k_max)
-            state[c, K_T] = min(max(memory[e, 4] * soften, k0), k_max)
-        else:
-            state[c, LAM_N] = 0.0
-            state[c, LAM_T] = 0.0
-            state[c, K_N] = k0
-            state[c, K_T] = k0
+        warm_start(state, c, memory, e, memory[e, MEM_ROW] == r, k0, carry, soften, k_max)
         s = cf[c, CORNER_S]
         rvx = (1.0 - s) * v[ia, 0] + s * v[ib, 0]
         rvy = (1.0 - s) * v[ia, 1] + s * v[ib, 1]
