@@ -550,6 +550,7 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
                     or min(ay, by) - margin >= rects[r, RECT_YMAX] or max(ay, by) + margin <= rects[r, RECT_YMIN]:
                 continue
             best, best_s, best_k = -margin, 0.0, -1
+            best_px = best_py = best_mx = best_my = 0.0
             w = rects[r, OMEGA]
             for k in range(corner_count(rects, r)):
                 px, py = collider_corner(rects, r, k)
@@ -557,24 +558,24 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
                 depth = (px - ax) * nx + (py - ay) * ny
                 if not (0.0 < t < 1.0 and depth > best and depth * depth < length2):
                     continue
-                # where the corner was at the start, against where the edge was
-                qx = px - h * (rects[r, VEL_X] - w * (py - rects[r, RECT_CY]))
-                qy = py - h * (rects[r, VEL_Y] + w * (px - rects[r, RECT_CX]))
-                if (qx - a0x) * n0x + (qy - a0y) * n0y > 0.01 * len0:
+                # how far the corner moved in the substep: where it was at the start, against
+                # where the edge was
+                mx = h * (rects[r, VEL_X] - w * (py - rects[r, RECT_CY]))
+                my = h * (rects[r, VEL_Y] + w * (px - rects[r, RECT_CX]))
+                if (px - mx - a0x) * n0x + (py - my - a0y) * n0y > 0.01 * len0:
                     continue
                 best, best_s, best_k = depth, t, k
+                best_px, best_py, best_mx, best_my = px, py, mx, my
             if best_k < 0:
                 continue
             if count >= pairs.shape[0]:
                 count += 1
                 continue
-            px, py = collider_corner(rects, r, best_k)
             pairs[count, 0], pairs[count, 1], pairs[count, 2], pairs[count, 3] = ia, ib, e, r
             out[count, CORNER_S] = best_s
             out[count, CORNER_NX], out[count, CORNER_NY] = nx, ny
-            out[count, CORNER_PX], out[count, CORNER_PY] = px, py
-            out[count, CORNER_MX] = h * (rects[r, VEL_X] - w * (py - rects[r, RECT_CY]))
-            out[count, CORNER_MY] = h * (rects[r, VEL_Y] + w * (px - rects[r, RECT_CX]))
+            out[count, CORNER_PX], out[count, CORNER_PY] = best_px, best_py
+            out[count, CORNER_MX], out[count, CORNER_MY] = best_mx, best_my
             out[count, CORNER_STATIC] = rects[r, RECT_STATIC_FRICTION]
             out[count, CORNER_DYNAMIC] = rects[r, RECT_FRICTION]
             out[count, CORNER_TARGET] = rects[r, RECT_SKIN]

@@ -172,9 +172,10 @@ def second_order_targets(x_n, y, v_n, x_prev, v_prev, x_end, v_end, anchor, mass
 
 
 @njit(cache=True)
-def rows_held(held, touch, count, topo, buf, n_body):
-    """Mark the vertices of this step's contact rows (the collider rows' and each body row's
-    vertex and edge ends): they step by backward Euler (:func:`second_order_targets`)."""
+def rows_held(held, touch, count, topo, buf, n_body, cpairs, n_corner):
+    """Mark the vertices of this step's contact rows (the collider rows', each body row's
+    vertex and edge ends, each corner row's edge ends): they step by backward Euler
+    (:func:`second_order_targets`)."""
     held[:] = False
     for k in range(count):
         held[touch[k]] = True
@@ -183,6 +184,9 @@ def rows_held(held, touch, count, topo, buf, n_body):
         held[cv[buf.vertex[c]]] = True
         held[cv[topo.ce_a[buf.edge[c]]]] = True
         held[cv[topo.ce_b[buf.edge[c]]]] = True
+    for c in range(n_corner):
+        held[cpairs[c, 0]] = True
+        held[cpairs[c, 1]] = True
 
 
 @njit(cache=True)
@@ -770,8 +774,7 @@ class AVBD(Integrator):
                 anchor, hd, free = x_n, hs, 0
                 if second and parts == 1 and self._history == hs:
                     np.copyto(self._held_before, self._held)
-                    rows_held(self._held, self._touch, count, ctopo, found, n_body)
-                    self._held[self._cpairs[:self._n_corner, :2].ravel()] = True
+                    rows_held(self._held, self._touch, count, ctopo, found, n_body, self._cpairs, self._n_corner)
                     anchor = self._anchor
                     free = second_order_targets(x_n, self._y, self._v_n, self._x_prev, self._v_prev, self._x_end,
                                                 self._v_end, anchor, mass_h2, model.vertex_mass, inv_mass, self._held,
@@ -910,7 +913,7 @@ class AVBD(Integrator):
         body_row_incidence(ctopo, buf, n_body, model.n_vertices, self._b_start, self._b_entry)
         nc = self._n_corner
         n_edges = len(ctopo.ce_a)
-        if self._corner_memory is None or self._corner_memory[1] is not model or len(self._corner_memory[0]) != n_edges:
+        if self._corner_memory is None or self._corner_memory[1] is not model:  # edges renumbered: no warm start
             self._corner_memory = (np.full((n_edges, MEMORY_COLUMNS), -1.0), model)
         if len(self._cstate) < nc:
             self._cstate = np.empty((2 * nc, ROW_COLUMNS))
