@@ -133,7 +133,8 @@ def test_bad_tolerance_or_iteration_limit_is_one_line_and_changes_nothing(option
 
 
 @pytest.mark.filterwarnings("ignore:the implicit solve stopped")  # a few substeps of the impact (5-9 of 120)
-@pytest.mark.parametrize("integrator, options", [("implicit-euler", {"tolerance": 1e-3}), ("implicit-bdf2", {})])
+@pytest.mark.parametrize("integrator, options", [("implicit-euler", {"tolerance": 1e-3}), ("implicit-bdf2", {}),
+                                                 ("avbd", {})])
 def test_a_stiff_block_dropped_on_its_corner_topples_flat(integrator, options):
     # 40 x 20 cm, 1e7 Pa, dropped from 1 m tilted 30 degrees, 1/60 s x 1: it must fall over
     # onto its long side. Three fixed iterations lose the rotation the corner's impact starts,

@@ -37,7 +37,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .rows import row_blocks
 
 
 @njit(cache=True)
@@ -73,12 +72,12 @@ def incidence(items, n_vertices):
 
 
 @njit(cache=True, inline="always")
-def outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, whole):
-    """Vertex ``i``'s block from all but its elements: the inertia ``M / h^2 (x - y)``, its
-    grab (a zero-length spring of strength S to the target: ``S (x - t)``) and its contact
-    rows (``rs``, :class:`~deforma.physics.integrators.avbd.rows.RowSet`; ``whole``: as
-    :func:`~deforma.physics.integrators.avbd.rows.row_blocks` takes it). Returns ``(gx, gy,
-    hxx, hxy, hyy)``."""
+def outer_block(x, y, i, mass_h2, grab_slot, grab_pull):
+    """Vertex ``i``'s block from its inertia ``M / h^2 (x - y)`` and its grab (a zero-length
+    spring of strength S to the target: ``S (x - t)``): ``(gx, gy, hxx, hxy, hyy)``. Its
+    contact rows are :func:`~deforma.physics.integrators.avbd.rows.row_blocks`', added by
+    the callers only where ``rs.rowed`` (a kernel that hands the rows to a helper for
+    every vertex pays for the hand-over of each of their arrays)."""
     m = mass_h2[i]
     gx = m * (x[i, 0] - y[i, 0])
     gy = m * (x[i, 1] - y[i, 1])
@@ -90,5 +89,4 @@ def outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, whole):
         gy += grab_pull[s, 0] * x[i, 1] - grab_pull[s, 2]
         hxx += grab_pull[s, 0]
         hyy += grab_pull[s, 0]
-    cgx, cgy, cxx, cxy, cyy = row_blocks(x, x_n, i, rs, whole)
-    return gx + cgx, gy + cgy, hxx + cxx, hxy + cxy, hyy + cyy
+    return gx, gy, hxx, hxy, hyy

@@ -9,7 +9,8 @@ vertex meets it, :func:`~deforma.physics.colliders.response.contact_planes`) is 
   Hessian ``k_n n n^T``;
 - the friction row, the slip ``C_t = t . (x_i - x_n - s)`` since the step began relative to
   the surface (which moved by ``s``), with force ``f_t = lambda_t - k_t C_t`` bounded by ``mu
-  lambda_n`` (the normal multiplier, steadier than the force at an iterate): ``mu`` is the static coefficient while the contact sticks and the dynamic one once
+  lambda_n`` (the normal force the contact ended the last step with, steadier than the
+  force at an iterate; the iterate's for a contact new this step, :func:`friction_bound`): ``mu`` is the static coefficient while the contact sticks and the dynamic one once
   it slides. The gradient is ``-f_t t`` and, while it sticks, the Hessian ``k_t t t^T``.
 
 Once a step, after the sweeps, the multipliers take the rows' forces (``lambda_n = f_n``; ``lambda_t =
@@ -33,6 +34,7 @@ from __future__ import annotations
 
 from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ...colliders.response import (
@@ -49,19 +51,31 @@ from ...colliders.response import (
 )
 
 #: A step's contact rows as the sweeps read them: the collider rows (``vertex_row`` (N,),
-#: ``planes`` (N, 7), ``rows`` (N, ROW_COLUMNS)) and the body rows (the contact stage's
-#: topology ``topo`` and buffer ``buf``, their state ``bstate`` (C, ROW_COLUMNS), and which
-#: rows each vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``) and the corner rows
+#: ``planes`` (N, 7), ``rows`` (N, ROW_COLUMNS)) and the body rows (their vertices ``bidx``
+#: (C, 3) and geometry ``bgeo`` (C, BODY_COLUMNS), taken from the contact stage's buffer by
+#: :func:`start_body_rows`, their state ``bstate`` (C, ROW_COLUMNS), and which rows each
+#: vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``) and the corner rows
 #: (:func:`~deforma.physics.colliders.response.corner_contacts`' ``cpairs`` and ``cf``, their
 #: state ``cstate`` and incidence ``c_start``, ``c_entry``), and which vertices hold a gas
-#: (``gas_start``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`'s ``start``: flat, since a
-#: namedtuple nested here slowed every kernel that takes the rows by a fifth).
-RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "topo", "buf", "bstate", "b_start", "b_entry",
-                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas_start"])
+#: (``gas_start``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`'s ``start``), and
+#: whether each vertex takes part in any row or holds a gas (``rowed`` (N,) bool, :func:`mark_rowed`).
+#: Every field is an array, and kernels hand the set to a helper only for vertices with
+#: rows: Numba counts a reference to each of its arrays at every hand-over, 60 ns for these
+#: fields (170 ns when it nested the contact stage's topology and buffer), which made a
+#: vertex sweep of the README bunny's springs three times slower and its affine patches
+#: five times.
+RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "bidx", "bgeo", "bstate", "b_start", "b_entry",
+                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas_start", "rowed"])
 
-#: Columns of a step's contact rows (K, ROW_COLUMNS).
-LAM_N, LAM_T, K_N, K_T, STICK, BOUND = 0, 1, 2, 3, 4, 5
-ROW_COLUMNS = 6
+#: Columns of a step's body-row geometry ``bgeo`` (C, BODY_COLUMNS): where on the edge, the
+#: normal, the distance held, and the pair's dynamic and static friction.
+BODY_S, BODY_NX, BODY_NY, BODY_TARGET, BODY_DYNAMIC, BODY_STATIC = 0, 1, 2, 3, 4, 5
+BODY_COLUMNS = 6
+
+#: Columns of a step's contact rows (K, ROW_COLUMNS). ``LAG``: the normal force the same pair
+#: ended the last step with (N; -1 for a pair new this step), which bounds the friction.
+LAM_N, LAM_T, K_N, K_T, STICK, BOUND, LAG = 0, 1, 2, 3, 4, 5, 6
+ROW_COLUMNS = 7
 #: Columns of the per-vertex warm-start memory (N, MEMORY_COLUMNS): the collider row, then the same four.
 MEM_ROW = 0
 MEMORY_COLUMNS = 5
@@ -78,15 +92,29 @@ def warm_start(state, k, memory, m, same, k0, carry, soften, k_max):
     last step (``same``: ``lambda * carry``, ``k * soften``, within ``[k0, k_max]``), else ``(0,
     k0)``."""
     if same:
+        state[k, LAG] = memory[m, 1]
         state[k, LAM_N] = memory[m, 1] * carry
         state[k, LAM_T] = memory[m, 2] * carry
         state[k, K_N] = min(max(memory[m, 3] * soften, k0), k_max)
         state[k, K_T] = min(max(memory[m, 4] * soften, k0), k_max)
     else:
+        state[k, LAG] = -1.0
         state[k, LAM_N] = 0.0
         state[k, LAM_T] = 0.0
         state[k, K_N] = k0
         state[k, K_T] = k0
+
+
+@njit(cache=True, inline="always")
+def friction_bound(state, k, mu, fn):
+    """Row ``k``'s friction bound in the sweeps (N): ``mu`` times the normal force its pair
+    ended the last step with, or, for a pair new this step, times ``fn``, its normal force at
+    the iterate. The iterate's own force swings by newtons between sweeps (a micrometre of
+    gap times a penalty of 1e5-1e6 N/m): bounded by it, a block sliding down a slope at 1.1
+    times its static limit gained speed at 2.16 m/s^2 with its vertices swept in one order
+    and at 0.08 m/s^2 in the reverse order (2.15 is right)."""
+    lag = state[k, LAG]
+    return mu * (lag if lag >= 0.0 else fn)
 
 
 @njit(cache=True)
@@ -188,18 +216,18 @@ def contact_block(x, x_n, i, planes, state, k, whole):
     """Row ``k``'s share of vertex ``i``'s block: ``(gx, gy, hxx, hxy, hyy)`` (``whole``: as
     :func:`weighted_row` takes it)."""
     fn, ft, _, _, mu = contact_forces(x, x_n, i, planes, state, k)
-    # bounded by the normal force at this iterate (for a step of the whole body, by the
-    # bound frozen before it, so that the line search sees one potential)
-    bound = state[k, BOUND] if whole else mu * fn
+    # bounded by friction_bound (for a step of the whole body, by the bound frozen before
+    # it, so that the line search sees one potential)
+    bound = state[k, BOUND] if whole else friction_bound(state, k, mu, fn)
     return weighted_row(1.0, fn, ft, state[k, K_N], state[k, K_T], planes[k, 0], planes[k, 1], bound, whole)
 
 
 @njit(cache=True)
 def freeze_bounds(x, x_n, touch, planes, state, count):
-    """Each row's friction bound ``mu f_n`` at the iterate ``x``, into ``state[:, BOUND]``."""
+    """Each row's friction bound (:func:`friction_bound`) at the iterate ``x``, into ``state[:, BOUND]``."""
     for k in range(count):
         fn, _, _, _, mu = contact_forces(x, x_n, touch[k], planes, state, k)
-        state[k, BOUND] = mu * fn
+        state[k, BOUND] = friction_bound(state, k, mu, fn)
 
 
 @njit(cache=True, inline="always")
@@ -241,7 +269,7 @@ def update_rows(x, x_n, touch, planes, state, count, beta, k_max):
 
 
 @njit(cache=True, inline="always")
-def body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, mu, state, c):
+def body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, bgeo, state, c):
     """Body row ``c``'s normal and friction force: ``(f_n, f_t, C_n, C_t, mu)`` (friction
     unclamped; ``mu`` static or dynamic by the row's stick flag)."""
     ca = 1.0 - s
@@ -251,13 +279,14 @@ def body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, mu, state, c):
     ry = (x[ip, 1] - x_n[ip, 1]) - ca * (x[ia, 1] - x_n[ia, 1]) - s * (x[ib, 1] - x_n[ib, 1])
     slip = -rx * ny + ry * nx
     ft = state[c, LAM_T] - state[c, K_T] * slip
-    m = mu[c, 1] if state[c, STICK] > 0.0 else mu[c, 0]
+    m = bgeo[c, BODY_STATIC] if state[c, STICK] > 0.0 else bgeo[c, BODY_DYNAMIC]
     return fn, ft, gap, slip, m
 
 
 @njit(cache=True)
-def start_body_rows(topo, buf, count, memory, state, k_start, carry, soften, k_max, v):
-    """Open the step's body rows (``buf[:count]``), warm-started from ``memory`` (per collision
+def start_body_rows(topo, buf, count, memory, state, bidx, bgeo, k_start, carry, soften, k_max, v):
+    """Open the step's body rows (``buf[:count]``): their vertices into ``bidx`` and their
+    geometry into ``bgeo`` (:data:`RowSet`), warm-started from ``memory`` (per collision
     vertex: edge, ``lambda_n``, ``lambda_t``, ``k_n``, ``k_t``) when the same vertex met the
     same edge last step; static friction for the step when the pair's relative velocity
     along the edge was below :data:`STICK_SPEED` as it began. Where two outlines lie face to
@@ -274,6 +303,9 @@ def start_body_rows(topo, buf, count, memory, state, k_start, carry, soften, k_m
         warm_start(state, c, memory, q, memory[q, MEM_ROW] == buf.edge[c], k0, carry, soften, k_max)
         s = buf.s[c]
         nx, ny = buf.normal[c, 0], buf.normal[c, 1]
+        bidx[c, 0], bidx[c, 1], bidx[c, 2] = ip, ia, ib
+        bgeo[c, BODY_S], bgeo[c, BODY_NX], bgeo[c, BODY_NY], bgeo[c, BODY_TARGET] = s, nx, ny, buf.target[c]
+        bgeo[c, BODY_DYNAMIC], bgeo[c, BODY_STATIC] = buf.mu[c, 0], buf.mu[c, 1]
         rvx = v[ip, 0] - (1.0 - s) * v[ia, 0] - s * v[ib, 0]
         rvy = v[ip, 1] - (1.0 - s) * v[ia, 1] - s * v[ib, 1]
         state[c, STICK] = 1.0 if abs(-rvx * ny + rvy * nx) <= STICK_SPEED else 0.0
@@ -296,39 +328,30 @@ def close_body_rows(buf, count, memory, state):
 
 
 @njit(cache=True)
-def body_row_incidence(topo, buf, count, n_vertices, start, entry):
+def body_row_incidence(bidx, count, n_vertices, start, entry):
     """Which body rows each vertex takes part in, as CSR into ``start`` (N + 1) and ``entry``
     (3 count,): ``entry`` holds ``3 c + role`` (role 0: the vertex, 1: the edge's first end,
     2: its second)."""
-    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
     for i in range(n_vertices + 1):
         start[i] = 0
     for c in range(count):
-        start[cv[buf.vertex[c]] + 1] += 1
-        start[cv[ce_a[buf.edge[c]]] + 1] += 1
-        start[cv[ce_b[buf.edge[c]]] + 1] += 1
+        for role in range(3):
+            start[bidx[c, role] + 1] += 1
     for i in range(n_vertices):
         start[i + 1] += start[i]
     fill = start[:n_vertices].copy()
     for c in range(count):
         for role in range(3):
-            if role == 0:
-                i = cv[buf.vertex[c]]
-            elif role == 1:
-                i = cv[ce_a[buf.edge[c]]]
-            else:
-                i = cv[ce_b[buf.edge[c]]]
+            i = bidx[c, role]
             entry[fill[i]] = 3 * c + role
             fill[i] += 1
 
 
 @njit(cache=True, inline="always")
-def body_row_parts(topo, buf, c):
+def body_row_parts(bidx, bgeo, c):
     """``(ip, ia, ib, s, nx, ny, target)`` of body row ``c``."""
-    cv = topo.cv_vertex
-    e = buf.edge[c]
-    return (cv[buf.vertex[c]], cv[topo.ce_a[e]], cv[topo.ce_b[e]], buf.s[c], buf.normal[c, 0], buf.normal[c, 1],
-            buf.target[c])
+    return (bidx[c, 0], bidx[c, 1], bidx[c, 2], bgeo[c, BODY_S], bgeo[c, BODY_NX], bgeo[c, BODY_NY],
+            bgeo[c, BODY_TARGET])
 
 
 @njit(cache=True, inline="always")
@@ -342,17 +365,17 @@ def role_weight(role, s):
 
 
 @njit(cache=True)
-def body_blocks(x, x_n, i, topo, buf, state, start, entry, whole):
+def body_blocks(x, x_n, i, bidx, bgeo, state, start, entry, whole):
     """Vertex ``i``'s share of its body rows: ``(gx, gy, hxx, hxy, hyy)`` (``whole``: the
     normal stiffness of rows that do not push now too, and the frozen friction bounds)."""
     gx = gy = hxx = hxy = hyy = 0.0
     for p in range(start[i], start[i + 1]):
         c = entry[p] // 3
         role = entry[p] - 3 * c
-        ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
+        ip, ia, ib, s, nx, ny, target = body_row_parts(bidx, bgeo, c)
         w = role_weight(role, s)
-        fn, ft, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
-        bound = state[c, BOUND] if whole else mu * fn
+        fn, ft, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, bgeo, state, c)
+        bound = state[c, BOUND] if whole else friction_bound(state, c, mu, fn)
         a, b, c0, c1, c2 = weighted_row(w, fn, ft, state[c, K_N], state[c, K_T], nx, ny, bound, whole)
         gx += a
         gy += b
@@ -375,20 +398,20 @@ def row_energy(fn, ft, kn, kt, bound):
 
 
 @njit(cache=True)
-def freeze_body_bounds(x, x_n, topo, buf, state, count):
-    """Each body row's friction bound ``mu f_n`` at the iterate ``x``, into ``state[:, BOUND]``."""
+def freeze_body_bounds(x, x_n, bidx, bgeo, state, count):
+    """Each body row's friction bound (:func:`friction_bound`) at the iterate ``x``, into ``state[:, BOUND]``."""
     for c in range(count):
-        ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
-        fn, _, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
-        state[c, BOUND] = mu * fn
+        ip, ia, ib, s, nx, ny, target = body_row_parts(bidx, bgeo, c)
+        fn, _, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, bgeo, state, c)
+        state[c, BOUND] = friction_bound(state, c, mu, fn)
 
 
 @njit(cache=True)
-def update_body_rows(x, x_n, topo, buf, state, count, beta, k_max):
+def update_body_rows(x, x_n, bidx, bgeo, state, count, beta, k_max):
     """The body rows' dual step, as :func:`update_rows`'s."""
     for c in range(count):
-        ip, ia, ib, s, nx, ny, target = body_row_parts(topo, buf, c)
-        fn, ft, gap, slip, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, buf.mu, state, c)
+        ip, ia, ib, s, nx, ny, target = body_row_parts(bidx, bgeo, c)
+        fn, ft, gap, slip, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, bgeo, state, c)
         dual_step(state, c, fn, ft, gap, slip, mu, beta, k_max)
 
 
@@ -492,7 +515,7 @@ def corner_blocks(x, x_n, i, rs, whole):
         s = cf[c, CORNER_S]
         w = s if role == 1 else 1.0 - s
         fn, ft, _, _, mu = corner_row_forces(x, x_n, rs.cpairs[c, 0], rs.cpairs[c, 1], cf, state, c)
-        bound = state[c, BOUND] if whole else mu * fn
+        bound = state[c, BOUND] if whole else friction_bound(state, c, mu, fn)
         a, b, c0, c1, c2 = weighted_row(w, fn, ft, state[c, K_N], state[c, K_T], cf[c, CORNER_NX], cf[c, CORNER_NY],
                                         bound, whole)
         gx += a
@@ -505,10 +528,10 @@ def corner_blocks(x, x_n, i, rs, whole):
 
 @njit(cache=True)
 def freeze_corner_bounds(x, x_n, pairs, cf, state, count):
-    """Each corner row's friction bound ``mu f_n`` at the iterate ``x``."""
+    """Each corner row's friction bound (:func:`friction_bound`) at the iterate ``x``."""
     for c in range(count):
         fn, _, _, _, mu = corner_row_forces(x, x_n, pairs[c, 0], pairs[c, 1], cf, state, c)
-        state[c, BOUND] = mu * fn
+        state[c, BOUND] = friction_bound(state, c, mu, fn)
 
 
 @njit(cache=True)
@@ -523,7 +546,9 @@ def update_corner_rows(x, x_n, pairs, cf, state, count, beta, k_max):
 def row_blocks(x, x_n, i, rs, whole):
     """Vertex ``i``'s share of all its contact rows, collider, corner and body: ``(gx, gy,
     hxx, hxy, hyy)``."""
-    gx, gy, hxx, hxy, hyy = body_blocks(x, x_n, i, rs.topo, rs.buf, rs.bstate, rs.b_start, rs.b_entry, whole)
+    gx = gy = hxx = hxy = hyy = 0.0
+    if rs.b_start[i + 1] > rs.b_start[i]:
+        gx, gy, hxx, hxy, hyy = body_blocks(x, x_n, i, rs.bidx, rs.bgeo, rs.bstate, rs.b_start, rs.b_entry, whole)
     if rs.c_start[i + 1] > rs.c_start[i]:
         cgx, cgy, cxx, cxy, cyy = corner_blocks(x, x_n, i, rs, whole)
         gx += cgx
@@ -542,8 +567,10 @@ def row_blocks(x, x_n, i, rs, whole):
     return gx, gy, hxx, hxy, hyy
 
 
-@njit(cache=True, inline="always")
-def on_rows(i, rs):
-    """Whether vertex ``i`` takes part in any contact row this step, or holds a gas."""
-    return (rs.vertex_row[i] >= 0 or rs.b_start[i + 1] > rs.b_start[i] or rs.c_start[i + 1] > rs.c_start[i]
-            or rs.gas_start[i + 1] > rs.gas_start[i])
+def mark_rowed(vertex_row, b_start, c_start, gas_start, rowed):
+    """Into ``rowed`` (N,) bool: whether each vertex takes part in any contact row this step,
+    or holds a gas."""
+    np.greater_equal(vertex_row, 0, out=rowed)
+    rowed |= b_start[1:] > b_start[:-1]
+    rowed |= c_start[1:] > c_start[:-1]
+    rowed |= gas_start[1:] > gas_start[:-1]

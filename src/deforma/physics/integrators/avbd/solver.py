@@ -73,6 +73,7 @@ from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .gas import gas_areas, gas_block, gas_moved, gas_set
 from .rows import (
+    BODY_COLUMNS,
     BOUND,
     K_N,
     K_T,
@@ -92,6 +93,8 @@ from .rows import (
     freeze_body_bounds,
     freeze_bounds,
     freeze_corner_bounds,
+    mark_rowed,
+    row_blocks,
     row_energy,
     start_body_rows,
     start_corner_rows,
@@ -203,10 +206,10 @@ def second_order_velocities(x, v, anchor, solved, held, inv_mass, h):
 
 
 @njit(cache=True, inline="always")
-def descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs):
-    """Finish vertex ``i``'s block (its elements' share ``g``, ``H`` given): add the inertia,
-    its grab and its contact row, and take the Newton step. Returns the squared move (m^2)."""
-    ogx, ogy, oxx, oxy, oyy = outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, False)
+def descend(x, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull):
+    """Finish vertex ``i``'s block (its elements' and rows' share ``g``, ``H`` given): add the
+    inertia and its grab, and take the Newton step. Returns the squared move (m^2)."""
+    ogx, ogy, oxx, oxy, oyy = outer_block(x, y, i, mass_h2, grab_slot, grab_pull)
     gx += ogx
     gy += ogy
     hxx += oxx
@@ -252,7 +255,14 @@ def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_
                 hxx += exx
                 hxy += exy
                 hyy += eyy
-            moved = descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs)
+            if rs.rowed[i]:
+                ex, ey, exx, exy, eyy = row_blocks(x, x_n, i, rs, False)
+                gx += ex
+                gy += ey
+                hxx += exx
+                hxy += exy
+                hyy += eyy
+            moved = descend(x, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull)
             most = max(most, moved)
     return most
 
@@ -270,6 +280,13 @@ def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, 
         if inv_mass[i] == 0.0:
             continue
         gx, gy, hxx, hxy, hyy = g[i, 0], g[i, 1], hb[i, 0], hb[i, 1], hb[i, 2]
+        if rs.rowed[i]:
+            ex, ey, exx, exy, eyy = row_blocks(x, x_n, i, rs, False)
+            gx += ex
+            gy += ey
+            hxx += exx
+            hxy += exy
+            hyy += eyy
         on_gas = gas.start[i + 1] > gas.start[i]
         if on_gas:
             ggx, ggy, gxx, gxy, gyy = gas_block(x, i, gas)
@@ -279,7 +296,7 @@ def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, 
             hxy += gxy
             hyy += gyy
         x0, y0 = x[i, 0], x[i, 1]
-        moved = descend(x, x_n, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull, rs)
+        moved = descend(x, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull)
         if on_gas:
             gas_moved(x, i, gas, x[i, 0] - x0, x[i, 1] - y0)
         most = max(most, moved)
@@ -374,7 +391,14 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
             # the rows' gradient where they are, and their stiffness whether they push now or
             # not: a row that starts to push within the step bounds the step (with only the
             # active rows a resting block rocked on its warm-started contacts)
-            gx, gy, hxx, hxy, hyy = outer_block(x, x_n, y, i, mass_h2, grab_slot, grab_pull, rs, True)
+            gx, gy, hxx, hxy, hyy = outer_block(x, y, i, mass_h2, grab_slot, grab_pull)
+            if rs.rowed[i]:
+                ex, ey, exx, exy, eyy = row_blocks(x, x_n, i, rs, True)
+                gx += ex
+                gy += ey
+                hxx += exx
+                hxy += exy
+                hyy += eyy
             # J = [[1, 0, -ry], [0, 1, rx]]
             rx, ry = x[i, 0] - cx, x[i, 1] - cy
             g0 += gx
@@ -455,7 +479,7 @@ def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, d
         # body moved and the others where they are
         for p in range(rs.b_start[i], rs.b_start[i + 1]):
             c = rs.b_entry[p] // 3
-            ip, ia, ib, s, nx, ny, target = body_row_parts(rs.topo, rs.buf, c)
+            ip, ia, ib, s, nx, ny, target = body_row_parts(rs.bidx, rs.bgeo, c)
             first = ip if lo <= ip < hi else (ia if lo <= ia < hi else ib)
             if first != i:
                 continue
@@ -601,6 +625,8 @@ class AVBD(Integrator):
         self._body_memory = None
         self._search = None
         self._bstate = np.empty((0, ROW_COLUMNS))
+        self._bidx = np.empty((0, 3), np.int64)
+        self._bgeo = np.empty((0, BODY_COLUMNS))
         self._b_entry = np.empty(0, np.int64)
         self._cpairs = np.empty((64, 4), np.int64)  # the corner rows (corner_contacts)
         self._cf = np.empty((64, CORNER_COLUMNS))
@@ -702,6 +728,7 @@ class AVBD(Integrator):
             self._hf = np.empty((4, 4))
             self._b_start = np.zeros(n + 1, np.int64)
             self._c_start = np.zeros(n + 1, np.int64)
+            self._rowed = np.zeros(n, np.bool_)
             self._x_prev = np.empty((n, 2))  # the last step's start, for BDF2
             self._v_prev = np.empty((n, 2))
             self._v_n = np.empty((n, 2))
@@ -906,11 +933,13 @@ class AVBD(Integrator):
             self._body_memory = (np.full((n_cv, MEMORY_COLUMNS), -1.0), model)
         if len(self._bstate) < n_body:
             self._bstate = np.empty((2 * n_body, ROW_COLUMNS))
+            self._bidx = np.empty((2 * n_body, 3), np.int64)
+            self._bgeo = np.empty((2 * n_body, BODY_COLUMNS))
             self._b_entry = np.empty(6 * n_body, np.int64)
         opts = self._options
-        start_body_rows(ctopo, buf, n_body, self._body_memory[0], self._bstate, k_start, self.CARRY, self.SOFTEN,
-                        opts["penalty_max"], v)
-        body_row_incidence(ctopo, buf, n_body, model.n_vertices, self._b_start, self._b_entry)
+        start_body_rows(ctopo, buf, n_body, self._body_memory[0], self._bstate, self._bidx, self._bgeo, k_start,
+                        self.CARRY, self.SOFTEN, opts["penalty_max"], v)
+        body_row_incidence(self._bidx, n_body, model.n_vertices, self._b_start, self._b_entry)
         nc = self._n_corner
         n_edges = len(ctopo.ce_a)
         if self._corner_memory is None or self._corner_memory[1] is not model:  # edges renumbered: no warm start
@@ -925,8 +954,10 @@ class AVBD(Integrator):
             self._gas = (model, gas_set(model))
         gas = self._gas[1]
         np.multiply(model.body_pressure, model.body_pressure_area, out=gas.load)  # settable live
-        return RowSet(self._vertex_row, self._planes, self._rows, ctopo, buf, self._bstate, self._b_start,
-                      self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas.start)
+        mark_rowed(self._vertex_row, self._b_start, self._c_start, gas.start, self._rowed)
+        return RowSet(self._vertex_row, self._planes, self._rows, self._bidx, self._bgeo, self._bstate, self._b_start,
+                      self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas.start,
+                      self._rowed)
 
     def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
@@ -958,7 +989,7 @@ class AVBD(Integrator):
                 most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs,
                                          self._gas[1])
             freeze_bounds(x, x_n, self._touch, self._planes, self._rows, count)
-            freeze_body_bounds(x, x_n, rs.topo, rs.buf, rs.bstate, n_body)
+            freeze_body_bounds(x, x_n, rs.bidx, rs.bgeo, rs.bstate, n_body)
             freeze_corner_bounds(x, x_n, rs.cpairs, rs.cf, rs.cstate, self._n_corner)
             if patches is not None:
                 cluster_sweep(x, x_n, y, mass_h2, *patches, tris.elem, tris.b, tris.area, tris.mu, tris.lam,
@@ -975,7 +1006,7 @@ class AVBD(Integrator):
         # stiff body's contacts chased its unconverged sweeps (a 1e5 Pa block's support jumped
         # between its corners from sweep to sweep and it slid off a slope it should stand on)
         update_rows(x, x_n, self._touch, self._planes, self._rows, count, opts["penalty_ramp"], opts["penalty_max"])
-        update_body_rows(x, x_n, rs.topo, rs.buf, rs.bstate, n_body, opts["penalty_ramp"], opts["penalty_max"])
+        update_body_rows(x, x_n, rs.bidx, rs.bgeo, rs.bstate, n_body, opts["penalty_ramp"], opts["penalty_max"])
         update_corner_rows(x, x_n, rs.cpairs, rs.cf, rs.cstate, self._n_corner, opts["penalty_ramp"],
                            opts["penalty_max"])
         self.iterations_run += it + 1
