@@ -120,19 +120,20 @@ def stress_derivative(f00, f01, f10, f11, mu, lam, out):
     c = f00 + f11
     s = f10 - f01
     r = np.sqrt(c * c + s * s)
-    a = np.array([[1.0, 0.0, 0.0, 1.0], [0.0, -1.0, 1.0, 0.0]])
+    # A's rows as tuples, not arrays: this runs for every element at every vertex of every
+    # sweep, and two small arrays allocated a call were a third of avbd's sweep
+    a0 = (1.0, 0.0, 0.0, 1.0)
+    a1 = (0.0, -1.0, 1.0, 0.0)
     for p in range(4):
         for q in range(4):
             out[p, q] = 2.0 * mu if p == q else 0.0
     if r == 0.0:
         return
     u0, u1 = c / r, s / r
-    dr = np.empty(4)
-    for p in range(4):
-        dr[p] = a[0, p] * u0 + a[1, p] * u1
+    dr = (a0[0] * u0 + a1[0] * u1, a0[1] * u0 + a1[1] * u1, a0[2] * u0 + a1[2] * u1, a0[3] * u0 + a1[3] * u1)
     k = (lam * (r - 2.0) - 2.0 * mu) / r
     for p in range(4):
         for q in range(4):
             # d^2 r = A^T (I - u u^T) A / r, u = (c, s) / r
-            m = a[0, p] * a[0, q] + a[1, p] * a[1, q] - dr[p] * dr[q]
+            m = a0[p] * a0[q] + a1[p] * a1[q] - dr[p] * dr[q]
             out[p, q] += k * m + lam * dr[p] * dr[q]

@@ -534,10 +534,9 @@ def triangle_vertex_block(x, x_n, e, corner, elem, b, area, mu, lam, beta, kind,
     be = beta[e]
     if be > 0.0:
         # the damping stress of the rate F(x - x_n) / h, and beta / h times its linear stiffness
-        r00, r01, r10, r11 = deformation_gradient(x, i, j, k, b0, b1, b2, b3)
         q00, q01, q10, q11 = deformation_gradient(x_n, i, j, k, b0, b1, b2, b3)
-        s00, s01, s10, s11 = rate_stress(f00, f01, f10, f11, (r00 - q00) * inv_h, (r01 - q01) * inv_h,
-                                         (r10 - q10) * inv_h, (r11 - q11) * inv_h, mu[e], lam[e])
+        s00, s01, s10, s11 = rate_stress(f00, f01, f10, f11, (f00 - q00) * inv_h, (f01 - q01) * inv_h,
+                                         (f10 - q10) * inv_h, (f11 - q11) * inv_h, mu[e], lam[e])
         gx += a * be * (s00 * d0 + s01 * d1)
         gy += a * be * (s10 * d0 + s11 * d1)
         w = a * be * inv_h

@@ -239,10 +239,9 @@ def cluster_sweep(x, x_n, y, mass_h2, cluster, v_start, v_list, te_start, te_lis
                 neo_hookean.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
             be = beta[e]
             if be > 0.0:
-                r00, r01, r10, r11 = deformation_gradient(x, i0, i1, i2, b0, b1, b2, b3)
                 q00, q01, q10, q11 = deformation_gradient(x_n, i0, i1, i2, b0, b1, b2, b3)
-                u00, u01, u10, u11 = rate_stress(f00, f01, f10, f11, (r00 - q00) * inv_h, (r01 - q01) * inv_h,
-                                                 (r10 - q10) * inv_h, (r11 - q11) * inv_h, mu[e], lam[e])
+                u00, u01, u10, u11 = rate_stress(f00, f01, f10, f11, (f00 - q00) * inv_h, (f01 - q01) * inv_h,
+                                                 (f10 - q10) * inv_h, (f11 - q11) * inv_h, mu[e], lam[e])
                 pvec[0] += be * u00
                 pvec[1] += be * u01
                 pvec[2] += be * u10
