@@ -137,3 +137,39 @@ def stress_derivative(f00, f01, f10, f11, mu, lam, out):
             # d^2 r = A^T (I - u u^T) A / r, u = (c, s) / r
             m = a0[p] * a0[q] + a1[p] * a1[q] - dr[p] * dr[q]
             out[p, q] += k * m + lam * dr[p] * dr[q]
+
+
+@njit(cache=True, inline="always")
+def vertex_stiffness(f00, f01, f10, f11, mu, lam, d0, d1):
+    """:func:`stress_derivative` contracted for one corner that moves: ``(k_xx, k_xy, k_yy)``
+    (Pa / m^2 per unit rest area), ``K_st = sum_{c, c'} dP/dF[2 s + c, 2 t + c'] d_c d_c'``
+    with ``(d0, d1)`` the corner's shape-function gradient. Each rank-one term ``v v^T`` of
+    the Hessian gives ``(v_s . d)(v_t . d)`` (``v_s`` the pair ``(v[2 s], v[2 s + 1])``) and
+    the identity ``delta_st |d|^2``: no 4 x 4 matrix is formed (the vertex sweeps run this
+    for every element at every corner).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = np.zeros((4, 4))
+    >>> f, d = (1.1, 0.2, -0.1, 0.9), (0.3, -0.7)
+    >>> stress_derivative(*f, 2.0, 3.0, h)
+    >>> D = np.array([[d[0], d[1], 0, 0], [0, 0, d[0], d[1]]])
+    >>> k = vertex_stiffness(*f, 2.0, 3.0, *d)
+    >>> bool(np.allclose(D @ h @ D.T, [[k[0], k[1]], [k[1], k[2]]]))
+    True
+    """
+    dd = d0 * d0 + d1 * d1
+    kxx = kyy = 2.0 * mu * dd
+    c = f00 + f11
+    s = f10 - f01
+    r = np.sqrt(c * c + s * s)
+    if r == 0.0:
+        return kxx, 0.0, kyy
+    u0, u1 = c / r, s / r
+    k = (lam * (r - 2.0) - 2.0 * mu) / r
+    # A's rows (1, 0, 0, 1) and (0, -1, 1, 0) give (d0, d1) and (-d1, d0), which sum to |d|^2 I;
+    # dr = A^T u gives (r0, r1), entering with lambda (the lambda term) and -k (from d^2 r)
+    r0, r1 = u0 * d0 - u1 * d1, u1 * d0 + u0 * d1
+    w = lam - k
+    return kxx + k * dd + w * r0 * r0, w * r0 * r1, kyy + k * dd + w * r1 * r1

@@ -152,3 +152,28 @@ def stress_derivative(f00, f01, f10, f11, mu, lam, out):
     out[3, 0] += k
     out[1, 2] -= k
     out[2, 1] -= k
+
+
+@njit(cache=True, inline="always")
+def vertex_stiffness(f00, f01, f10, f11, mu, lam, d0, d1):
+    """:func:`stress_derivative` contracted for one corner that moves: ``(k_xx, k_xy, k_yy)``
+    (as :func:`~deforma.physics.elements.corotated.vertex_stiffness`). ``J``'s Hessian drops
+    out (one corner's move changes ``F`` by a rank-one matrix, in which ``J`` is linear):
+    ``mu |d|^2 delta_st + lambda' (g_s . d)(g_t . d)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = np.zeros((4, 4))
+    >>> f, d = (1.1, 0.2, -0.1, 0.9), (0.3, -0.7)
+    >>> stress_derivative(*f, 2.0, 3.0, h)
+    >>> D = np.array([[d[0], d[1], 0, 0], [0, 0, d[0], d[1]]])
+    >>> k = vertex_stiffness(*f, 2.0, 3.0, *d)
+    >>> bool(np.allclose(D @ h @ D.T, [[k[0], k[1]], [k[1], k[2]]]))
+    True
+    """
+    lp, _ = bulk(mu, lam)
+    dd = mu * (d0 * d0 + d1 * d1)
+    g0 = f11 * d0 - f10 * d1
+    g1 = -f01 * d0 + f00 * d1
+    return dd + lp * g0 * g0, lp * g0 * g1, dd + lp * g1 * g1

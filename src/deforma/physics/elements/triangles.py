@@ -511,9 +511,9 @@ def psd2(hxx, hxy, hyy):
 
 
 @njit(cache=True)
-def triangle_vertex_block(x, x_n, e, corner, elem, b, area, mu, lam, beta, kind, inv_h, hf):
+def triangle_vertex_block(x, x_n, e, corner, elem, b, area, mu, lam, beta, kind, inv_h):
     """Element ``e``'s share of the block of its corner ``corner``: ``(gx, gy, hxx, hxy,
-    hyy)``. ``hf`` is (4, 4) scratch."""
+    hyy)``."""
     i, j, k = elem[e, 0], elem[e, 1], elem[e, 2]
     b0, b1, b2, b3 = b[e, 0], b[e, 1], b[e, 2], b[e, 3]
     d0, d1 = shape_gradient(corner, b0, b1, b2, b3)
@@ -522,15 +522,12 @@ def triangle_vertex_block(x, x_n, e, corner, elem, b, area, mu, lam, beta, kind,
     a = area[e]
     gx = a * (p00 * d0 + p01 * d1)
     gy = a * (p10 * d0 + p11 * d1)
+    # H[s, t] = A sum_{c, c'} dP/dF[2 s + c, 2 t + c'] d_c d_c'
     if kind[e] == KIND_COROTATED:
-        corotated.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
+        kxx, kxy, kyy = corotated.vertex_stiffness(f00, f01, f10, f11, mu[e], lam[e], d0, d1)
     else:
-        neo_hookean.stress_derivative(f00, f01, f10, f11, mu[e], lam[e], hf)
-    # H[s, t] = A sum_{c, c'} hf[2 s + c, 2 t + c'] d_c d_c'
-    hxx = a * (hf[0, 0] * d0 * d0 + (hf[0, 1] + hf[1, 0]) * d0 * d1 + hf[1, 1] * d1 * d1)
-    hxy = a * (hf[0, 2] * d0 * d0 + (hf[0, 3] + hf[1, 2]) * d0 * d1 + hf[1, 3] * d1 * d1)
-    hyy = a * (hf[2, 2] * d0 * d0 + (hf[2, 3] + hf[3, 2]) * d0 * d1 + hf[3, 3] * d1 * d1)
-    hxx, hxy, hyy = psd2(hxx, hxy, hyy)
+        kxx, kxy, kyy = neo_hookean.vertex_stiffness(f00, f01, f10, f11, mu[e], lam[e], d0, d1)
+    hxx, hxy, hyy = psd2(a * kxx, a * kxy, a * kyy)
     be = beta[e]
     if be > 0.0:
         # the damping stress of the rate F(x - x_n) / h, and beta / h times its linear stiffness
@@ -553,11 +550,10 @@ def triangle_vertex_block(x, x_n, e, corner, elem, b, area, mu, lam, beta, kind,
 def triangle_vertex_blocks(x, x_n, elem, b, area, mu, lam, beta, kind, inv_h, g, hb):
     """Every element's share of each corner's block (:func:`triangle_vertex_block`), added
     to ``g`` (N, 2) and ``hb`` (N, 3: xx, xy, yy)."""
-    hf = np.empty((4, 4))
     for e in range(elem.shape[0]):
         for c in range(3):
             v = elem[e, c]
-            gx, gy, hxx, hxy, hyy = triangle_vertex_block(x, x_n, e, c, elem, b, area, mu, lam, beta, kind, inv_h, hf)
+            gx, gy, hxx, hxy, hyy = triangle_vertex_block(x, x_n, e, c, elem, b, area, mu, lam, beta, kind, inv_h)
             g[v, 0] += gx
             g[v, 1] += gy
             hb[v, 0] += hxx

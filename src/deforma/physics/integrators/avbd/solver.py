@@ -228,7 +228,7 @@ def descend(x, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull):
 @njit(cache=True)
 def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_corner, elem, b, area, mu, lam,
           beta, kind, spring_start, spring_item, spring_corner, spring_i, spring_j, rest, ks, kd, grab_slot,
-          grab_pull, rs, inv_h, hf):
+          grab_pull, rs, inv_h):
     """One Gauss-Seidel sweep, colour after colour, over every free vertex's block (the
     built-in element kinds). Returns the largest squared move (m^2)."""
     most = 0.0
@@ -240,7 +240,7 @@ def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_
             gx = gy = hxx = hxy = hyy = 0.0
             for q in range(tri_start[i], tri_start[i + 1]):
                 ex, ey, exx, exy, eyy = triangle_vertex_block(x, x_n, tri_item[q], tri_corner[q], elem, b, area, mu,
-                                                              lam, beta, kind, inv_h, hf)
+                                                              lam, beta, kind, inv_h)
                 gx += ex
                 gy += ey
                 hxx += exx
@@ -725,7 +725,6 @@ class AVBD(Integrator):
             self._vertex_row = np.full(n, -1, np.int32)
             self._rows = np.empty((n, ROW_COLUMNS))
             self._memory = np.full((n, MEMORY_COLUMNS), -1.0)
-            self._hf = np.empty((4, 4))
             self._b_start = np.zeros(n + 1, np.int64)
             self._c_start = np.zeros(n + 1, np.int64)
             self._rowed = np.zeros(n, np.bool_)
@@ -984,7 +983,7 @@ class AVBD(Integrator):
                 most = sweep(x, x_n, y, mass_h2, inv_mass, order, starts, t_start, t_item, t_corner, tris.elem,
                              tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start, s_item, s_corner,
                              springs.i, springs.j, springs.rest, springs.ks, springs.kd, control.grab_slot,
-                             control.grab_pull, rs, inv_h, self._hf)
+                             control.grab_pull, rs, inv_h)
             else:
                 most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs,
                                          self._gas[1])
