@@ -5,6 +5,7 @@ import pytest
 
 import deforma
 from deforma.physics.integrators import symplectic
+from deforma.physics.integrators.driver import DriverChoice
 from deforma.physics.colliders.shapes import Rect, pack_colliders
 from deforma.physics.colliders.response import collide_point
 from deforma.physics.elements.springs import spring_force
@@ -118,20 +119,36 @@ def test_world_results_do_not_depend_on_the_threading_mode():
     assert np.array_equal(runs[0], runs[1]) and np.array_equal(runs[0], runs[2])
 
 
+def test_avbd_results_do_not_depend_on_the_threading_mode():
+    # its sweep runs each colour's vertices without contact rows in parallel, then those with
+    # rows one by one: the same result as one thread, bit for bit
+    runs = []
+    for mode in ("serial", "parallel", "auto"):
+        w, b = perturbed_world(40)
+        w.integrator, w.dt, w.substeps = "avbd", 1 / 60, 1
+        w.add_collider(Rect((0, -0.4), (3, 0.2), 10.0))
+        w.integrator_options = {"mode": mode}
+        for _ in range(40):
+            w.step()
+        assert w.integrator_stats["contacts"] > 0
+        runs.append(b.positions.copy())
+    assert np.array_equal(runs[0], runs[1]) and np.array_equal(runs[0], runs[2])
+
+
 def test_auto_mode_uses_the_faster_driver_and_probes_the_other_less_while_it_loses():
-    integ = symplectic.SymplecticEuler()
-    integ._samples = {"parallel": [1.0, 1.2, 0.9], "serial": [2.0, 2.1, 1.9]}
-    integ._estimate = {"parallel": 1.0, "serial": 2.0}
-    picks = [integ._choose() for _ in range(200)]
+    d = DriverChoice()
+    d._samples = {"parallel": [1.0, 1.2, 0.9], "serial": [2.0, 2.1, 1.9]}
+    d._estimate = {"parallel": 1.0, "serial": 2.0}
+    picks = [d.choose() for _ in range(200)]
     assert picks[:15] == ["parallel"] * 15 and picks[15:17] == ["serial"] * 2  # probe: two calls
     assert picks.count("serial") < 12  # 16, 32, 64, 128: fewer and fewer probes
-    integ._reset_timing()
-    integ._samples = {"parallel": [30.0] * 3, "serial": [1.0] * 3}  # threads starved by other work
-    integ._estimate = {"parallel": 30.0, "serial": 1.0}
-    picks = [integ._choose() for _ in range(1000)]
+    d.reset()
+    d._samples = {"parallel": [30.0] * 3, "serial": [1.0] * 3}  # threads starved by other work
+    d._estimate = {"parallel": 30.0, "serial": 1.0}
+    picks = [d.choose() for _ in range(1000)]
     assert picks.count("parallel") == 2  # one probe, then none for 4096 calls
-    integ._estimate["parallel"] = 0.5  # cores free again: the probe wins, parallel is used
-    assert integ._choose() == "parallel"
+    d._estimate["parallel"] = 0.5  # cores free again: the probe wins, parallel is used
+    assert d.choose() == "parallel"
 
 
 def test_the_implicit_matrix_assembly_matches_a_dense_sum():

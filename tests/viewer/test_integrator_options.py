@@ -19,7 +19,8 @@ ROWS = {"symplectic-euler": ["integrator_mode"],
         "xpbd": ["integrator_iterations"],
         "implicit-bdf2": ["integrator_iterations", "integrator_tolerance", "integrator_max_iterations",
                           "integrator_contact_weight"],
-        "avbd": ["integrator_iterations", "integrator_tolerance", "integrator_reach", "integrator_order",
+        "avbd": ["integrator_mode", "integrator_iterations", "integrator_tolerance", "integrator_reach",
+                 "integrator_order",
                  "integrator_cluster_size",
                  "integrator_chebyshev",
                  "integrator_penalty_start", "integrator_penalty_ramp", "integrator_penalty_max"]}
@@ -77,7 +78,7 @@ BAD = [
     ("integrator_contact_weight", "x",
      "implicit-euler option contact_weight must be a number in (0, 1e+12), got 'x'"),
     ("integrator_mode", "serial",
-     "'mode' is an option of symplectic-euler, not of implicit-euler "
+     "'mode' is an option of symplectic-euler and avbd, not of implicit-euler "
      "(implicit-euler takes iterations, tolerance, max_iterations, contact_weight)"),
 ]
 

@@ -140,13 +140,22 @@ def stress_derivative(f00, f01, f10, f11, mu, lam, out):
 
 
 @njit(cache=True, inline="always")
+def _hessian_entry(p, q, mu, lam, k, dr):
+    """Entry ``(p, q)`` of :func:`stress_derivative`'s matrix where ``r > 0`` (the same
+    arithmetic, so the same bits)."""
+    a0 = (1.0, 0.0, 0.0, 1.0)
+    a1 = (0.0, -1.0, 1.0, 0.0)
+    m = a0[p] * a0[q] + a1[p] * a1[q] - dr[p] * dr[q]
+    return (2.0 * mu if p == q else 0.0) + (k * m + lam * dr[p] * dr[q])
+
+
+@njit(cache=True, inline="always")
 def vertex_stiffness(f00, f01, f10, f11, mu, lam, d0, d1):
     """:func:`stress_derivative` contracted for one corner that moves: ``(k_xx, k_xy, k_yy)``
     (Pa / m^2 per unit rest area), ``K_st = sum_{c, c'} dP/dF[2 s + c, 2 t + c'] d_c d_c'``
-    with ``(d0, d1)`` the corner's shape-function gradient. Each rank-one term ``v v^T`` of
-    the Hessian gives ``(v_s . d)(v_t . d)`` (``v_s`` the pair ``(v[2 s], v[2 s + 1])``) and
-    the identity ``delta_st |d|^2``: no 4 x 4 matrix is formed (the vertex sweeps run this
-    for every element at every corner).
+    with ``(d0, d1)`` the corner's shape-function gradient. Only the twelve entries the
+    contraction reads are formed, each by :func:`stress_derivative`'s own arithmetic, and no
+    matrix is stored: the vertex sweeps run this for every element at every corner.
 
     Examples
     --------
@@ -159,17 +168,23 @@ def vertex_stiffness(f00, f01, f10, f11, mu, lam, d0, d1):
     >>> bool(np.allclose(D @ h @ D.T, [[k[0], k[1]], [k[1], k[2]]]))
     True
     """
-    dd = d0 * d0 + d1 * d1
-    kxx = kyy = 2.0 * mu * dd
     c = f00 + f11
     s = f10 - f01
     r = np.sqrt(c * c + s * s)
     if r == 0.0:
-        return kxx, 0.0, kyy
+        tm = 2.0 * mu
+        return (tm * d0 * d0 + (0.0 + 0.0) * d0 * d1 + tm * d1 * d1, 0.0 * d0 * d0 + (0.0 + 0.0) * d0 * d1
+                + 0.0 * d1 * d1, tm * d0 * d0 + (0.0 + 0.0) * d0 * d1 + tm * d1 * d1)
     u0, u1 = c / r, s / r
+    dr = (1.0 * u0 + 0.0 * u1, 0.0 * u0 + -1.0 * u1, 0.0 * u0 + 1.0 * u1, 1.0 * u0 + 0.0 * u1)
     k = (lam * (r - 2.0) - 2.0 * mu) / r
-    # A's rows (1, 0, 0, 1) and (0, -1, 1, 0) give (d0, d1) and (-d1, d0), which sum to |d|^2 I;
-    # dr = A^T u gives (r0, r1), entering with lambda (the lambda term) and -k (from d^2 r)
-    r0, r1 = u0 * d0 - u1 * d1, u1 * d0 + u0 * d1
-    w = lam - k
-    return kxx + k * dd + w * r0 * r0, w * r0 * r1, kyy + k * dd + w * r1 * r1
+    kxx = (_hessian_entry(0, 0, mu, lam, k, dr) * d0 * d0
+           + (_hessian_entry(0, 1, mu, lam, k, dr) + _hessian_entry(1, 0, mu, lam, k, dr)) * d0 * d1
+           + _hessian_entry(1, 1, mu, lam, k, dr) * d1 * d1)
+    kxy = (_hessian_entry(0, 2, mu, lam, k, dr) * d0 * d0
+           + (_hessian_entry(0, 3, mu, lam, k, dr) + _hessian_entry(1, 2, mu, lam, k, dr)) * d0 * d1
+           + _hessian_entry(1, 3, mu, lam, k, dr) * d1 * d1)
+    kyy = (_hessian_entry(2, 2, mu, lam, k, dr) * d0 * d0
+           + (_hessian_entry(2, 3, mu, lam, k, dr) + _hessian_entry(3, 2, mu, lam, k, dr)) * d0 * d1
+           + _hessian_entry(3, 3, mu, lam, k, dr) * d1 * d1)
+    return kxx, kxy, kyy

@@ -157,9 +157,8 @@ def stress_derivative(f00, f01, f10, f11, mu, lam, out):
 @njit(cache=True, inline="always")
 def vertex_stiffness(f00, f01, f10, f11, mu, lam, d0, d1):
     """:func:`stress_derivative` contracted for one corner that moves: ``(k_xx, k_xy, k_yy)``
-    (as :func:`~deforma.physics.elements.corotated.vertex_stiffness`). ``J``'s Hessian drops
-    out (one corner's move changes ``F`` by a rank-one matrix, in which ``J`` is linear):
-    ``mu |d|^2 delta_st + lambda' (g_s . d)(g_t . d)``.
+    (as :func:`~deforma.physics.elements.corotated.vertex_stiffness`: the twelve entries the
+    contraction reads, by :func:`stress_derivative`'s own arithmetic, and no matrix).
 
     Examples
     --------
@@ -172,8 +171,13 @@ def vertex_stiffness(f00, f01, f10, f11, mu, lam, d0, d1):
     >>> bool(np.allclose(D @ h @ D.T, [[k[0], k[1]], [k[1], k[2]]]))
     True
     """
-    lp, _ = bulk(mu, lam)
-    dd = mu * (d0 * d0 + d1 * d1)
-    g0 = f11 * d0 - f10 * d1
-    g1 = -f01 * d0 + f00 * d1
-    return dd + lp * g0 * g0, lp * g0 * g1, dd + lp * g1 * g1
+    lp, alpha = bulk(mu, lam)
+    g0, g1, g2, g3 = f11, -f10, -f01, f00
+    k = lp * (f00 * f11 - f01 * f10 - alpha)
+    kxx = ((mu + lp * g0 * g0) * d0 * d0 + ((0.0 + lp * g0 * g1) + (0.0 + lp * g1 * g0)) * d0 * d1
+           + (mu + lp * g1 * g1) * d1 * d1)
+    kxy = ((0.0 + lp * g0 * g2) * d0 * d0 + ((0.0 + lp * g0 * g3 + k) + (0.0 + lp * g1 * g2 - k)) * d0 * d1
+           + (0.0 + lp * g1 * g3) * d1 * d1)
+    kyy = ((mu + lp * g2 * g2) * d0 * d0 + ((0.0 + lp * g2 * g3) + (0.0 + lp * g3 * g2)) * d0 * d1
+           + (mu + lp * g3 * g3) * d1 * d1)
+    return kxx, kxy, kyy

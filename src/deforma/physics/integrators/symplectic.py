@@ -39,6 +39,7 @@ from ..elements.springs import SpringArrays, scatter_spring_forces
 from ..elements.triangles import TriangleArrays, element_forces
 from ..jit import serial_and_parallel
 from .base import Integrator, Option, StepReport, contact_epilogue, is_bad, register_integrator
+from .driver import MODE_OPTION_DOC, DriverChoice
 
 # Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
 PARALLEL_MIN_VERTICES = 512
@@ -243,8 +244,7 @@ class SymplecticEuler(Integrator):
     """
 
     name = "symplectic-euler"
-    OPTIONS = (Option("mode", "auto", "choice", choices=("auto", "serial", "parallel"),
-                      doc="which driver runs: measured (auto), one thread (serial) or all threads (parallel)"),)
+    OPTIONS = (Option("mode", "auto", "choice", choices=("auto", "serial", "parallel"), doc=MODE_OPTION_DOC),)
 
     def __init__(self, **options):
         super().__init__(**options)
@@ -256,42 +256,7 @@ class SymplecticEuler(Integrator):
         self._threads = None  # numba.get_num_threads(), re-read every 1024 steps
         self._damped = (-1, None, False)  # (Model version, Model, whether any element is damped)
         self._ticks = 0
-        self._reset_timing()
-
-    def _reset_timing(self):
-        self._samples = {"serial": [], "parallel": []}  # recent seconds per substep
-        self._estimate = {"serial": math.inf, "parallel": math.inf}
-        self._last = None  # driver of the previous call
-        self._calls = 0  # calls since the last probe
-        self._probing = 0  # calls of the other driver still to make
-        self._probe_every = 16
-        self._last_best = None
-
-    def _choose(self) -> str:
-        smp = self._samples
-        for k in ("parallel", "serial"):
-            if len(smp[k]) < 3:
-                return k
-        est = self._estimate
-        best, other = ("parallel", "serial") if est["parallel"] <= est["serial"] else ("serial", "parallel")
-        if self._probing:
-            self._probing -= 1
-            return other
-        self._calls += 1
-        if self._calls < self._probe_every:
-            return best
-        # Probe the other driver for two calls (only the second is timed: the first wakes
-        # sleeping threads and warms caches). A probe can cost 100x a step when the cores
-        # are busy, so probe less often while it keeps losing, often again once it wins.
-        self._calls, self._probing = 0, 1
-        if est[other] > 10 * est[best]:  # hopeless (cores taken): look again much later
-            self._probe_every = 4096
-        elif best != self._last_best:
-            self._probe_every = 16
-        else:
-            self._probe_every = min(2 * self._probe_every, 4096)
-        self._last_best = best
-        return other
+        self._driver = DriverChoice()
 
     def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
         n = model.n_vertices
@@ -309,7 +274,7 @@ class SymplecticEuler(Integrator):
             self._fbuf = np.zeros((n_chunks, n, 2))
             self._chunks, self._elem_chunks, self._chunk_vertices = merged_chunks(
                 model.spring_i, model.spring_j, model.elem, n_chunks)
-            self._reset_timing()
+            self._driver.reset()
         if self._damped[0] != model.version or self._damped[1] is not model:  # a material may change it in place
             self._damped = (model.version, model, bool(model.elem_damping.any()))
         if not may_parallel:
@@ -317,7 +282,7 @@ class SymplecticEuler(Integrator):
         elif mode == "parallel":
             which = "parallel"
         else:
-            which = self._choose()
+            which = self._driver.choose()
         kernel = symplectic_euler_parallel if which == "parallel" else symplectic_euler_serial
         gx, gy = model.gravity
         start = time.perf_counter()
@@ -331,13 +296,7 @@ class SymplecticEuler(Integrator):
         else:
             bad = self._step_kinds(kernel, model, state_out, control, contacts, substeps, max_speed, common, tail)
         if may_parallel:
-            took = (time.perf_counter() - start) / substeps
-            if which == self._last:  # the driver ran last call too: threads awake, caches warm
-                smp = self._samples[which]
-                smp.append(took)
-                del smp[:-3]
-                self._estimate[which] = sorted(smp)[len(smp) // 2]  # median: one outlier is ignored
-            self._last = which
+            self._driver.record(which, (time.perf_counter() - start) / substeps)
         return StepReport(int(bad), contacts.complete)
 
     def _step_kinds(self, kernel, model, state, control, contacts, substeps, max_speed, common, tail) -> int:

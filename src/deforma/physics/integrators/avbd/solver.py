@@ -38,7 +38,9 @@ collider, and a vertex against an outline edge of another body or its own. Each 
 inside the sweep with Coulomb friction (:mod:`~deforma.physics.integrators.avbd.rows`),
 warm-started by its pair; the shared contact stage after the sweep stays as the fail-safe.
 Pins stay put (infinite mass); a grab is a zero-length spring of its strength to its target.
-The sweep is serial: the colours are ready for a parallel one.
+Each colour's vertices without contact rows are swept in parallel and those with rows after
+them one by one (:func:`_sweep`; option ``mode`` picks the build, measured by default): every
+build gives the same result bit for bit.
 
 Units: m, s, kg, N, N/m.
 """
@@ -46,9 +48,11 @@ Units: m, s, kg, N, N/m.
 from __future__ import annotations
 
 import math
+import time
 
+import numba
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ...colliders.geometry import advance_colliders
 from ...colliders.response import CORNER_COLUMNS, contact_planes, corner_contacts, push_edges_off_corners
@@ -58,6 +62,7 @@ from ...contact.narrow_phase import detect_contacts
 from ...contact.response import hold_start_distance
 from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
+from ...jit import serial_and_parallel
 from ...rigid_motion import linear_and_angular_velocity, rigid_velocities
 from ...topology import lengths
 from ..base import (
@@ -68,6 +73,8 @@ from ..base import (
     finish_position_step,
     register_integrator,
 )
+from ..driver import MODE_OPTION_DOC, DriverChoice
+from ..symplectic import PARALLEL_MIN_VERTICES
 from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
@@ -225,46 +232,69 @@ def descend(x, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull):
     return dx * dx + dy * dy
 
 
-@njit(cache=True)
-def sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_corner, elem, b, area, mu, lam,
-          beta, kind, spring_start, spring_item, spring_corner, spring_i, spring_j, rest, ks, kd, grab_slot,
-          grab_pull, rs, inv_h):
+@njit(cache=True, inline="always")
+def element_block(x, x_n, i, tri_start, tri_item, tri_corner, elem, b, area, mu, lam, beta, kind, spring_start,
+                  spring_item, spring_corner, spring_i, spring_j, rest, ks, kd, inv_h):
+    """Vertex ``i``'s share of its elements' energy (the built-in kinds): ``(gx, gy, hxx, hxy,
+    hyy)``."""
+    gx = gy = hxx = hxy = hyy = 0.0
+    for q in range(tri_start[i], tri_start[i + 1]):
+        ex, ey, exx, exy, eyy = triangle_vertex_block(x, x_n, tri_item[q], tri_corner[q], elem, b, area, mu, lam,
+                                                      beta, kind, inv_h)
+        gx += ex
+        gy += ey
+        hxx += exx
+        hxy += exy
+        hyy += eyy
+    for q in range(spring_start[i], spring_start[i + 1]):
+        s = spring_item[q]
+        j = spring_j[s] if spring_corner[q] == 0 else spring_i[s]
+        ex, ey, exx, exy, eyy = spring_vertex_block(x, x_n, i, j, rest[s], ks[s], kd[s], inv_h)
+        gx += ex
+        gy += ey
+        hxx += exx
+        hxy += exy
+        hyy += eyy
+    return gx, gy, hxx, hxy, hyy
+
+
+def _sweep(x, x_n, y, mass_h2, inv_mass, order, starts, tri_start, tri_item, tri_corner, elem, b, area, mu, lam,
+           beta, kind, spring_start, spring_item, spring_corner, spring_i, spring_j, rest, ks, kd, grab_slot,
+           grab_pull, rs, inv_h, moves):
     """One Gauss-Seidel sweep, colour after colour, over every free vertex's block (the
-    built-in element kinds). Returns the largest squared move (m^2)."""
-    most = 0.0
+    built-in element kinds). Returns the largest squared move (m^2); ``moves`` (N,) is scratch.
+
+    A colour's vertices share no element, so those without contact rows are independent and
+    go in parallel (``prange``); a row can join two vertices of one colour (a vertex and the
+    edge it meets), so those with rows follow one by one. A row's vertices all have rows, so
+    this order gives what any order within the colour gives: the one-thread and all-threads
+    builds (:data:`sweep_serial`, :data:`sweep_parallel`) agree bit for bit."""
     for c in range(starts.shape[0] - 1):
-        for p in range(starts[c], starts[c + 1]):
+        lo, hi = starts[c], starts[c + 1]
+        for p in prange(lo, hi):
             i = order[p]
-            if inv_mass[i] == 0.0:
-                continue
-            gx = gy = hxx = hxy = hyy = 0.0
-            for q in range(tri_start[i], tri_start[i + 1]):
-                ex, ey, exx, exy, eyy = triangle_vertex_block(x, x_n, tri_item[q], tri_corner[q], elem, b, area, mu,
-                                                              lam, beta, kind, inv_h)
-                gx += ex
-                gy += ey
-                hxx += exx
-                hxy += exy
-                hyy += eyy
-            for q in range(spring_start[i], spring_start[i + 1]):
-                s = spring_item[q]
-                j = spring_j[s] if spring_corner[q] == 0 else spring_i[s]
-                ex, ey, exx, exy, eyy = spring_vertex_block(x, x_n, i, j, rest[s], ks[s], kd[s], inv_h)
-                gx += ex
-                gy += ey
-                hxx += exx
-                hxy += exy
-                hyy += eyy
-            if rs.rowed[i]:
+            moves[p] = 0.0
+            if inv_mass[i] != 0.0 and not rs.rowed[i]:
+                gx, gy, hxx, hxy, hyy = element_block(x, x_n, i, tri_start, tri_item, tri_corner, elem, b, area, mu,
+                                                      lam, beta, kind, spring_start, spring_item, spring_corner,
+                                                      spring_i, spring_j, rest, ks, kd, inv_h)
+                moves[p] = descend(x, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull)
+        for p in range(lo, hi):
+            i = order[p]
+            if inv_mass[i] != 0.0 and rs.rowed[i]:
+                gx, gy, hxx, hxy, hyy = element_block(x, x_n, i, tri_start, tri_item, tri_corner, elem, b, area, mu,
+                                                      lam, beta, kind, spring_start, spring_item, spring_corner,
+                                                      spring_i, spring_j, rest, ks, kd, inv_h)
                 ex, ey, exx, exy, eyy = row_blocks(x, x_n, i, rs, False)
-                gx += ex
-                gy += ey
-                hxx += exx
-                hxy += exy
-                hyy += eyy
-            moved = descend(x, y, i, gx, gy, hxx, hxy, hyy, mass_h2, grab_slot, grab_pull)
-            most = max(most, moved)
+                moves[p] = descend(x, y, i, gx + ex, gy + ey, hxx + exx, hxy + exy, hyy + eyy, mass_h2, grab_slot,
+                                   grab_pull)
+    most = 0.0
+    for p in range(starts[-1]):
+        most = max(most, moves[p])
     return most
+
+
+sweep_serial, sweep_parallel = serial_and_parallel(_sweep, "avbd_sweep")
 
 
 @njit(cache=True)
@@ -605,7 +635,8 @@ class AVBD(Integrator):
                       doc="a contact row's first stiffness, in its vertex's m / h^2 plus its elements' stiffness"),
                Option("penalty_ramp", 1e5, "float", low=0.0, high=1e15, closed_low=True,
                       doc="penalty growth per metre of violation, once a step (N/m^2)"),
-               Option("penalty_max", 1e10, "float", low=0.0, high=1e18, doc="the stiffest a contact row gets (N/m)"))
+               Option("penalty_max", 1e10, "float", low=0.0, high=1e18, doc="the stiffest a contact row gets (N/m)"),
+               Option("mode", "auto", "choice", choices=("auto", "serial", "parallel"), doc=MODE_OPTION_DOC))
 
     #: the most parts a step is split into where it reaches deep into its contacts
     MAX_PARTS = 16
@@ -635,6 +666,7 @@ class AVBD(Integrator):
         self._corner_memory = None
         self._n_corner = 0
         self._gas = None  # (model, GasSet)
+        self._driver = DriverChoice()  # which sweep build runs (option mode)
         self._n = -1
         self._size = None
         self._history = False  # BDF2's: the length of the last step if whole, else False
@@ -728,6 +760,7 @@ class AVBD(Integrator):
             self._b_start = np.zeros(n + 1, np.int64)
             self._c_start = np.zeros(n + 1, np.int64)
             self._rowed = np.zeros(n, np.bool_)
+            self._moves = np.empty(n)  # the sweep's scratch
             self._x_prev = np.empty((n, 2))  # the last step's start, for BDF2
             self._v_prev = np.empty((n, 2))
             self._v_n = np.empty((n, 2))
@@ -980,10 +1013,15 @@ class AVBD(Integrator):
             if gas is not None:
                 gas_areas(x, gas)  # the whole-body step and the patches moved vertices too
             if model.fused and gas is None:
-                most = sweep(x, x_n, y, mass_h2, inv_mass, order, starts, t_start, t_item, t_corner, tris.elem,
-                             tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start, s_item, s_corner,
-                             springs.i, springs.j, springs.rest, springs.ks, springs.kd, control.grab_slot,
-                             control.grab_pull, rs, inv_h)
+                which = self._which_sweep(model.n_vertices)
+                kernel = sweep_parallel if which == "parallel" else sweep_serial
+                start = time.perf_counter()
+                most = kernel(x, x_n, y, mass_h2, inv_mass, order, starts, t_start, t_item, t_corner, tris.elem,
+                              tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start, s_item, s_corner,
+                              springs.i, springs.j, springs.rest, springs.ks, springs.kd, control.grab_slot,
+                              control.grab_pull, rs, inv_h, self._moves)
+                if self._options["mode"] == "auto" and which is not None:
+                    self._driver.record(which, time.perf_counter() - start)
             else:
                 most = self._sweep_kinds(model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs,
                                          self._gas[1])
@@ -1012,6 +1050,16 @@ class AVBD(Integrator):
         self.residual = math.sqrt(most) * inv_h
         if tol > 0.0 and most > tol * tol:
             self.unconverged += 1
+
+    def _which_sweep(self, n):
+        """The sweep's build for ``n`` vertices: ``"serial"`` below
+        ``PARALLEL_MIN_VERTICES`` (symplectic Euler's threshold) or on one thread,
+        else as the option ``mode`` says (``auto``: :class:`~deforma.physics.integrators.driver.DriverChoice`'s
+        measure; None then means serial without timing)."""
+        mode = self._options["mode"]
+        if mode == "serial" or n < PARALLEL_MIN_VERTICES or numba.get_num_threads() < 2:
+            return "serial" if mode != "auto" else None
+        return "parallel" if mode == "parallel" else self._driver.choose()
 
     def _sweep_kinds(self, model, control, x, x_n, mass_h2, inv_mass, order, starts, h, rs, gas):
         """One sweep with the elements' share of each colour's blocks from the kinds'
