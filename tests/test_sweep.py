@@ -310,6 +310,66 @@ def test_a_range_that_cannot_be_drawn_from_is_named_before_anything_runs(folder,
     assert not (folder / "never_inf").exists()
 
 
+GRID_1000 = "[" + ", ".join(str(i / 1000) for i in range(1000)) + "]"
+
+
+@pytest.mark.parametrize("text, message", [
+    (f'[parameters]\n"physics.friction" = {GRID_1000}\n"physics.static_friction" = {GRID_1000}\n',
+     r"^big\.toml: \[parameters\]: 1000000 combinations; a sweep file plans at most 10000 runs \(more: split"),
+    ('mode = "random"\nsamples = 1000000\n[parameters]\n"physics.friction" = { min = 0.1, max = 0.9 }\n',
+     r"^big\.toml: samples: 1000000 runs; a sweep file plans at most 10000 \(more: several files with other seeds"),
+    ('mode = "random"\nsamples = 1' + "0" * 400 + '\n[parameters]\n"physics.friction" = { min = 0.1, max = 0.9 }\n',
+     r"^big\.toml: samples: over 1e100 runs; a sweep file plans at most 10000"),
+])
+def test_a_plan_past_the_run_limit_is_refused_from_its_count_before_anything_is_built(folder, text, message):
+    # a million runs planned for minutes (300-500 MB) before the first one started (issue 51);
+    # now the count alone is refused, quickly and in little memory, and nothing is written
+    import tracemalloc
+
+    spec = _spec(folder, "big.toml", 'scene = "tiny.toml"\nseconds = 0.3\n' + text)
+    sweeps.load_spec(_spec(folder, "small.toml", SWEEP))  # the scene loader imported: not measured
+    tracemalloc.start()
+    try:
+        start = time.perf_counter()
+        with pytest.raises(sweeps.SweepError, match=message) as e:
+            sweeps.sweep(spec, folder / "never_big")
+        seconds = time.perf_counter() - start
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert "\n" not in str(e.value)
+    assert seconds < 1.0 and peak < 5e6, (seconds, peak)
+    assert not (folder / "never_big").exists()
+
+
+def test_the_run_limit_is_inclusive(folder, monkeypatch):
+    monkeypatch.setattr(sweeps, "MAX_RUNS", 6)
+    assert len(sweeps.plan(sweeps.load_spec(_spec(folder, "six.toml", SWEEP)))) == 6  # 3 x 2
+    eight = SWEEP.replace("[500, 1000, 1e9]", "[500, 1000, 1e9, 2000]")
+    with pytest.raises(sweeps.SweepError, match=r"8 combinations; a sweep file plans at most 6 runs"):
+        sweeps.load_spec(_spec(folder, "eight.toml", eight))
+    random = ('scene = "tiny.toml"\nseconds = 0.3\nmode = "random"\nsamples = {}\n[parameters]\n'
+              '"physics.friction" = {{ min = 0.1, max = 0.9 }}\n')
+    assert len(sweeps.plan(sweeps.load_spec(_spec(folder, "r6.toml", random.format(6))))) == 6
+    with pytest.raises(sweeps.SweepError, match=r"samples: 7 runs; a sweep file plans at most 6"):
+        sweeps.load_spec(_spec(folder, "r7.toml", random.format(7)))
+
+
+@pytest.mark.parametrize("text, message", [
+    ('mode = "random"\nsamples = 2\n[parameters]\n"physics.friction" = { min = 0, max = inf }\n',
+     "a range needs finite numbers"),
+    ('mode = "random"\nsamples = 1000000\n[parameters]\n"physics.friction" = { min = 0.1, max = 0.9 }\n',
+     "samples: 1000000 runs; a sweep file plans at most 10000"),
+])
+def test_cli_refuses_a_bad_plan_in_one_line_writing_nothing(folder, capsys, text, message):
+    spec = _spec(folder, "bad_plan.toml", 'scene = "tiny.toml"\nseconds = 0.3\n' + text)
+    assert main(["sweep", str(spec), "-o", str(folder / "never_cli")]) == 1
+    captured = capsys.readouterr()
+    assert captured.err.startswith("deforma: error: bad_plan.toml: ") and message in captured.err
+    assert captured.err.count("\n") == 1 and "Traceback" not in captured.err and captured.out == ""
+    assert not (folder / "never_cli").exists()
+
+
 @pytest.mark.parametrize("parameters, message", [
     ('"physics.stifness" = [1, 2]', r"physics\.stifness: unknown key; did you mean 'stiffness'"),
     ('"phyiscs.stiffness" = [1, 2]', r"phyiscs\.stiffness: unknown table 'phyiscs'; did you mean 'physics'"),
