@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import sys
+import time
 
 import pytest
 
@@ -93,6 +94,16 @@ def test_seconds_since_process_start_counts_the_interpreter_start():
     age = startup.seconds_since_process_start()
     # this test process imported pytest, numpy and deforma first: well over 0.1 s
     assert 0.1 < age < 24 * 3600
+
+
+def test_a_process_that_began_as_a_shell_counts_from_deformas_import(monkeypatch):
+    # bash -c "pip install ... && deforma run demo" runs deforma in the shell's own process,
+    # which started before pip: its age is not Python's start-up (it said 48.61 s for about 5)
+    since_import = time.perf_counter() - startup._IMPORTED
+    monkeypatch.setattr(startup, "_process_age", lambda: since_import + startup.EXEC_AGE + 40.0)
+    assert startup.seconds_since_process_start() == pytest.approx(since_import, abs=1.0)
+    monkeypatch.setattr(startup, "_process_age", lambda: since_import + 0.5)  # Python from the start
+    assert startup.seconds_since_process_start() == pytest.approx(since_import + 0.5, abs=0.1)
 
 
 def test_a_run_without_a_terminal_does_not_import_tqdm(tmp_path):

@@ -91,12 +91,15 @@ class CompileWatch:
         event.unregister("numba:compile", self._listener)
 
 
-def seconds_since_process_start() -> float:
-    """Wall seconds since this Python process started (Linux: from ``/proc``, 10 ms steps).
+#: A process older than this (s) when deforma was imported began as something else that then
+#: ran Python in its place: ``bash -c "pip install ... && deforma run demo"`` execs its last
+#: command, so that process started with the shell, before pip, and the run's summary counted
+#: pip's 45 s as its start-up. Python and the imports before deforma's take about 1 s.
+EXEC_AGE = 10.0
 
-    Elsewhere, or if ``/proc`` cannot be read, the seconds since this module was imported:
-    then the interpreter's start and deforma's import (about 1 s) are not counted.
-    """
+
+def _process_age() -> float | None:
+    """Wall seconds since this process started, from ``/proc`` (Linux, 10 ms steps), or None."""
     try:
         with open("/proc/self/stat") as f:
             fields = f.read().rsplit(")", 1)[1].split()
@@ -108,7 +111,23 @@ def seconds_since_process_start() -> float:
             return age
     except (OSError, ValueError, IndexError, AttributeError):
         pass
-    return time.perf_counter() - _IMPORTED
+    return None
+
+
+def seconds_since_process_start() -> float:
+    """Wall seconds since the Python interpreter of this process started.
+
+    From ``/proc`` on Linux, unless the process was already :data:`EXEC_AGE` s old when
+    deforma was imported (a shell that ran Python in its place: its start is not
+    Python's). Then, and where ``/proc`` cannot be read, the seconds since deforma was
+    imported: the interpreter's start and the imports before deforma's (about 1 s) are
+    not counted.
+    """
+    since_import = time.perf_counter() - _IMPORTED
+    age = _process_age()
+    if age is None or age - since_import > EXEC_AGE:
+        return since_import
+    return age
 
 
 def warn(message: str) -> None:
