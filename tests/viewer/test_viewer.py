@@ -268,6 +268,16 @@ def test_cli_view_without_display_is_one_line(tmp_path):
     assert r.returncode == 4 and r.stderr.count("\n") == 1 and "display" in r.stderr
 
 
+@pytest.mark.parametrize("driver", ["offscreen", "dummy"])
+def test_cli_view_offscreen_without_frames_is_refused_not_run_forever(driver):
+    # an off-screen window nobody can see or close ran until it was killed
+    env = dict(os.environ, SDL_VIDEODRIVER=driver)
+    r = subprocess.run([sys.executable, "-m", "deforma.cli", "view", "demo"], capture_output=True, text=True,
+                       env=env, timeout=120)
+    assert r.returncode == 4 and r.stderr.count("\n") == 1
+    assert f"SDL_VIDEODRIVER={driver}" in r.stderr and "--frames N" in r.stderr
+
+
 def test_panel_adds_selects_and_removes_colliders(demo):
     import pygame_gui
 

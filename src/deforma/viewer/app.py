@@ -794,6 +794,10 @@ class Viewer:
             limiter.tick(max_fps)
 
 
+#: SDL video drivers that draw nowhere a person sees: fine for ``frames``, never without it.
+INVISIBLE_DRIVERS = ("offscreen", "dummy")
+
+
 def _no_display() -> bool:
     """True on Linux/BSD without X11 or Wayland (and no SDL driver chosen by the user).
 
@@ -819,7 +823,9 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
         Window size in pixels.
     frames : int, keyword-only
         Run this many frames (each 1/60 s of simulated time) without waiting for input, then
-        return. Without a display, the window is then made off-screen (SDL's ``offscreen``).
+        return. Without a display, the window is then made off-screen (SDL's ``offscreen``);
+        without ``frames``, an off-screen window (``SDL_VIDEODRIVER=offscreen`` or ``dummy``)
+        is refused, since nothing could close it.
     screenshot : str, keyword-only
         With ``frames``: save the last frame to this PNG.
     panel, wireframe, samples, paused : keyword-only
@@ -828,7 +834,8 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
     Raises
     ------
     RuntimeError
-        No OpenGL window can be opened; ValueError for a bad scene or output path.
+        No OpenGL window can be opened, or only an off-screen one without ``frames``;
+        ValueError for a bad scene or output path.
     """
     size = check_window_size(size)
     if screenshot is not None:
@@ -846,6 +853,11 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
             raise RuntimeError("no display to open a window on (neither DISPLAY nor WAYLAND_DISPLAY is set); "
                                "for scripts use --frames N --screenshot out.png")
         os.environ["SDL_VIDEODRIVER"] = "offscreen"
+    driver = os.environ.get("SDL_VIDEODRIVER", "").lower()
+    if frames is None and driver in INVISIBLE_DRIVERS:
+        # nobody can see or close such a window: it ran until killed
+        raise RuntimeError(f"SDL_VIDEODRIVER={driver} opens a window nobody can see or close; "
+                           f"give --frames N (and --screenshot out.png) to run N frames and stop")
     v = Viewer(session, size=size, panel=panel, vsync=frames is None, samples=samples)
     v.paused = paused
     try:
