@@ -43,6 +43,7 @@ import math
 import os
 import re
 import socket
+import sys
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -136,6 +137,9 @@ def _read_toml(path: Path, what: str) -> dict:
         raise SweepError(f"{path}: not a text file (a {what} is TOML in UTF-8)") from None
     except tomllib.TOMLDecodeError as e:
         raise SweepError(f"{path}: invalid TOML: {e}") from None
+    except ValueError:  # an integer past Python's 4300 digits: the reader's int() refuses it
+        raise SweepError(f"{path}: invalid TOML: an integer of more than {sys.get_int_max_str_digits()} digits "
+                         f"(every number in a {what} is far smaller)") from None
 
 
 def _is_number(v) -> bool:

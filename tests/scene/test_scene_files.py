@@ -200,6 +200,8 @@ BAD = [
     ("[[body]]\ndetail = 1" + "0" * 400 + "\n",  # TOML integers are unbounded: not an OverflowError
      "body[0].detail: expected a finite number, got an integer of 401 digits, too large for a float"),
     ("[physics]\ngravity = [0, -1" + "0" * 400 + "]\n", "physics.gravity[1]: expected a finite number, got an integer"),
+    ("[run]\nseconds = 1" + "0" * 5000 + "\n",  # past 4300 digits the TOML reader's int() refuses it
+     "invalid TOML: an integer of more than 4300 digits (every number in a scene is far smaller)"),
     ("[[body]]\nedges = 1\n", "body[0].edges: expected true or false, got integer 1"),
     ("[[body]]\ncorners = [[0, 0], [1, 0], [1, 1]]\n", "body[0].corners: expected four corners"),
     ("[[body]]\nshape = 'circle'\n", "body[0].shape: unknown value 'circle'; allowed: box, image, mesh"),

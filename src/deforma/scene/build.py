@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -65,6 +66,9 @@ def load(name_or_path) -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"{shown}: invalid TOML: {e}") from None
+    except ValueError:  # an integer past Python's 4300 digits: the reader's int() refuses it
+        raise SceneError(f"{shown}: invalid TOML: an integer of more than {sys.get_int_max_str_digits()} digits "
+                         f"(every number in a scene is far smaller)") from None
     except RecursionError:
         # arrays or tables nested hundreds deep: the TOML reader recurses once per level
         raise SceneError(f"{shown}: invalid TOML: arrays or tables nested too deep for the reader "
