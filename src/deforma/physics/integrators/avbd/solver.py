@@ -302,7 +302,7 @@ def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, 
     """The vertices ``order[start:stop]`` (one colour) with their elements' share of the
     block given (``g`` (N, 2), ``hb`` (N, 3)): the path for element kinds that are not
     built in, and for a world with gas (``gas``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`,
-    whose share each outline vertex adds here; in :func:`sweep`, the gas's code, even never
+    whose share each outline vertex adds here; in :func:`_sweep`, the gas's code, even never
     run, cost the built-in path half its speed). Returns the largest squared move (m^2)."""
     most = 0.0
     for p in range(start, stop):
