@@ -17,7 +17,11 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["DriverChoice", "MODE_OPTION_DOC"]
+__all__ = ["DriverChoice", "MODE_OPTION_DOC", "PARALLEL_MIN_VERTICES"]
+
+#: Below this many vertices one thread is faster than two (thread wake-up ~ a few us): both
+#: integrators with two builds run one thread there, whatever their ``mode``'s measure.
+PARALLEL_MIN_VERTICES = 512
 
 #: an integrator option ``mode``'s description, for the integrators that have two builds
 MODE_OPTION_DOC = "which driver runs: measured (auto), one thread (serial) or all threads (parallel)"

@@ -39,10 +39,7 @@ from ..elements.springs import SpringArrays, scatter_spring_forces
 from ..elements.triangles import TriangleArrays, element_forces
 from ..jit import serial_and_parallel
 from .base import Integrator, Option, StepReport, contact_epilogue, is_bad, register_integrator
-from .driver import MODE_OPTION_DOC, DriverChoice
-
-# Below this many vertices one thread is faster than two (thread wake-up ~ a few us).
-PARALLEL_MIN_VERTICES = 512
+from .driver import MODE_OPTION_DOC, PARALLEL_MIN_VERTICES, DriverChoice
 
 
 @njit(cache=True, inline="always")

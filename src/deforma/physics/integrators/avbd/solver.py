@@ -73,8 +73,7 @@ from ..base import (
     finish_position_step,
     register_integrator,
 )
-from ..driver import MODE_OPTION_DOC, DriverChoice
-from ..symplectic import PARALLEL_MIN_VERTICES
+from ..driver import MODE_OPTION_DOC, PARALLEL_MIN_VERTICES, DriverChoice
 from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
@@ -1053,7 +1052,7 @@ class AVBD(Integrator):
 
     def _which_sweep(self, n):
         """The sweep's build for ``n`` vertices: ``"serial"`` below
-        ``PARALLEL_MIN_VERTICES`` (symplectic Euler's threshold) or on one thread,
+        :data:`~deforma.physics.integrators.driver.PARALLEL_MIN_VERTICES` or on one thread,
         else as the option ``mode`` says (``auto``: :class:`~deforma.physics.integrators.driver.DriverChoice`'s
         measure; None then means serial without timing)."""
         mode = self._options["mode"]
