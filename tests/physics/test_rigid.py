@@ -71,7 +71,7 @@ def slope_run(angle_deg, mesh, *, friction=0.3, static_friction=0.5, seconds=1.0
     return coef[2], b
 
 
-@pytest.mark.parametrize("angle", [30.0, 40.0])
+@pytest.mark.parametrize("angle", [30.0, 40.0, math.degrees(math.atan(1.1 * 0.5))])  # the last: 1.1x the limit
 def test_a_rigid_box_slides_down_a_slope_at_g_sin_minus_mu_cos(angle):
     box = deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=3)
     acc, _ = slope_run(angle, box)
@@ -79,9 +79,12 @@ def test_a_rigid_box_slides_down_a_slope_at_g_sin_minus_mu_cos(angle):
     assert acc == pytest.approx(G * (math.sin(a) - 0.3 * math.cos(a)), rel=0.03)
 
 
-def test_a_rigid_box_sticks_below_the_static_limit():
+@pytest.mark.parametrize("share", [0.73, 0.95])
+def test_a_rigid_box_sticks_below_the_static_limit(share):
+    # tan a = share * static_friction; it lands from a millimetre above, coming in sliding
+    # at 2.6 cm/s at 0.95 (the impact's static friction stops it)
     box = deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=3)
-    acc, b = slope_run(20.0, box)  # tan 20 = 0.36 < 0.5
+    acc, b = slope_run(math.degrees(math.atan(share * 0.5)), box)
     assert abs(acc) < 1e-6 and np.abs(b.velocity).max() < 1e-6
 
 
@@ -111,6 +114,91 @@ def test_a_stack_of_ten_rigid_boxes_stands_for_ten_seconds():
     now = np.array([b.center_of_mass for b in boxes])
     assert np.abs(now - settled).max() < 0.01
     assert max(abs(b.angle) for b in boxes) < 0.5
+
+
+def test_avbd_holds_a_stack_of_ten_rigid_boxes_still():
+    # the default integrator solves each rigid box as one block of its sweep: settled (3 s),
+    # every box stays within a millimetre for ten seconds and ends slower than 1 mm/s
+    w = deforma.World(dt=1 / 60)
+    assert w.integrator == "avbd"
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
+    boxes = [w.add_body(deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=2),
+                        position=(0.01 * (i % 2), 0.1 + 0.201 * i), material=RIGID) for i in range(10)]
+    for _ in range(180):
+        w.step()
+    settled = np.array([b.center_of_mass for b in boxes])
+    most = 0.0
+    for _ in range(600):
+        w.step()
+        most = max(most, np.abs(np.array([b.center_of_mass for b in boxes]) - settled).max())
+    assert most < 1e-3
+    assert max(np.hypot(*b.velocity) for b in boxes) < 1e-3
+    assert max(abs(b.angle) for b in boxes) < 0.1
+    assert w.integrator_stats["failsafe"] == 0
+
+
+def two_boxes_through(*integrators):
+    """A rigid box resting on another, stepped half a second under each integrator in turn:
+    the top box's heights (m) and its last angle (degrees)."""
+    w = deforma.World(dt=1 / 60)
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
+    box = lambda y: w.add_body(deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=2),  # noqa: E731
+                               position=(0.0, y), material=RIGID)
+    box(0.1)
+    top = box(0.301)
+    heights = []
+    for name in integrators:
+        w.integrator = name
+        for _ in range(30):
+            w.step()
+        heights.append(top.center_of_mass[1])
+    return heights, top.angle
+
+
+def test_rigid_bodies_change_hands_when_the_integrator_changes():
+    # avbd moves rigid bodies in its sweep, the others in the rigid stage after each substep
+    heights, angle = two_boxes_through("avbd", "implicit-euler")
+    assert max(heights) - min(heights) < 5e-3 and min(heights) > 0.295 and abs(angle) < 0.1
+
+
+@pytest.mark.xfail(strict=True, reason="the rigid stage leaves the boxes 0.02 mm into each other, and avbd's rows "
+                                       "meet no pair that begins crossed: the top box sinks through (issue 49)")
+def test_rigid_bodies_change_back_to_avbd():
+    heights, angle = two_boxes_through("avbd", "implicit-euler", "avbd")
+    assert max(heights) - min(heights) < 5e-3 and min(heights) > 0.295 and abs(angle) < 0.1
+
+
+def test_a_jelly_block_stays_on_a_level_rigid_crate():
+    # it slid off at 0.8 m/s under implicit Euler when the crate was a rigid stage's outline
+    w = deforma.World(dt=1 / 60)
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
+    crate = w.add_body(deforma.mesh.box(((0, 0), (0.6, 0), (0.6, 0.4), (0, 0.4)), detail=2), position=(0, 0.2),
+                       material=RIGID)
+    jelly = w.add_body(deforma.mesh.box(((0, 0), (0.3, 0), (0.3, 0.2), (0, 0.2)), detail=6), position=(0.05, 0.55),
+                       material=deforma.Material.preset("jelly"))
+    for _ in range(240):
+        w.step()
+    assert abs(jelly.center_of_mass[0] - 0.05) < 5e-3 and 0.49 < jelly.center_of_mass[1] < 0.52
+    assert np.hypot(*crate.velocity) < 1e-3 and np.abs(crate.center_of_mass - (0.0, 0.2)).max() < 1e-3
+
+
+@pytest.mark.xfail(strict=True, reason="its contact vertices buzz at 5-80 mm/s on the crate (at rest on a fixed "
+                                       "box of the crate's shape): the rows between a soft body and a rigid one "
+                                       "(issue 49)")
+def test_a_jelly_block_on_a_rigid_crate_comes_to_rest_within_two_seconds():
+    w = deforma.World(dt=1 / 60)
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
+    w.add_body(deforma.mesh.box(((0, 0), (0.6, 0), (0.6, 0.4), (0, 0.4)), detail=2), position=(0, 0.2),
+               material=RIGID)
+    jelly = w.add_body(deforma.mesh.box(((0, 0), (0.3, 0), (0.3, 0.2), (0, 0.2)), detail=6), position=(0.05, 0.55),
+                       material=deforma.Material.preset("jelly"))
+    for _ in range(150):  # lands within half a second
+        w.step()
+    most = 0.0
+    for _ in range(30):
+        w.step()
+        most = max(most, np.hypot(*jelly.velocities.T).max())
+    assert most < 1e-3
 
 
 @pytest.mark.parametrize("integrator", ["symplectic-euler", "implicit-euler", "implicit-bdf2", "xpbd"])

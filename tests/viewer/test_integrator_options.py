@@ -23,7 +23,8 @@ ROWS = {"symplectic-euler": ["integrator_mode"],
                  "integrator_order",
                  "integrator_cluster_size",
                  "integrator_chebyshev",
-                 "integrator_penalty_start", "integrator_penalty_ramp", "integrator_penalty_max"]}
+                 "integrator_penalty_start", "integrator_penalty_ramp", "integrator_penalty_max",
+                 "integrator_rigid_passes"]}
 
 
 def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
@@ -32,7 +33,7 @@ def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
                           "integrator_max_iterations", "integrator_contact_weight", "integrator_reach",
                           "integrator_order", "integrator_cluster_size",
                           "integrator_chebyshev", "integrator_penalty_start", "integrator_penalty_ramp",
-                          "integrator_penalty_max"]
+                          "integrator_penalty_max", "integrator_rigid_passes"]
     assert not set(rows) & set(PARAMS)
     mode = rows["integrator_mode"]
     assert mode.kind == "choice" and mode.choices == ("auto", "serial", "parallel")

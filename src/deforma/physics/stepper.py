@@ -82,7 +82,8 @@ def step(world) -> None:
     """Advance ``world`` by ``world.dt`` (the stages of the module docstring)."""
     w = world
     poses = [(c, c.center, c.angle) for c in w._colliders if c.moving]
-    rigid = bool(w._model.n_vertices) and w._model.rigid.any()
+    # the rigid stage after each substep, unless the integrator solves the rigid bodies itself
+    rigid = bool(w._model.n_vertices) and w._model.rigid.any() and not w._rigid_in_solve()
     moving = bool(poses) or rigid  # the rigid bodies' outlines move as colliders
     moved = w._colliders_changed() or rigid
     if moved:

@@ -258,7 +258,7 @@ class World:
             return self._substeps
         stable = self.stable_dt()
         need = 1 if not math.isfinite(stable) else max(1, math.ceil(self._dt / stable * (1.0 + 1e-9)))
-        if model.n_vertices and model.rigid.any():
+        if model.n_vertices and model.rigid.any() and not self._rigid_in_solve():
             # a soft body meets a rigid one between substeps (its outline stands still within
             # one): at one 1/60 s implicit step a jelly ball went 5 cm into a crate before it
             # was put out, and bounced off with 22 % more energy than it came with; none at 1/120 s
@@ -418,6 +418,26 @@ class World:
     @integrator.setter
     def integrator(self, name):
         self._integrator = make_integrator(name)
+        self._rigid_solve_changed()
+
+    def _rigid_in_solve(self) -> bool:
+        """Whether the integrator solves the rigid bodies in its own sweep (avbd's blocks,
+        :mod:`deforma.physics.integrators.avbd.rigid`; not yet with joints): else the rigid
+        stage after each substep moves them and others meet their outlines as colliders'
+        (:mod:`deforma.physics.rigid`)."""
+        return self._integrator.solves_rigid and not self._joints
+
+    def _rigid_solve_changed(self) -> None:
+        """Who moves the rigid bodies may have changed (the integrator, or the joints): their
+        contact switches follow, and their outlines are packed again or no more."""
+        model = getattr(self, "_model", None)
+        if model is None or not model.n_vertices or not model.rigid.any():
+            return
+        for body in self._bodies:
+            if body.material.is_rigid:
+                model.set_contact_parameters(body._index, **self._contact_parameters(body))
+        self._packed_colliders = None
+        self._auto_key = None
 
     @property
     def integrator_options(self) -> dict:
@@ -660,7 +680,9 @@ class World:
 
     def _contact_parameters(self, body) -> dict:
         o = body._overrides
-        if body.material.is_rigid:  # others meet its outline as a collider's (deforma.physics.rigid)
+        if body.material.is_rigid and not self._rigid_in_solve():
+            # others meet its outline as a collider's (deforma.physics.rigid); in avbd's
+            # sweep it is a block whose outline meets others as any body's does
             return dict(collide=False, self_collision=False, friction=body.friction,
                         static_friction=body.static_friction, thickness=self._body_thickness(body))
         return dict(collide=o["collide"], self_collision=o["self_collision"], friction=body.friction,
@@ -767,7 +789,7 @@ class World:
     def _pack_colliders(self):
         shapes = list(self._colliders)
         model = self._model
-        rigid = model is not None and model.rigid.any()
+        rigid = model is not None and model.rigid.any() and not self._rigid_in_solve()
         if rigid:  # the rigid bodies' outlines follow, where the state has them now
             rs = rigid_set(model)
             shapes += rs.outlines(*rs.poses(model, self._state.x, self._state.v), self._bodies)
@@ -860,6 +882,7 @@ class World:
             turn += angle[k] if side == 0 else -angle[k]
         j = Joint(self, a, b, kind, point, np.concatenate(local), turn, stiffness, damping, motor_speed, max_torque)
         self._joints.append(j)
+        self._rigid_solve_changed()
         return j
 
     def remove_joint(self, joint: Joint) -> None:
@@ -873,6 +896,7 @@ class World:
         if not any(joint is j for j in self._joints):
             raise ValueError(f"unknown joint {joint!r}: pass one returned by this world's join")
         self._joints = [j for j in self._joints if j is not joint]
+        self._rigid_solve_changed()
 
     # -- interaction ------------------------------------------------------------------------
     def explode(self, strength: float, *, center=None, radius=None) -> None:

@@ -228,7 +228,9 @@ class Integrator:
     ``self.options[name]``. ``unconditionally_stable = True`` tells ``World.stable_dt`` that
     it has no explicit step limit. ``solves_pressure = True`` says that its step holds the
     bodies' gas itself (else the stepper kicks the velocities by the gas force first,
-    :mod:`deforma.physics.behaviours.pressure`). :meth:`stats` gives counters a user may want
+    :mod:`deforma.physics.behaviours.pressure`). ``solves_rigid = True`` says that it moves
+    the rigid bodies as blocks of its own solve (else the rigid stage does after each
+    substep, :mod:`deforma.physics.rigid`). :meth:`stats` gives counters a user may want
     to see (``world.integrator_stats``).
 
     Examples
@@ -241,6 +243,7 @@ class Integrator:
     OPTIONS: tuple[Option, ...] = ()
     unconditionally_stable = False
     solves_pressure = False
+    solves_rigid = False
 
     def __init__(self, **options):
         self._options = {o.name: o.default for o in self.OPTIONS}

@@ -38,7 +38,6 @@ import numpy as np
 from numba import njit
 
 
-
 @njit(cache=True)
 def incidence(items, n_vertices):
     """Which items (springs (E, 2) or triangles (T, 3)) each vertex is a corner of, as CSR:

@@ -574,3 +574,106 @@ def mark_rowed(vertex_row, b_start, c_start, gas_start, rowed):
     rowed |= b_start[1:] > b_start[:-1]
     rowed |= c_start[1:] > c_start[:-1]
     rowed |= gas_start[1:] > gas_start[:-1]
+
+
+@njit(cache=True)
+def update_rigid_rows(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner, beta, k_max):
+    """The dual step of the rows whose every vertex is a rigid body's (``rigid`` (N,) bool),
+    after each pass over the rigid blocks: a block is solved to the rows' current forces in
+    one Newton step, so its rows' multipliers can follow every pass, as the AVBD paper's
+    follow every iteration (once a step, a stack of ten boxes sank into itself and fell
+    over); the soft bodies' rows wait for the step's end (see :func:`update_rows`)."""
+    for k in range(count):
+        i = touch[k]
+        if rigid[i]:
+            fn, ft, gap, slip, mu = contact_forces(x, x_n, i, planes, state, k)
+            dual_step(state, k, fn, ft, gap, slip, mu, beta, k_max)
+    for c in range(n_body):
+        ip, ia, ib, s, nx, ny, target = body_row_parts(rs.bidx, rs.bgeo, c)
+        if rigid[ip] and rigid[ia] and rigid[ib]:
+            fn, ft, gap, slip, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, rs.bgeo, rs.bstate, c)
+            dual_step(rs.bstate, c, fn, ft, gap, slip, mu, beta, k_max)
+    for c in range(n_corner):
+        ia, ib = rs.cpairs[c, 0], rs.cpairs[c, 1]
+        if rigid[ia] and rigid[ib]:
+            fn, ft, gap, slip, mu = corner_row_forces(x, x_n, ia, ib, rs.cf, rs.cstate, c)
+            dual_step(rs.cstate, c, fn, ft, gap, slip, mu, beta, k_max)
+
+
+
+@njit(cache=True)
+def freeze_rigid_bounds(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner):
+    """The friction bound of each row whose every vertex is a rigid body's, before a pass over
+    the rigid blocks: ``mu`` times the row's normal force at the iterate, as the AVBD paper
+    bounds it. The last step's force (:func:`friction_bound`, for the soft bodies' sweeps)
+    bounds a landing by what the contact held before it was loaded: a box landing on a
+    slope it should stand on (tan a 0.36, static friction 0.5) slid on for good."""
+    for k in range(count):
+        i = touch[k]
+        if rigid[i]:
+            fn, _, _, _, mu = contact_forces(x, x_n, i, planes, state, k)
+            state[k, BOUND] = mu * fn
+    for c in range(n_body):
+        ip, ia, ib, s, nx, ny, target = body_row_parts(rs.bidx, rs.bgeo, c)
+        if rigid[ip] and rigid[ia] and rigid[ib]:
+            fn, _, _, _, mu = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, rs.bgeo, rs.bstate, c)
+            rs.bstate[c, BOUND] = mu * fn
+    for c in range(n_corner):
+        ia, ib = rs.cpairs[c, 0], rs.cpairs[c, 1]
+        if rigid[ia] and rigid[ib]:
+            fn, _, _, _, mu = corner_row_forces(x, x_n, ia, ib, rs.cf, rs.cstate, c)
+            rs.cstate[c, BOUND] = mu * fn
+
+
+@njit(cache=True, inline="always")
+def _impact_sticks(rvx, rvy, nx, ny, mu_static):
+    """Whether a contact whose relative velocity is ``rv`` (m/s, the body side less the
+    other, ``n`` toward the body side) holds by static friction this step: it slides slower
+    than :data:`STICK_SPEED`, or it comes in along ``n`` fast enough that the impulse
+    stopping it bounds a friction impulse that stops its slide too (``|v_t| <= mu_s v_in``,
+    Coulomb's law for an impact)."""
+    v_in = max(0.0, -(rvx * nx + rvy * ny))
+    return abs(-rvx * ny + rvy * nx) <= max(STICK_SPEED, mu_static * v_in)
+
+
+@njit(cache=True, inline="always")
+def _stiffen(state, k, k0):
+    state[k, K_N] = max(state[k, K_N], k0)
+    state[k, K_T] = max(state[k, K_T], k0)
+
+
+@njit(cache=True)
+def start_rigid_rows(rigid, k_rigid, v, touch, planes, state, count, rs, n_body, n_corner, h):
+    """Open the rows between rigid bodies and colliders (after the others': this overrides
+    two things). Their penalties start at least at ``k_rigid`` of their stiffest vertex
+    (N/m; the body's mass over ``h^2`` times the option ``penalty_start``: a rigid body's
+    vertex moves with the whole body behind it, and at its own mass a stack of boxes sank
+    into itself and fell). A row with a soft vertex keeps the soft side's start: stiffened
+    to the rigid body's, a jelly resting on a crate buzzed at 8 cm/s. And each row's
+    static-or-dynamic choice is :func:`_impact_sticks`': a box landing on a slope it should
+    stand on (tan a 0.95 of its static friction) came in sliding at 2.6 cm/s, the speed
+    alone gave it the dynamic coefficient, and it slid down for good."""
+    for k in range(count):
+        i = touch[k]
+        if rigid[i]:
+            _stiffen(state, k, k_rigid[i])
+            state[k, STICK] = 1.0 if _impact_sticks(v[i, 0] - planes[k, 5] / h, v[i, 1] - planes[k, 6] / h,
+                                                     planes[k, 0], planes[k, 1], planes[k, 3]) else 0.0
+    for c in range(n_body):
+        ip, ia, ib = rs.bidx[c, 0], rs.bidx[c, 1], rs.bidx[c, 2]
+        if rigid[ip] and rigid[ia] and rigid[ib]:
+            _stiffen(rs.bstate, c, max(k_rigid[ip], k_rigid[ia], k_rigid[ib]))
+            s = rs.bgeo[c, BODY_S]
+            rvx = v[ip, 0] - (1.0 - s) * v[ia, 0] - s * v[ib, 0]
+            rvy = v[ip, 1] - (1.0 - s) * v[ia, 1] - s * v[ib, 1]
+            rs.bstate[c, STICK] = 1.0 if _impact_sticks(rvx, rvy, rs.bgeo[c, BODY_NX], rs.bgeo[c, BODY_NY],
+                                                         rs.bgeo[c, BODY_STATIC]) else 0.0
+    for c in range(n_corner):
+        ia, ib = rs.cpairs[c, 0], rs.cpairs[c, 1]
+        if rigid[ia] and rigid[ib]:
+            _stiffen(rs.cstate, c, max(k_rigid[ia], k_rigid[ib]))
+            s, cf = rs.cf[c, CORNER_S], rs.cf
+            rvx = (1.0 - s) * v[ia, 0] + s * v[ib, 0] - cf[c, CORNER_MX] / h
+            rvy = (1.0 - s) * v[ia, 1] + s * v[ib, 1] - cf[c, CORNER_MY] / h
+            rs.cstate[c, STICK] = 1.0 if _impact_sticks(rvx, rvy, cf[c, CORNER_NX], cf[c, CORNER_NY],
+                                                         cf[c, CORNER_STATIC]) else 0.0

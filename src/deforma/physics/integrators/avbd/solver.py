@@ -16,6 +16,7 @@ or a body, option ``reach``: see :meth:`AVBD.step`)::
                 x_i -= H^-1 g
         for patch in patches: affine Newton step        # the coarse level
         for body: rigid Newton step with a line search
+        for rigid body: Newton step over its pose (x, y, angle) with a line search
         x = omega (x - x'') + x''                        # Chebyshev, if rho > 0
     rows: lambda = clamp(k C + lambda); k += beta |C| inside the bounds   # once a step
     v = (x - x_n) / h;  the collider fail-safe and the body contact stage
@@ -31,7 +32,8 @@ contacts it made them chatter.
 Between sweeps, patches of about ``cluster_size`` vertices each take a Newton step over their
 affine motions (:mod:`~deforma.physics.integrators.avbd.clusters`, a coarse level that moves a
 correction a patch per visit), and every body without a pin one over its rigid motions
-(:func:`rigid_correction`).
+(:func:`~deforma.physics.integrators.avbd.rigid.rigid_correction`). A rigid body is
+one block of three degrees of freedom, its pose (:mod:`~deforma.physics.integrators.avbd.rigid`).
 
 Contacts are found once, before the solve, for the predicted motion: a vertex against a
 collider, and a vertex against an outline edge of another body or its own. Each is a row
@@ -63,6 +65,7 @@ from ...contact.response import hold_start_distance
 from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
 from ...jit import serial_and_parallel
+from ...rigid.stage import rigid_set
 from ...rigid_motion import linear_and_angular_velocity, rigid_velocities
 from ...topology import lengths
 from ..base import (
@@ -78,35 +81,30 @@ from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .gas import gas_areas, gas_block, gas_moved, gas_set
+from .rigid import rigid_blocks, rigid_correction, rigid_place, rigid_rates, rigid_sweep, rigid_targets
 from .rows import (
     BODY_COLUMNS,
-    BOUND,
-    K_N,
-    K_T,
-    LAM_N,
-    LAM_T,
     MEMORY_COLUMNS,
     ROW_COLUMNS,
     RowSet,
     body_row_incidence,
-    body_row_parts,
     close_body_rows,
     close_corner_rows,
     close_rows,
-    contact_energy,
-    corner_row_forces_at,
     corner_row_incidence,
     freeze_body_bounds,
     freeze_bounds,
     freeze_corner_bounds,
+    freeze_rigid_bounds,
     mark_rowed,
     row_blocks,
-    row_energy,
     start_body_rows,
     start_corner_rows,
+    start_rigid_rows,
     start_rows,
     update_body_rows,
     update_corner_rows,
+    update_rigid_rows,
     update_rows,
 )
 
@@ -384,160 +382,6 @@ def chebyshev(x, x_prev, x_prev2, inv_mass, vertex_row, omega):
         x_prev[i, 0], x_prev[i, 1] = x[i, 0], x[i, 1]
 
 
-@njit(cache=True)
-def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_pull, rs):
-    """Move each body as a whole by the Newton step of the objective over its rigid motions.
-
-    A vertex sweep moves a stiff body's rigid modes slowly: each vertex is held by its
-    elements (stiffness ~ E) while the inertia pulls with only ``m / h^2``, so a block
-    sliding down a frictionless slope took 2 % of ``g sin a`` in ten sweeps. Over a rigid
-    motion (a translation ``d`` and a turn ``theta`` about the centre of mass) the elements'
-    energy does not change, so the objective there is the inertia's, the grabs' and the
-    contact rows' alone: its gradient ``(sum g_i, sum r_i x g_i)`` and 3 x 3 Hessian ``sum
-    J_i^T H_i J_i`` (``J_i = [I | perp(r_i)]``) cost one pass over the vertices, and one
-    Newton step solves the rigid modes as well as the iterate allows. Without outside
-    forces it makes ``sum m (x - y) = 0``: the step keeps the body's momentum. A body with a
-    pinned vertex does not move as a whole."""
-    for body in range(body_start.shape[0] - 1):
-        lo, hi = body_start[body], body_start[body + 1]
-        sm = cx = cy = 0.0
-        pinned = False
-        for i in range(lo, hi):
-            if inv_mass[i] == 0.0:
-                pinned = True
-                break
-            m = mass_h2[i]
-            sm += m
-            cx += m * x[i, 0]
-            cy += m * x[i, 1]
-        if pinned or sm == 0.0:
-            continue
-        cx /= sm
-        cy /= sm
-        g0 = g1 = g2 = 0.0
-        a00 = a01 = a02 = a11 = a12 = a22 = 0.0
-        for i in range(lo, hi):
-            # the rows' gradient where they are, and their stiffness whether they push now or
-            # not: a row that starts to push within the step bounds the step (with only the
-            # active rows a resting block rocked on its warm-started contacts)
-            gx, gy, hxx, hxy, hyy = outer_block(x, y, i, mass_h2, grab_slot, grab_pull)
-            if rs.rowed[i]:
-                ex, ey, exx, exy, eyy = row_blocks(x, x_n, i, rs, True)
-                gx += ex
-                gy += ey
-                hxx += exx
-                hxy += exy
-                hyy += eyy
-            # J = [[1, 0, -ry], [0, 1, rx]]
-            rx, ry = x[i, 0] - cx, x[i, 1] - cy
-            g0 += gx
-            g1 += gy
-            g2 += rx * gy - ry * gx
-            a00 += hxx
-            a01 += hxy
-            a11 += hyy
-            a02 += -hxx * ry + hxy * rx
-            a12 += -hxy * ry + hyy * rx
-            a22 += hxx * ry * ry - 2.0 * hxy * rx * ry + hyy * rx * rx
-        # solve the 3 x 3 system A d = -g (symmetric positive definite: A includes sum m / h^2)
-        c00 = a11 * a22 - a12 * a12
-        c01 = a02 * a12 - a01 * a22
-        c02 = a01 * a12 - a02 * a11
-        det = a00 * c00 + a01 * c01 + a02 * c02
-        if not det > 0.0:
-            continue
-        c11 = a00 * a22 - a02 * a02
-        c12 = a01 * a02 - a00 * a12
-        c22 = a00 * a11 - a01 * a01
-        dx = -(c00 * g0 + c01 * g1 + c02 * g2) / det
-        dy = -(c01 * g0 + c11 * g1 + c12 * g2) / det
-        th = -(c02 * g0 + c12 * g1 + c22 * g2) / det
-        # Backtracking on the objective: the rows are piecewise quadratic, and a full Newton
-        # step across their kinks rocked a block on the floor from step to step until it
-        # walked off sideways. The turn is exact (a rotation, not its linearisation, leaves
-        # the elements unstrained, so they need no part in the test).
-        slope = g0 * dx + g1 * dy + g2 * th
-        if not slope < 0.0:
-            continue
-        e0 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
-                          0.0, 0.0, 0.0)
-        t = 1.0
-        while t > 1e-3:
-            e1 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
-                              t * dx, t * dy, t * th)
-            if e1 <= e0 + 1e-4 * t * slope + 1e-12 * abs(e0):  # (rounding: a step too small to measure is taken)
-                break
-            t *= 0.5
-        if t <= 1e-3:
-            continue
-        co, si = np.cos(t * th), np.sin(t * th)
-        for i in range(lo, hi):
-            rx, ry = x[i, 0] - cx, x[i, 1] - cy
-            x[i, 0] = cx + t * dx + co * rx - si * ry
-            x[i, 1] = cy + t * dy + si * rx + co * ry
-
-
-@njit(cache=True, inline="always")
-def _moved(x, v, lo, hi, cx, cy, dx, dy, co, si):
-    """Vertex ``v`` turned about ``(cx, cy)`` and shifted if it is one of ``lo:hi``."""
-    if lo <= v < hi:
-        ux, uy = x[v, 0] - cx, x[v, 1] - cy
-        return cx + dx + co * ux - si * uy, cy + dy + si * ux + co * uy
-    return x[v, 0], x[v, 1]
-
-
-@njit(cache=True)
-def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, dx, dy, th):
-    """The objective's inertia, grab and contact-row part (J) over the vertices ``lo:hi`` moved
-    as a whole: turned by ``th`` about ``(cx, cy)`` and shifted by ``(dx, dy)``."""
-    co, si = np.cos(th), np.sin(th)
-    e = 0.0
-    for i in range(lo, hi):
-        rx, ry = x[i, 0] - cx, x[i, 1] - cy
-        px = cx + dx + co * rx - si * ry
-        py = cy + dy + si * rx + co * ry
-        e += 0.5 * mass_h2[i] * ((px - y[i, 0]) ** 2 + (py - y[i, 1]) ** 2)
-        s = grab_slot[i]
-        if s >= 0:
-            tx, ty = grab_pull[s, 1] / grab_pull[s, 0], grab_pull[s, 2] / grab_pull[s, 0]
-            e += 0.5 * grab_pull[s, 0] * ((px - tx) ** 2 + (py - ty) ** 2)
-        k = rs.vertex_row[i]
-        if k >= 0:
-            e += contact_energy(px, py, x_n, i, rs.planes, rs.rows, k)
-        # body rows, each once (at its first vertex in the body), with its vertices in the
-        # body moved and the others where they are
-        for p in range(rs.b_start[i], rs.b_start[i + 1]):
-            c = rs.b_entry[p] // 3
-            ip, ia, ib, s, nx, ny, target = body_row_parts(rs.bidx, rs.bgeo, c)
-            first = ip if lo <= ip < hi else (ia if lo <= ia < hi else ib)
-            if first != i:
-                continue
-            p0x, p0y = _moved(x, ip, lo, hi, cx, cy, dx, dy, co, si)
-            p1x, p1y = _moved(x, ia, lo, hi, cx, cy, dx, dy, co, si)
-            p2x, p2y = _moved(x, ib, lo, hi, cx, cy, dx, dy, co, si)
-            ca = 1.0 - s
-            gap = (p0x - ca * p1x - s * p2x) * nx + (p0y - ca * p1y - s * p2y) * ny - target
-            st = rs.bstate
-            fn = max(0.0, st[c, LAM_N] - st[c, K_N] * gap)
-            rx = (p0x - x_n[ip, 0]) - ca * (p1x - x_n[ia, 0]) - s * (p2x - x_n[ib, 0])
-            ry = (p0y - x_n[ip, 1]) - ca * (p1y - x_n[ia, 1]) - s * (p2y - x_n[ib, 1])
-            ft = st[c, LAM_T] - st[c, K_T] * (-rx * ny + ry * nx)
-            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
-        # corner rows, each once (at its first end in the body)
-        for p in range(rs.c_start[i], rs.c_start[i + 1]):
-            c = rs.c_entry[p] // 2
-            ia, ib = rs.cpairs[c, 0], rs.cpairs[c, 1]
-            if ia != i and lo <= ia < hi:
-                continue
-            pax, pay = _moved(x, ia, lo, hi, cx, cy, dx, dy, co, si)
-            pbx, pby = _moved(x, ib, lo, hi, cx, cy, dx, dy, co, si)
-            st = rs.cstate
-            fn, ft, _, _, _ = corner_row_forces_at(pax, pay, pbx, pby, x_n[ia, 0], x_n[ia, 1], x_n[ib, 0], x_n[ib, 1],
-                                                   rs.cf, st, c)
-            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
-    return e
-
-
 def deepest_strain_reach(x, v, mass, body_start, size, h) -> float:
     """How far the bodies' deformation moves a vertex in ``h`` s, as a multiple of its
     ``size`` (m), at most over the vertices: its velocity less its body's rigid motion
@@ -618,6 +462,7 @@ class AVBD(Integrator):
     name = "avbd"
     unconditionally_stable = True
     solves_pressure = True  # the gas's energy is in the vertex blocks (avbd.gas)
+    solves_rigid = True  # a rigid body is a block of the sweep (avbd.rigid)
     OPTIONS = (Option("iterations", 10, "int", low=1, high=10_000, doc="sweeps per step (the most, with tolerance)"),
                Option("reach", 0.5, "float", low=0.0, high=1e6, closed_low=True,
                       doc="split a step into parts where it moves a vertex into a contact further than this "
@@ -635,6 +480,8 @@ class AVBD(Integrator):
                Option("penalty_ramp", 1e5, "float", low=0.0, high=1e15, closed_low=True,
                       doc="penalty growth per metre of violation, once a step (N/m^2)"),
                Option("penalty_max", 1e10, "float", low=0.0, high=1e18, doc="the stiffest a contact row gets (N/m)"),
+               Option("rigid_passes", 4, "int", low=1, high=1000,
+                      doc="passes over the rigid bodies' blocks per sweep, each with their rows' dual step"),
                Option("mode", "auto", "choice", choices=("auto", "serial", "parallel"), doc=MODE_OPTION_DOC))
 
     #: the most parts a step is split into where it reaches deep into its contacts
@@ -665,6 +512,7 @@ class AVBD(Integrator):
         self._corner_memory = None
         self._n_corner = 0
         self._gas = None  # (model, GasSet)
+        self._rigid = None  # (model, RigidBlocks or None, per-vertex body mass or None)
         self._driver = DriverChoice()  # which sweep build runs (option mode)
         self._n = -1
         self._size = None
@@ -806,6 +654,10 @@ class AVBD(Integrator):
                 had_last = self._has_last
                 predict(x, v, self._x_n, self._y, self._v_last, self._has_last, inv_mass, gx, gy, keep,
                         control.force, control.has_force, hs)
+                blocks, body_mass = self._rigid_blocks(model)
+                if blocks is not None:
+                    rigid_targets(x, v, self._x_n, self._y, model.vertex_mass, blocks, gx, gy, keep, control.force,
+                                  control.has_force, hs)
                 self._has_last = True
                 x_n = self._x_n
                 # collide once, before the solve: the collider contacts and the body contacts of
@@ -844,14 +696,21 @@ class AVBD(Integrator):
                 start_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows, k_start,
                            self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, hs)
                 rs = self._body_rows(model, ctopo, found, n_body, k_start, v)
+                if blocks is not None:
+                    start_rigid_rows(model.rigid, opts["penalty_start"] * body_mass / (hs * hs), v, self._touch,
+                                     self._planes, self._rows, count, rs, n_body, self._n_corner, hs)
                 self._solve(model, topo, control, x, anchor, mass_h2, inv_mass, count, n_body, rs, hd,
                             opts["tolerance"] * hs)
+                if blocks is not None:
+                    rigid_rates(blocks, hs)
                 close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
                 close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
                 close_corner_rows(self._cpairs, self._n_corner, self._corner_memory[0], self._cstate)
                 self.active_contacts = count + n_body + self._n_corner
                 solved = x.copy() if free else None
                 bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, hs, vmax2)
+                if blocks is not None:
+                    rigid_place(x, x_n, v, blocks)
                 if bad:
                     self._history = False
                     return StepReport(int(bad), contacts.complete)
@@ -868,6 +727,10 @@ class AVBD(Integrator):
                                     hits, hs, True) < 0:
                     self._history = False
                     return StepReport(0, False)
+                if blocks is not None:
+                    # the contact stage holds a rigid body's vertices (no inverse mass there)
+                    # but its fail-safe may put one back where it began: the body stays whole
+                    rigid_place(x, x_n, v, blocks)
                 self.failsafe += not np.array_equal(x, collided)
                 if free:
                     second_order_velocities(x, v, anchor, solved, self._held, inv_mass, hs)
@@ -878,6 +741,23 @@ class AVBD(Integrator):
                     np.copyto(self._v_end, v)
                     self._history = hs if parts == 1 else False
         return StepReport(0, contacts.complete)
+
+    def _rigid_blocks(self, model):
+        """``(blocks, body_mass)``: the rigid bodies as blocks of the sweep
+        (:func:`~deforma.physics.integrators.avbd.rigid.rigid_blocks`) and per vertex its rigid
+        body's mass (kg), or ``(None, None)`` without rigid bodies; once per Model and version
+        (a pin holds a rigid body whole)."""
+        key = (model, model.version)
+        if self._rigid is None or self._rigid[0] is not model or self._rigid[1] != key[1]:
+            blocks = body_mass = None
+            if model.n_vertices and model.rigid.any():
+                blocks = rigid_blocks(model, rigid_set(model))
+                body_mass = np.zeros(model.n_vertices)
+                for a, b, m in zip(blocks.lo, blocks.hi, blocks.mass):
+                    body_mass[a:b] = m
+                self._zeros = np.zeros(model.n_vertices)
+            self._rigid = (*key, blocks, body_mass)
+        return self._rigid[2], self._rigid[3]
 
     def _edge_size(self, model):
         """Per vertex, its shortest edge in its body's rest shape (m), once per Model (measured
@@ -993,6 +873,7 @@ class AVBD(Integrator):
     def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
         opts = self._options
+        blocks = self._rigid[2]
         rho = opts["chebyshev"]
         _, t_start, t_item, t_corner, s_start, s_item, s_corner, order, starts = topo
         inv_h = 1.0 / h
@@ -1033,6 +914,17 @@ class AVBD(Integrator):
                               control.grab_slot, control.grab_pull, rs, inv_h)
             rigid_correction(x, x_n, y, mass_h2, inv_mass, model.body_vertex_offsets, control.grab_slot,
                              control.grab_pull, rs)
+            if blocks is not None:
+                # the rigid blocks' passes, each followed by their rows' dual step (the last
+                # sweep's last is every row's, below)
+                for pass_ in range(opts["rigid_passes"]):
+                    freeze_rigid_bounds(x, x_n, model.rigid, self._touch, self._planes, self._rows, count, rs, n_body,
+                                        self._n_corner)
+                    most = max(most, rigid_sweep(x, x_n, self._zeros, blocks, control.grab_slot, control.grab_pull,
+                                                 rs, h))
+                    if it < sweeps - 1 or pass_ < opts["rigid_passes"] - 1:
+                        update_rigid_rows(x, x_n, model.rigid, self._touch, self._planes, self._rows, count, rs,
+                                          n_body, self._n_corner, opts["penalty_ramp"], opts["penalty_max"])
             if rho > 0.0:
                 omega = chebyshev_omega(it, rho, omega)
                 chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)

@@ -1,0 +1,488 @@
+"""Rigid bodies as blocks of the avbd sweep (Giles, Diaz, Yuksel, "Augmented Vertex Block
+Descent", SIGGRAPH 2025: a rigid body is one block of three degrees of freedom).
+
+A rigid body (``Material("rigid")``) keeps its vertices in the State, but in the sweep they
+move as one: its block is its pose ``q = (c, phi)``, ``c`` its centre of mass and ``phi`` how
+far it has turned since the substep began, and its vertices are placed at
+
+    x_i = c + R(phi) (x_n,i - c_n)
+
+(``c_n`` the centre at the start). Its share of backward Euler's objective is
+
+    M / 2h^2 |c - c~|^2 + I / 2h^2 (phi - phi~)^2 + its grabs + its vertices' contact rows
+
+with ``c~ = c_n + h v + h^2 (g + F / M)`` and ``phi~ = h omega + h^2 tau / I`` (``F``, ``tau``
+the applied forces' total and moment): the true mass and moment of inertia of its
+triangles (:func:`~deforma.physics.rigid.bodies.triangle_inertia`), not its vertices'
+lumped ones. A block's step is one Newton step over ``q``: the rows' gradients and
+stiffnesses at its vertices carried by ``J_i = [I | perp(x_i - c)]``, the 3 x 3 system solved,
+and a backtracking line search on the objective (the rows are piecewise quadratic: across
+their kinks a full step rocked a block on its contacts). Without rows or grabs one step
+lands exactly on the inertial pose: a free body keeps its momentum and spin to rounding.
+
+A rigid body's outline is an outline like any body's: its vertices meet other bodies'
+edges, and others' vertices its edges, as the same rows (:mod:`~deforma.physics.integrators.avbd.rows`),
+so soft and rigid bodies, rigid and rigid, and rigid and colliders share one contact model
+and one sweep. After the sweeps its vertices' velocities are the pose's rate, ``v_i =
+(c - c_n) / h + (phi / h) perp(x_i - c)``: read back, the body's spin is exactly ``phi / h``.
+
+A rigid body with a pinned vertex is held as a whole (it stands as a collider would).
+
+Units: m, kg, s, rad; N, N/m.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from ...colliders.response import CORNER_NX, CORNER_NY, CORNER_S
+from .blocks import outer_block
+from .rows import (
+    BOUND,
+    K_N,
+    K_T,
+    LAM_N,
+    LAM_T,
+    body_row_forces,
+    body_row_parts,
+    contact_energy,
+    contact_forces,
+    corner_row_forces,
+    corner_row_forces_at,
+    row_blocks,
+    row_energy,
+)
+
+
+@njit(cache=True)
+def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_pull, rs):
+    """Move each body as a whole by the Newton step of the objective over its rigid motions.
+
+    A vertex sweep moves a stiff body's rigid modes slowly: each vertex is held by its
+    elements (stiffness ~ E) while the inertia pulls with only ``m / h^2``, so a block
+    sliding down a frictionless slope took 2 % of ``g sin a`` in ten sweeps. Over a rigid
+    motion (a translation ``d`` and a turn ``theta`` about the centre of mass) the elements'
+    energy does not change, so the objective there is the inertia's, the grabs' and the
+    contact rows' alone: its gradient ``(sum g_i, sum r_i x g_i)`` and 3 x 3 Hessian ``sum
+    J_i^T H_i J_i`` (``J_i = [I | perp(r_i)]``) cost one pass over the vertices, and one
+    Newton step solves the rigid modes as well as the iterate allows. Without outside
+    forces it makes ``sum m (x - y) = 0``: the step keeps the body's momentum. A body with a
+    pinned vertex does not move as a whole."""
+    for body in range(body_start.shape[0] - 1):
+        lo, hi = body_start[body], body_start[body + 1]
+        sm = cx = cy = 0.0
+        pinned = False
+        for i in range(lo, hi):
+            if inv_mass[i] == 0.0:
+                pinned = True
+                break
+            m = mass_h2[i]
+            sm += m
+            cx += m * x[i, 0]
+            cy += m * x[i, 1]
+        if pinned or sm == 0.0:
+            continue
+        cx /= sm
+        cy /= sm
+        g0 = g1 = g2 = 0.0
+        a00 = a01 = a02 = a11 = a12 = a22 = 0.0
+        for i in range(lo, hi):
+            # the rows' gradient where they are, and their stiffness whether they push now or
+            # not: a row that starts to push within the step bounds the step (with only the
+            # active rows a resting block rocked on its warm-started contacts)
+            gx, gy, hxx, hxy, hyy = outer_block(x, y, i, mass_h2, grab_slot, grab_pull)
+            if rs.rowed[i]:
+                ex, ey, exx, exy, eyy = row_blocks(x, x_n, i, rs, True)
+                gx += ex
+                gy += ey
+                hxx += exx
+                hxy += exy
+                hyy += eyy
+            # J = [[1, 0, -ry], [0, 1, rx]]
+            rx, ry = x[i, 0] - cx, x[i, 1] - cy
+            g0 += gx
+            g1 += gy
+            g2 += rx * gy - ry * gx
+            a00 += hxx
+            a01 += hxy
+            a11 += hyy
+            a02 += -hxx * ry + hxy * rx
+            a12 += -hxy * ry + hyy * rx
+            a22 += hxx * ry * ry - 2.0 * hxy * rx * ry + hyy * rx * rx
+        # solve the 3 x 3 system A d = -g (symmetric positive definite: A includes sum m / h^2)
+        c00 = a11 * a22 - a12 * a12
+        c01 = a02 * a12 - a01 * a22
+        c02 = a01 * a12 - a02 * a11
+        det = a00 * c00 + a01 * c01 + a02 * c02
+        if not det > 0.0:
+            continue
+        c11 = a00 * a22 - a02 * a02
+        c12 = a01 * a02 - a00 * a12
+        c22 = a00 * a11 - a01 * a01
+        dx = -(c00 * g0 + c01 * g1 + c02 * g2) / det
+        dy = -(c01 * g0 + c11 * g1 + c12 * g2) / det
+        th = -(c02 * g0 + c12 * g1 + c22 * g2) / det
+        # Backtracking on the objective: the rows are piecewise quadratic, and a full Newton
+        # step across their kinks rocked a block on the floor from step to step until it
+        # walked off sideways. The turn is exact (a rotation, not its linearisation, leaves
+        # the elements unstrained, so they need no part in the test).
+        slope = g0 * dx + g1 * dy + g2 * th
+        if not slope < 0.0:
+            continue
+        e0 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
+                          0.0, 0.0, 0.0)
+        t = 1.0
+        while t > 1e-3:
+            e1 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
+                              t * dx, t * dy, t * th)
+            if e1 <= e0 + 1e-4 * t * slope + 1e-12 * abs(e0):  # (rounding: a step too small to measure is taken)
+                break
+            t *= 0.5
+        if t <= 1e-3:
+            continue
+        co, si = np.cos(t * th), np.sin(t * th)
+        for i in range(lo, hi):
+            rx, ry = x[i, 0] - cx, x[i, 1] - cy
+            x[i, 0] = cx + t * dx + co * rx - si * ry
+            x[i, 1] = cy + t * dy + si * rx + co * ry
+
+
+@njit(cache=True, inline="always")
+def _moved(x, v, lo, hi, cx, cy, dx, dy, co, si):
+    """Vertex ``v`` turned about ``(cx, cy)`` and shifted if it is one of ``lo:hi``."""
+    if lo <= v < hi:
+        ux, uy = x[v, 0] - cx, x[v, 1] - cy
+        return cx + dx + co * ux - si * uy, cy + dy + si * ux + co * uy
+    return x[v, 0], x[v, 1]
+
+
+@njit(cache=True)
+def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, dx, dy, th):
+    """The objective's inertia, grab and contact-row part (J) over the vertices ``lo:hi`` moved
+    as a whole: turned by ``th`` about ``(cx, cy)`` and shifted by ``(dx, dy)``."""
+    co, si = np.cos(th), np.sin(th)
+    e = 0.0
+    for i in range(lo, hi):
+        rx, ry = x[i, 0] - cx, x[i, 1] - cy
+        px = cx + dx + co * rx - si * ry
+        py = cy + dy + si * rx + co * ry
+        e += 0.5 * mass_h2[i] * ((px - y[i, 0]) ** 2 + (py - y[i, 1]) ** 2)
+        s = grab_slot[i]
+        if s >= 0:
+            tx, ty = grab_pull[s, 1] / grab_pull[s, 0], grab_pull[s, 2] / grab_pull[s, 0]
+            e += 0.5 * grab_pull[s, 0] * ((px - tx) ** 2 + (py - ty) ** 2)
+        k = rs.vertex_row[i]
+        if k >= 0:
+            e += contact_energy(px, py, x_n, i, rs.planes, rs.rows, k)
+        # body rows, each once (at its first vertex in the body), with its vertices in the
+        # body moved and the others where they are
+        for p in range(rs.b_start[i], rs.b_start[i + 1]):
+            c = rs.b_entry[p] // 3
+            ip, ia, ib, s, nx, ny, target = body_row_parts(rs.bidx, rs.bgeo, c)
+            first = ip if lo <= ip < hi else (ia if lo <= ia < hi else ib)
+            if first != i:
+                continue
+            p0x, p0y = _moved(x, ip, lo, hi, cx, cy, dx, dy, co, si)
+            p1x, p1y = _moved(x, ia, lo, hi, cx, cy, dx, dy, co, si)
+            p2x, p2y = _moved(x, ib, lo, hi, cx, cy, dx, dy, co, si)
+            ca = 1.0 - s
+            gap = (p0x - ca * p1x - s * p2x) * nx + (p0y - ca * p1y - s * p2y) * ny - target
+            st = rs.bstate
+            fn = max(0.0, st[c, LAM_N] - st[c, K_N] * gap)
+            rx = (p0x - x_n[ip, 0]) - ca * (p1x - x_n[ia, 0]) - s * (p2x - x_n[ib, 0])
+            ry = (p0y - x_n[ip, 1]) - ca * (p1y - x_n[ia, 1]) - s * (p2y - x_n[ib, 1])
+            ft = st[c, LAM_T] - st[c, K_T] * (-rx * ny + ry * nx)
+            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
+        # corner rows, each once (at its first end in the body)
+        for p in range(rs.c_start[i], rs.c_start[i + 1]):
+            c = rs.c_entry[p] // 2
+            ia, ib = rs.cpairs[c, 0], rs.cpairs[c, 1]
+            if ia != i and lo <= ia < hi:
+                continue
+            pax, pay = _moved(x, ia, lo, hi, cx, cy, dx, dy, co, si)
+            pbx, pby = _moved(x, ib, lo, hi, cx, cy, dx, dy, co, si)
+            st = rs.cstate
+            fn, ft, _, _, _ = corner_row_forces_at(pax, pay, pbx, pby, x_n[ia, 0], x_n[ia, 1], x_n[ib, 0], x_n[ib, 1],
+                                                   rs.cf, st, c)
+            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
+    return e
+
+
+
+#: The rigid bodies of a Model as the sweep reads them: vertex ranges ``lo``, ``hi`` (K,),
+#: mass (kg) and moment of inertia about the centre of mass (kg m^2) (K,), ``held`` (K,)
+#: (a pinned vertex), and per substep the start centre ``c_n`` (K, 2), the inertial target
+#: ``target`` (K, 3: c~, phi~), the pose ``pose`` (K, 3: c, phi) and the velocities it
+#: ended the substep with, ``rate`` (K, 3: m/s, m/s, rad/s).
+RigidBlocks = namedtuple("RigidBlocks", ["lo", "hi", "mass", "inertia", "held", "c_n", "target", "pose", "rate"])
+
+
+def rigid_blocks(model, rigid_set) -> RigidBlocks:
+    """The rigid bodies of ``model`` as blocks (``rigid_set``: its
+    :class:`~deforma.physics.rigid.bodies.RigidSet`)."""
+    off = model.body_vertex_offsets
+    bodies = rigid_set.bodies
+    lo, hi = off[bodies].astype(np.int64), off[bodies + 1].astype(np.int64)
+    held = np.array([model.pinned[a:b].any() for a, b in zip(lo, hi)], np.bool_)
+    # the vertices' lumped masses sum to the body's (density times area): its momentum is
+    # theirs
+    mass = np.array([model.vertex_mass[a:b].sum() for a, b in zip(lo, hi)], np.float64)
+    k = len(bodies)
+    return RigidBlocks(lo, hi, mass, rigid_set.inertia.astype(np.float64), held, np.zeros((k, 2)),
+                       np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)))
+
+
+@njit(cache=True, inline="always")
+def _place(x, x_n, a, b, cnx, cny, cx, cy, phi):
+    """Put vertices ``a:b`` at the pose ``(cx, cy, phi)`` from where they began, about ``(cnx, cny)``."""
+    co, si = np.cos(phi), np.sin(phi)
+    for i in range(a, b):
+        rx, ry = x_n[i, 0] - cnx, x_n[i, 1] - cny
+        x[i, 0] = cx + co * rx - si * ry
+        x[i, 1] = cy + si * rx + co * ry
+
+
+@njit(cache=True)
+def rigid_targets(x, v, x_n, y, vertex_mass, blocks, gx, gy, keep, force, has_force, h):
+    """Start a substep for the rigid bodies (after :func:`~deforma.physics.integrators.avbd.solver.predict`,
+    which left their vertices where they were): each body's centre ``c_n``, its inertial
+    target (``blocks.target``), its vertices' targets ``y`` at that pose (what the collision
+    stage sees of its motion), and its pose started where its velocity alone takes it."""
+    h2 = h * h
+    for k in range(blocks.lo.shape[0]):
+        a, b = blocks.lo[k], blocks.hi[k]
+        sm = cx = cy = px = py = 0.0
+        for i in range(a, b):
+            m = vertex_mass[i]
+            sm += m
+            cx += m * x_n[i, 0]
+            cy += m * x_n[i, 1]
+            px += m * v[i, 0]
+            py += m * v[i, 1]
+        cx /= sm
+        cy /= sm
+        vx, vy = px / sm, py / sm
+        moment = spin = fx = fy = tau = 0.0
+        for i in range(a, b):
+            m = vertex_mass[i]
+            rx, ry = x_n[i, 0] - cx, x_n[i, 1] - cy
+            moment += m * (rx * rx + ry * ry)
+            spin += m * (rx * (v[i, 1] - vy) - ry * (v[i, 0] - vx))
+            if has_force:
+                fx += force[i, 0]
+                fy += force[i, 1]
+                tau += rx * force[i, 1] - ry * force[i, 0]
+        omega = spin / moment if moment > 0.0 else 0.0
+        blocks.c_n[k, 0], blocks.c_n[k, 1] = cx, cy
+        t = blocks.target
+        p = blocks.pose
+        if blocks.held[k]:
+            t[k, 0], t[k, 1], t[k, 2] = cx, cy, 0.0
+        else:
+            t[k, 0] = cx + h * keep * vx + h2 * keep * (gx + fx / blocks.mass[k])
+            t[k, 1] = cy + h * keep * vy + h2 * keep * (gy + fy / blocks.mass[k])
+            t[k, 2] = h * keep * omega + h2 * keep * tau / blocks.inertia[k]
+        _place(y, x_n, a, b, cx, cy, t[k, 0], t[k, 1], t[k, 2])
+        if blocks.held[k]:
+            p[k, 0], p[k, 1], p[k, 2] = cx, cy, 0.0
+        else:
+            p[k, 0], p[k, 1], p[k, 2] = cx + h * keep * vx, cy + h * keep * vy, h * keep * omega
+        _place(x, x_n, a, b, cx, cy, p[k, 0], p[k, 1], p[k, 2])
+
+
+@njit(cache=True, inline="always")
+def _inertia_energy(blocks, k, cx, cy, phi, inv_h2):
+    t = blocks.target
+    return 0.5 * inv_h2 * (blocks.mass[k] * ((cx - t[k, 0]) ** 2 + (cy - t[k, 1]) ** 2)
+                           + blocks.inertia[k] * (phi - t[k, 2]) ** 2)
+
+
+@njit(cache=True, inline="always")
+def _add_row(acc, fn, ft, kn, kt, bound, nx, ny, w, wr_n, wr_t):
+    """Add a row to a rigid block's gradient and Hessian ``acc`` (g0, g1, g2, a00, a01, a02,
+    a11, a12, a22): its normal force ``fn``, unclamped friction ``ft`` bounded by ``bound``,
+    penalties, normal ``n``, and how the body's pose moves its distance: ``w`` (the sum of
+    its vertices' weights in the row) along ``n``, and ``wr_n``, ``wr_t`` the weighted moments
+    ``sum w r x n`` and ``sum w r x t`` (``r`` from the centre, ``t = perp(n)``). The
+    normal stiffness counts whether the row pushes now or not (a row that starts to push
+    within the step bounds it), the friction's only while it sticks."""
+    tx, ty = -ny, nx
+    jn0, jn1, jn2 = w * nx, w * ny, wr_n
+    jt0, jt1, jt2 = w * tx, w * ty, wr_t
+    if fn <= 0.0:
+        fn = ft = kt = 0.0
+    elif abs(ft) >= bound:
+        ft = bound if ft > 0.0 else -bound
+        kt = 0.0
+    acc[0] -= fn * jn0 + ft * jt0
+    acc[1] -= fn * jn1 + ft * jt1
+    acc[2] -= fn * jn2 + ft * jt2
+    acc[3] += kn * jn0 * jn0 + kt * jt0 * jt0
+    acc[4] += kn * jn0 * jn1 + kt * jt0 * jt1
+    acc[5] += kn * jn0 * jn2 + kt * jt0 * jt2
+    acc[6] += kn * jn1 * jn1 + kt * jt1 * jt1
+    acc[7] += kn * jn1 * jn2 + kt * jt1 * jt2
+    acc[8] += kn * jn2 * jn2 + kt * jt2 * jt2
+
+
+@njit(cache=True, inline="always")
+def _share(x, v, a, b, w, cx, cy, nx, ny, sums):
+    """Add vertex ``v``'s weight ``w`` in a row to ``sums`` (w, w r x n, w r x t) if it is one
+    of the body's ``a:b``."""
+    if a <= v < b:
+        rx, ry = x[v, 0] - cx, x[v, 1] - cy
+        sums[0] += w
+        sums[1] += w * (rx * ny - ry * nx)
+        sums[2] += w * (rx * nx + ry * ny)  # r x t with t = (-ny, nx)
+
+
+@njit(cache=True)
+def block_rows(x, x_n, a, b, cx, cy, grab_slot, grab_pull, rs, acc):
+    """The gradient and Hessian over a rigid body's pose (vertices ``a:b``, centre ``(cx,
+    cy)``) of its grabs and contact rows, into ``acc`` (see :func:`_add_row`). A row between
+    two of its own vertices (an edge of its outline) is counted once with the moments of
+    both: summed vertex by vertex, its stiffness lost the cross terms and a box met on an
+    edge's middle took half of it."""
+    for j in range(9):
+        acc[j] = 0.0
+    sums = np.zeros(3)
+    for i in range(a, b):
+        s = grab_slot[i]
+        rx, ry = x[i, 0] - cx, x[i, 1] - cy
+        if s >= 0:  # a zero-length spring of strength S to the target
+            k = grab_pull[s, 0]
+            gx, gy = k * x[i, 0] - grab_pull[s, 1], k * x[i, 1] - grab_pull[s, 2]
+            acc[0] += gx
+            acc[1] += gy
+            acc[2] += rx * gy - ry * gx
+            acc[3] += k
+            acc[5] += -k * ry
+            acc[6] += k
+            acc[7] += k * rx
+            acc[8] += k * (rx * rx + ry * ry)
+        if not rs.rowed[i]:
+            continue
+        k = rs.vertex_row[i]
+        if k >= 0:  # against a collider: this vertex alone
+            fn, ft, _, _, _ = contact_forces(x, x_n, i, rs.planes, rs.rows, k)
+            nx, ny = rs.planes[k, 0], rs.planes[k, 1]
+            st = rs.rows
+            _add_row(acc, fn, ft, st[k, K_N], st[k, K_T], st[k, BOUND], nx, ny, 1.0, rx * ny - ry * nx,
+                     rx * nx + ry * ny)
+        for p in range(rs.b_start[i], rs.b_start[i + 1]):
+            c = rs.b_entry[p] // 3
+            ip, ia, ib, s, nx, ny, target = body_row_parts(rs.bidx, rs.bgeo, c)
+            if (ip if a <= ip < b else (ia if a <= ia < b else ib)) != i:
+                continue  # each row once, at its first vertex in the body
+            sums[0] = sums[1] = sums[2] = 0.0
+            _share(x, ip, a, b, 1.0, cx, cy, nx, ny, sums)
+            _share(x, ia, a, b, -(1.0 - s), cx, cy, nx, ny, sums)
+            _share(x, ib, a, b, -s, cx, cy, nx, ny, sums)
+            fn, ft, _, _, _ = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, rs.bgeo, rs.bstate, c)
+            st = rs.bstate
+            _add_row(acc, fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND], nx, ny, sums[0], sums[1], sums[2])
+        for p in range(rs.c_start[i], rs.c_start[i + 1]):
+            c = rs.c_entry[p] // 2
+            ia, ib = rs.cpairs[c, 0], rs.cpairs[c, 1]
+            if (ia if a <= ia < b else ib) != i:
+                continue
+            s = rs.cf[c, CORNER_S]
+            nx, ny = rs.cf[c, CORNER_NX], rs.cf[c, CORNER_NY]
+            sums[0] = sums[1] = sums[2] = 0.0
+            _share(x, ia, a, b, 1.0 - s, cx, cy, nx, ny, sums)
+            _share(x, ib, a, b, s, cx, cy, nx, ny, sums)
+            fn, ft, _, _, _ = corner_row_forces(x, x_n, ia, ib, rs.cf, rs.cstate, c)
+            st = rs.cstate
+            _add_row(acc, fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND], nx, ny, sums[0], sums[1], sums[2])
+
+
+@njit(cache=True)
+def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h):
+    """One Newton step with a line search per rigid body, in turn (see the module
+    docstring). ``zeros`` (N,) is a zero mass per vertex (the rows' and grabs' share of the
+    objective without the vertices' inertia, which the body's own replaces). Returns the largest
+    squared vertex move (m^2)."""
+    inv_h2 = 1.0 / (h * h)
+    most = 0.0
+    acc = np.zeros(9)
+    for k in range(blocks.lo.shape[0]):
+        if blocks.held[k]:
+            continue
+        a, b = blocks.lo[k], blocks.hi[k]
+        p, t = blocks.pose, blocks.target
+        cx, cy, phi = p[k, 0], p[k, 1], p[k, 2]
+        m, inertia = blocks.mass[k] * inv_h2, blocks.inertia[k] * inv_h2
+        g0 = m * (cx - t[k, 0])
+        g1 = m * (cy - t[k, 1])
+        g2 = inertia * (phi - t[k, 2])
+        block_rows(x, x_n, a, b, cx, cy, grab_slot, grab_pull, rs, acc)
+        g0 += acc[0]
+        g1 += acc[1]
+        g2 += acc[2]
+        a00, a01, a02, a11, a12, a22 = m + acc[3], acc[4], acc[5], m + acc[6], acc[7], inertia + acc[8]
+        c00 = a11 * a22 - a12 * a12
+        c01 = a02 * a12 - a01 * a22
+        c02 = a01 * a12 - a02 * a11
+        det = a00 * c00 + a01 * c01 + a02 * c02
+        if not det > 0.0:
+            continue
+        c11 = a00 * a22 - a02 * a02
+        c12 = a01 * a02 - a00 * a12
+        c22 = a00 * a11 - a01 * a01
+        dx = -(c00 * g0 + c01 * g1 + c02 * g2) / det
+        dy = -(c01 * g0 + c11 * g1 + c12 * g2) / det
+        th = -(c02 * g0 + c12 * g1 + c22 * g2) / det
+        slope = g0 * dx + g1 * dy + g2 * th
+        if not slope < 0.0:
+            continue
+        e0 = _inertia_energy(blocks, k, cx, cy, phi, inv_h2) + rigid_energy(
+            x, x_n, x_n, zeros, a, b, grab_slot, grab_pull, rs, cx, cy, 0.0, 0.0, 0.0)
+        s = 1.0
+        while s > 1e-3:
+            e1 = _inertia_energy(blocks, k, cx + s * dx, cy + s * dy, phi + s * th, inv_h2) + rigid_energy(
+                x, x_n, x_n, zeros, a, b, grab_slot, grab_pull, rs, cx, cy, s * dx, s * dy, s * th)
+            if e1 <= e0 + 1e-4 * s * slope + 1e-12 * abs(e0):  # (a step too small to measure is taken)
+                break
+            s *= 0.5
+        if s <= 1e-3:
+            continue
+        p[k, 0], p[k, 1], p[k, 2] = cx + s * dx, cy + s * dy, phi + s * th
+        _place(x, x_n, a, b, blocks.c_n[k, 0], blocks.c_n[k, 1], p[k, 0], p[k, 1], p[k, 2])
+        # the furthest a vertex moved: the centre's move plus the turn at the first vertex
+        # (the block moves its vertices as one; the tolerance asks about the largest)
+        reach = 0.0
+        for i in range(a, b):
+            reach = max(reach, (x_n[i, 0] - blocks.c_n[k, 0]) ** 2 + (x_n[i, 1] - blocks.c_n[k, 1]) ** 2)
+        move = np.sqrt((s * dx) ** 2 + (s * dy) ** 2) + abs(s * th) * np.sqrt(reach)
+        most = max(most, move * move)
+    return most
+
+
+@njit(cache=True)
+def rigid_rates(blocks, h):
+    """The rigid bodies' velocities over the substep of ``h`` s, from their poses, into
+    ``blocks.rate``: the centre's ``(c - c_n) / h`` and the spin ``phi / h``."""
+    inv_h = 1.0 / h
+    for k in range(blocks.lo.shape[0]):
+        p = blocks.pose
+        blocks.rate[k, 0] = (p[k, 0] - blocks.c_n[k, 0]) * inv_h
+        blocks.rate[k, 1] = (p[k, 1] - blocks.c_n[k, 1]) * inv_h
+        blocks.rate[k, 2] = p[k, 2] * inv_h
+
+
+@njit(cache=True)
+def rigid_place(x, x_n, v, blocks):
+    """The rigid bodies' vertices at their poses, with their rates as velocities
+    (:func:`rigid_rates`): what ends a substep, after the collider projection and the
+    contact stage, which move vertices one by one."""
+    for k in range(blocks.lo.shape[0]):
+        a, b = blocks.lo[k], blocks.hi[k]
+        p, r = blocks.pose, blocks.rate
+        _place(x, x_n, a, b, blocks.c_n[k, 0], blocks.c_n[k, 1], p[k, 0], p[k, 1], p[k, 2])
+        for i in range(a, b):
+            rx, ry = x[i, 0] - p[k, 0], x[i, 1] - p[k, 1]
+            v[i, 0] = r[k, 0] - r[k, 2] * ry
+            v[i, 1] = r[k, 1] + r[k, 2] * rx
