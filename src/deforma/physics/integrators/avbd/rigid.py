@@ -52,8 +52,10 @@ from .rows import (
     contact_forces,
     corner_row_forces,
     corner_row_forces_at,
+    freeze_rigid_bounds,
     row_blocks,
     row_energy,
+    update_rigid_rows,
 )
 
 
@@ -71,6 +73,7 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
     Newton step solves the rigid modes as well as the iterate allows. Without outside
     forces it makes ``sum m (x - y) = 0``: the step keeps the body's momentum. A body with a
     pinned vertex does not move as a whole."""
+    verts = np.arange(x.shape[0])
     for body in range(body_start.shape[0] - 1):
         lo, hi = body_start[body], body_start[body + 1]
         sm = cx = cy = 0.0
@@ -132,11 +135,11 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
         slope = g0 * dx + g1 * dy + g2 * th
         if not slope < 0.0:
             continue
-        e0 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
+        e0 = rigid_energy(x, x_n, y, mass_h2, verts, lo, hi, lo, hi, grab_slot, grab_pull, rs, cx, cy,
                           0.0, 0.0, 0.0)
         t = 1.0
         while t > 1e-3:
-            e1 = rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy,
+            e1 = rigid_energy(x, x_n, y, mass_h2, verts, lo, hi, lo, hi, grab_slot, grab_pull, rs, cx, cy,
                               t * dx, t * dy, t * th)
             if e1 <= e0 + 1e-4 * t * slope + 1e-12 * abs(e0):  # (rounding: a step too small to measure is taken)
                 break
@@ -160,12 +163,17 @@ def _moved(x, v, lo, hi, cx, cy, dx, dy, co, si):
 
 
 @njit(cache=True)
-def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, dx, dy, th):
-    """The objective's inertia, grab and contact-row part (J) over the vertices ``lo:hi`` moved
-    as a whole: turned by ``th`` about ``(cx, cy)`` and shifted by ``(dx, dy)``."""
+def rigid_energy(x, x_n, y, mass_h2, verts, p0, p1, lo, hi, grab_slot, grab_pull, rs, cx, cy, dx, dy, th):
+    """The objective's inertia, grab and contact-row part (J) over the vertices ``verts[p0:p1]``
+    of the body ``lo:hi``, with the body moved as a whole: turned by ``th`` about ``(cx, cy)``
+    and shifted by ``(dx, dy)`` (its other vertices add nothing: no rows, no grab, no mass).
+    One loop with no helper taking the rows: Numba counts a reference to each of their
+    arrays at every hand-over, and a helper per vertex made the rigid blocks' sweep twice as
+    slow."""
     co, si = np.cos(th), np.sin(th)
     e = 0.0
-    for i in range(lo, hi):
+    for q in range(p0, p1):
+        i = verts[q]
         rx, ry = x[i, 0] - cx, x[i, 1] - cy
         px = cx + dx + co * rx - si * ry
         py = cy + dy + si * rx + co * ry
@@ -211,13 +219,15 @@ def rigid_energy(x, x_n, y, mass_h2, lo, hi, grab_slot, grab_pull, rs, cx, cy, d
     return e
 
 
-
 #: The rigid bodies of a Model as the sweep reads them: vertex ranges ``lo``, ``hi`` (K,),
 #: mass (kg) and moment of inertia about the centre of mass (kg m^2) (K,), ``held`` (K,)
 #: (a pinned vertex), and per substep the start centre ``c_n`` (K, 2), the inertial target
 #: ``target`` (K, 3: c~, phi~), the pose ``pose`` (K, 3: c, phi) and the velocities it
-#: ended the substep with, ``rate`` (K, 3: m/s, m/s, rad/s).
-RigidBlocks = namedtuple("RigidBlocks", ["lo", "hi", "mass", "inertia", "held", "c_n", "target", "pose", "rate"])
+#: ended the substep with, ``rate`` (K, 3: m/s, m/s, rad/s), the farthest vertex from the
+#: centre ``radius`` (K,, m), and the vertices with a contact row or a grab, body by body, as
+#: CSR ``act_start`` (K + 1,), ``act`` (the sweep moves only those; :func:`rigid_active`).
+RigidBlocks = namedtuple("RigidBlocks", ["lo", "hi", "mass", "inertia", "held", "c_n", "target", "pose", "rate",
+                                         "radius", "act_start", "act"])
 
 
 def rigid_blocks(model, rigid_set) -> RigidBlocks:
@@ -232,7 +242,24 @@ def rigid_blocks(model, rigid_set) -> RigidBlocks:
     mass = np.array([model.vertex_mass[a:b].sum() for a, b in zip(lo, hi)], np.float64)
     k = len(bodies)
     return RigidBlocks(lo, hi, mass, rigid_set.inertia.astype(np.float64), held, np.zeros((k, 2)),
-                       np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)))
+                       np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)), np.zeros(k), np.zeros(k + 1, np.int64),
+                       np.zeros(int((hi - lo).sum()), np.int64))
+
+
+@njit(cache=True)
+def rigid_active(blocks, rowed, grab_slot):
+    """List each rigid body's vertices that have a contact row or a grab this substep
+    (``blocks.act``): the sweep's blocks read and move only those (a box of 16 vertices
+    resting on another has 3 to 6), and :func:`rigid_place` puts every vertex at its pose
+    at the end."""
+    n = 0
+    for k in range(blocks.lo.shape[0]):
+        blocks.act_start[k] = n
+        for i in range(blocks.lo[k], blocks.hi[k]):
+            if rowed[i] or grab_slot[i] >= 0:
+                blocks.act[n] = i
+                n += 1
+    blocks.act_start[blocks.lo.shape[0]] = n
 
 
 @njit(cache=True, inline="always")
@@ -240,6 +267,17 @@ def _place(x, x_n, a, b, cnx, cny, cx, cy, phi):
     """Put vertices ``a:b`` at the pose ``(cx, cy, phi)`` from where they began, about ``(cnx, cny)``."""
     co, si = np.cos(phi), np.sin(phi)
     for i in range(a, b):
+        rx, ry = x_n[i, 0] - cnx, x_n[i, 1] - cny
+        x[i, 0] = cx + co * rx - si * ry
+        x[i, 1] = cy + si * rx + co * ry
+
+
+@njit(cache=True, inline="always")
+def _place_listed(x, x_n, act, p0, p1, cnx, cny, cx, cy, phi):
+    """:func:`_place` for the vertices ``act[p0:p1]`` only."""
+    co, si = np.cos(phi), np.sin(phi)
+    for q in range(p0, p1):
+        i = act[q]
         rx, ry = x_n[i, 0] - cnx, x_n[i, 1] - cny
         x[i, 0] = cx + co * rx - si * ry
         x[i, 1] = cy + si * rx + co * ry
@@ -277,6 +315,10 @@ def rigid_targets(x, v, x_n, y, vertex_mass, blocks, gx, gy, keep, force, has_fo
                 tau += rx * force[i, 1] - ry * force[i, 0]
         omega = spin / moment if moment > 0.0 else 0.0
         blocks.c_n[k, 0], blocks.c_n[k, 1] = cx, cy
+        reach = 0.0
+        for i in range(a, b):
+            reach = max(reach, (x_n[i, 0] - cx) ** 2 + (x_n[i, 1] - cy) ** 2)
+        blocks.radius[k] = np.sqrt(reach)
         t = blocks.target
         p = blocks.pose
         if blocks.held[k]:
@@ -340,16 +382,18 @@ def _share(x, v, a, b, w, cx, cy, nx, ny, sums):
 
 
 @njit(cache=True)
-def block_rows(x, x_n, a, b, cx, cy, grab_slot, grab_pull, rs, acc):
+def block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc):
     """The gradient and Hessian over a rigid body's pose (vertices ``a:b``, centre ``(cx,
-    cy)``) of its grabs and contact rows, into ``acc`` (see :func:`_add_row`). A row between
+    cy)``, those with a row or a grab ``act[p0:p1]``) of its grabs and contact rows, into
+    ``acc`` (see :func:`_add_row`). A row between
     two of its own vertices (an edge of its outline) is counted once with the moments of
     both: summed vertex by vertex, its stiffness lost the cross terms and a box met on an
     edge's middle took half of it."""
     for j in range(9):
         acc[j] = 0.0
     sums = np.zeros(3)
-    for i in range(a, b):
+    for q in range(p0, p1):
+        i = act[q]
         s = grab_slot[i]
         rx, ry = x[i, 0] - cx, x[i, 1] - cy
         if s >= 0:  # a zero-length spring of strength S to the target
@@ -402,23 +446,25 @@ def block_rows(x, x_n, a, b, cx, cy, grab_slot, grab_pull, rs, acc):
 @njit(cache=True)
 def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h):
     """One Newton step with a line search per rigid body, in turn (see the module
-    docstring). ``zeros`` (N,) is a zero mass per vertex (the rows' and grabs' share of the
-    objective without the vertices' inertia, which the body's own replaces). Returns the largest
-    squared vertex move (m^2)."""
+    docstring), over the vertices with a row or a grab (:func:`rigid_active`). ``zeros``
+    (N,): no mass per vertex (the body's own inertia replaces its vertices'). Returns the
+    largest squared vertex move (m^2)."""
     inv_h2 = 1.0 / (h * h)
     most = 0.0
     acc = np.zeros(9)
+    act, act_start = blocks.act, blocks.act_start
     for k in range(blocks.lo.shape[0]):
         if blocks.held[k]:
             continue
         a, b = blocks.lo[k], blocks.hi[k]
+        p0, p1 = act_start[k], act_start[k + 1]
         p, t = blocks.pose, blocks.target
         cx, cy, phi = p[k, 0], p[k, 1], p[k, 2]
         m, inertia = blocks.mass[k] * inv_h2, blocks.inertia[k] * inv_h2
         g0 = m * (cx - t[k, 0])
         g1 = m * (cy - t[k, 1])
         g2 = inertia * (phi - t[k, 2])
-        block_rows(x, x_n, a, b, cx, cy, grab_slot, grab_pull, rs, acc)
+        block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc)
         g0 += acc[0]
         g1 += acc[1]
         g2 += acc[2]
@@ -438,26 +484,42 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h):
         slope = g0 * dx + g1 * dy + g2 * th
         if not slope < 0.0:
             continue
-        e0 = _inertia_energy(blocks, k, cx, cy, phi, inv_h2) + rigid_energy(
-            x, x_n, x_n, zeros, a, b, grab_slot, grab_pull, rs, cx, cy, 0.0, 0.0, 0.0)
-        s = 1.0
-        while s > 1e-3:
-            e1 = _inertia_energy(blocks, k, cx + s * dx, cy + s * dy, phi + s * th, inv_h2) + rigid_energy(
-                x, x_n, x_n, zeros, a, b, grab_slot, grab_pull, rs, cx, cy, s * dx, s * dy, s * th)
-            if e1 <= e0 + 1e-4 * s * slope + 1e-12 * abs(e0):  # (a step too small to measure is taken)
-                break
-            s *= 0.5
-        if s <= 1e-3:
-            continue
-        p[k, 0], p[k, 1], p[k, 2] = cx + s * dx, cy + s * dy, phi + s * th
-        _place(x, x_n, a, b, blocks.c_n[k, 0], blocks.c_n[k, 1], p[k, 0], p[k, 1], p[k, 2])
-        # the furthest a vertex moved: the centre's move plus the turn at the first vertex
-        # (the block moves its vertices as one; the tolerance asks about the largest)
-        reach = 0.0
-        for i in range(a, b):
-            reach = max(reach, (x_n[i, 0] - blocks.c_n[k, 0]) ** 2 + (x_n[i, 1] - blocks.c_n[k, 1]) ** 2)
-        move = np.sqrt((s * dx) ** 2 + (s * dy) ** 2) + abs(s * th) * np.sqrt(reach)
+        step = 1.0
+        if p1 > p0:  # rows or grabs: backtrack on the objective (without, it is quadratic: exact)
+            e0 = _inertia_energy(blocks, k, cx, cy, phi, inv_h2) + rigid_energy(
+                x, x_n, x_n, zeros, act, p0, p1, a, b, grab_slot, grab_pull, rs, cx, cy, 0.0, 0.0, 0.0)
+            while step > 1e-3:
+                e1 = _inertia_energy(blocks, k, cx + step * dx, cy + step * dy, phi + step * th, inv_h2) + rigid_energy(
+                    x, x_n, x_n, zeros, act, p0, p1, a, b, grab_slot, grab_pull, rs, cx, cy, step * dx, step * dy,
+                    step * th)
+                if e1 <= e0 + 1e-4 * step * slope + 1e-12 * abs(e0):  # (a step too small to measure is taken)
+                    break
+                step *= 0.5
+            if step <= 1e-3:
+                continue
+        p[k, 0], p[k, 1], p[k, 2] = cx + step * dx, cy + step * dy, phi + step * th
+        _place_listed(x, x_n, act, p0, p1, blocks.c_n[k, 0], blocks.c_n[k, 1], p[k, 0], p[k, 1], p[k, 2])
+        # the furthest a vertex moved: the centre's move plus the turn at the farthest vertex
+        move = np.sqrt((step * dx) ** 2 + (step * dy) ** 2) + abs(step * th) * blocks.radius[k]
         most = max(most, move * move)
+    return most
+
+
+@njit(cache=True)
+def rigid_passes(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, touch, planes, state, count, n_body, n_corner, h,
+                 passes, beta, k_max, last):
+    """``passes`` passes over the rigid blocks (:func:`rigid_sweep`), each after the friction
+    bounds of the rows between rigid bodies follow their normal force
+    (:func:`~deforma.physics.integrators.avbd.rows.freeze_rigid_bounds`) and before those rows'
+    dual step (:func:`~deforma.physics.integrators.avbd.rows.update_rigid_rows`; not after the
+    ``last`` sweep's last pass, whose dual step is every row's). Returns the largest squared
+    vertex move (m^2)."""
+    most = 0.0
+    for q in range(passes):
+        freeze_rigid_bounds(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner)
+        most = max(most, rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h))
+        if not last or q < passes - 1:
+            update_rigid_rows(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner, beta, k_max)
     return most
 
 

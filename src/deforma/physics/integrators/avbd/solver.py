@@ -81,7 +81,7 @@ from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .gas import gas_areas, gas_block, gas_moved, gas_set
-from .rigid import rigid_blocks, rigid_correction, rigid_place, rigid_rates, rigid_sweep, rigid_targets
+from .rigid import rigid_active, rigid_blocks, rigid_correction, rigid_passes, rigid_place, rigid_rates, rigid_targets
 from .rows import (
     BODY_COLUMNS,
     MEMORY_COLUMNS,
@@ -95,7 +95,6 @@ from .rows import (
     freeze_body_bounds,
     freeze_bounds,
     freeze_corner_bounds,
-    freeze_rigid_bounds,
     mark_rowed,
     row_blocks,
     start_body_rows,
@@ -104,7 +103,6 @@ from .rows import (
     start_rows,
     update_body_rows,
     update_corner_rows,
-    update_rigid_rows,
     update_rows,
 )
 
@@ -382,15 +380,17 @@ def chebyshev(x, x_prev, x_prev2, inv_mass, vertex_row, omega):
         x_prev[i, 0], x_prev[i, 1] = x[i, 0], x[i, 1]
 
 
-def deepest_strain_reach(x, v, mass, body_start, size, h) -> float:
+def deepest_strain_reach(x, v, mass, body_start, size, h, rigid=None) -> float:
     """How far the bodies' deformation moves a vertex in ``h`` s, as a multiple of its
     ``size`` (m), at most over the vertices: its velocity less its body's rigid motion
     (:func:`~deforma.physics.rigid_motion.linear_and_angular_velocity`). A body that falls,
     slides or turns as a whole reaches nothing; one crushed by an impact does."""
     most = 0.0
     for lo, hi in zip(body_start[:-1], body_start[1:]):
+        if hi <= lo or (rigid is not None and rigid[lo]):  # (a rigid body moves rigidly)
+            continue
         xb, vb, mb = x[lo:hi], v[lo:hi], mass[lo:hi]
-        if hi <= lo or not mb.sum() > 0.0:
+        if not mb.sum() > 0.0:
             continue
         own = vb - rigid_velocities(xb, mb, *linear_and_angular_velocity(xb, vb, mb))
         most = max(most, float((np.sqrt((own * own).sum(axis=1)) / size[lo:hi]).max()) * h)
@@ -667,7 +667,8 @@ class AVBD(Integrator):
                     size = self._edge_size(model)
                     deep = max(deepest_reach(self._y, v, self._planes, self._touch, count, ctopo, found, n_body, size,
                                              hs),
-                               deepest_strain_reach(x_n, v, model.vertex_mass, model.body_vertex_offsets, size, hs)
+                               deepest_strain_reach(x_n, v, model.vertex_mass, model.body_vertex_offsets, size, hs,
+                                                    model.rigid if blocks is not None else None)
                                / self.STRAIN_SHARE)
                     if deep > reach:
                         # an impact: the step in parts, each reaching past its contacts by
@@ -697,6 +698,7 @@ class AVBD(Integrator):
                            self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, hs)
                 rs = self._body_rows(model, ctopo, found, n_body, k_start, v)
                 if blocks is not None:
+                    rigid_active(blocks, rs.rowed, control.grab_slot)
                     start_rigid_rows(model.rigid, opts["penalty_start"] * body_mass / (hs * hs), v, self._touch,
                                      self._planes, self._rows, count, rs, n_body, self._n_corner, hs)
                 self._solve(model, topo, control, x, anchor, mass_h2, inv_mass, count, n_body, rs, hd,
@@ -915,16 +917,11 @@ class AVBD(Integrator):
             rigid_correction(x, x_n, y, mass_h2, inv_mass, model.body_vertex_offsets, control.grab_slot,
                              control.grab_pull, rs)
             if blocks is not None:
-                # the rigid blocks' passes, each followed by their rows' dual step (the last
-                # sweep's last is every row's, below)
-                for pass_ in range(opts["rigid_passes"]):
-                    freeze_rigid_bounds(x, x_n, model.rigid, self._touch, self._planes, self._rows, count, rs, n_body,
-                                        self._n_corner)
-                    most = max(most, rigid_sweep(x, x_n, self._zeros, blocks, control.grab_slot, control.grab_pull,
-                                                 rs, h))
-                    if it < sweeps - 1 or pass_ < opts["rigid_passes"] - 1:
-                        update_rigid_rows(x, x_n, model.rigid, self._touch, self._planes, self._rows, count, rs,
-                                          n_body, self._n_corner, opts["penalty_ramp"], opts["penalty_max"])
+                # the rigid blocks' passes, each followed by their rows' dual step
+                most = max(most, rigid_passes(x, x_n, self._zeros, model.rigid, blocks, control.grab_slot, control.grab_pull, rs,
+                                              self._touch, self._planes, self._rows, count, n_body, self._n_corner,
+                                              h, opts["rigid_passes"], opts["penalty_ramp"], opts["penalty_max"],
+                                              it == sweeps - 1))
             if rho > 0.0:
                 omega = chebyshev_omega(it, rho, omega)
                 chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)
