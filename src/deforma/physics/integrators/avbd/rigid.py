@@ -59,6 +59,23 @@ from .rows import (
 )
 
 
+@njit(cache=True, inline="always")
+def newton_step3(a00, a01, a02, a11, a12, a22, g0, g1, g2):
+    """``(ok, d0, d1, d2)``: the solution of the symmetric 3 x 3 system ``A d = -g`` by its
+    adjugate; ``ok`` False where ``A`` is not positive definite enough to give one."""
+    c00 = a11 * a22 - a12 * a12
+    c01 = a02 * a12 - a01 * a22
+    c02 = a01 * a12 - a02 * a11
+    det = a00 * c00 + a01 * c01 + a02 * c02
+    if not det > 0.0:
+        return False, 0.0, 0.0, 0.0
+    c11 = a00 * a22 - a02 * a02
+    c12 = a01 * a02 - a00 * a12
+    c22 = a00 * a11 - a01 * a01
+    return (True, -(c00 * g0 + c01 * g1 + c02 * g2) / det, -(c01 * g0 + c11 * g1 + c12 * g2) / det,
+            -(c02 * g0 + c12 * g1 + c22 * g2) / det)
+
+
 @njit(cache=True)
 def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_pull, rs):
     """Move each body as a whole by the Newton step of the objective over its rigid motions.
@@ -116,18 +133,9 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
             a12 += -hxy * ry + hyy * rx
             a22 += hxx * ry * ry - 2.0 * hxy * rx * ry + hyy * rx * rx
         # solve the 3 x 3 system A d = -g (symmetric positive definite: A includes sum m / h^2)
-        c00 = a11 * a22 - a12 * a12
-        c01 = a02 * a12 - a01 * a22
-        c02 = a01 * a12 - a02 * a11
-        det = a00 * c00 + a01 * c01 + a02 * c02
-        if not det > 0.0:
+        ok, dx, dy, th = newton_step3(a00, a01, a02, a11, a12, a22, g0, g1, g2)
+        if not ok:
             continue
-        c11 = a00 * a22 - a02 * a02
-        c12 = a01 * a02 - a00 * a12
-        c22 = a00 * a11 - a01 * a01
-        dx = -(c00 * g0 + c01 * g1 + c02 * g2) / det
-        dy = -(c01 * g0 + c11 * g1 + c12 * g2) / det
-        th = -(c02 * g0 + c12 * g1 + c22 * g2) / det
         # Backtracking on the objective: the rows are piecewise quadratic, and a full Newton
         # step across their kinks rocked a block on the floor from step to step until it
         # walked off sideways. The turn is exact (a rotation, not its linearisation, leaves
@@ -469,18 +477,9 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h):
         g1 += acc[1]
         g2 += acc[2]
         a00, a01, a02, a11, a12, a22 = m + acc[3], acc[4], acc[5], m + acc[6], acc[7], inertia + acc[8]
-        c00 = a11 * a22 - a12 * a12
-        c01 = a02 * a12 - a01 * a22
-        c02 = a01 * a12 - a02 * a11
-        det = a00 * c00 + a01 * c01 + a02 * c02
-        if not det > 0.0:
+        ok, dx, dy, th = newton_step3(a00, a01, a02, a11, a12, a22, g0, g1, g2)
+        if not ok:
             continue
-        c11 = a00 * a22 - a02 * a02
-        c12 = a01 * a02 - a00 * a12
-        c22 = a00 * a11 - a01 * a01
-        dx = -(c00 * g0 + c01 * g1 + c02 * g2) / det
-        dy = -(c01 * g0 + c11 * g1 + c12 * g2) / det
-        th = -(c02 * g0 + c12 * g1 + c22 * g2) / det
         slope = g0 * dx + g1 * dy + g2 * th
         if not slope < 0.0:
             continue
