@@ -450,6 +450,14 @@ class AVBD(Integrator):
         ``beta``, N/m per m of violation: how fast a row's penalty stiffens, once a step (>= 0).
     penalty_max : float
         The stiffest a row gets (N/m).
+    rigid_passes : int
+        Passes over the rigid bodies' blocks per sweep (:mod:`~deforma.physics.integrators.avbd.rigid`),
+        each followed by the dual step of the rows between rigid bodies and colliders and by a
+        sweep of the soft vertices with contact rows (so that a soft body resting on a rigid
+        one converges with it). A block is three unknowns and its pass visits only its
+        vertices with rows: cheap beside a soft body's sweep. Measured on a stack of ten rigid
+        boxes at ten sweeps: one pass a sweep sank it into itself and it fell within a second,
+        two held it eight seconds, three and four within a millimetre for ten seconds.
 
     Examples
     --------
@@ -481,7 +489,8 @@ class AVBD(Integrator):
                       doc="penalty growth per metre of violation, once a step (N/m^2)"),
                Option("penalty_max", 1e10, "float", low=0.0, high=1e18, doc="the stiffest a contact row gets (N/m)"),
                Option("rigid_passes", 4, "int", low=1, high=1000,
-                      doc="passes over the rigid bodies' blocks per sweep, each with their rows' dual step"),
+                      doc="passes over the rigid bodies' blocks per sweep, each with their rows' dual step and "
+                          "the soft vertices on contacts swept again"),
                Option("mode", "auto", "choice", choices=("auto", "serial", "parallel"), doc=MODE_OPTION_DOC))
 
     #: the most parts a step is split into where it reaches deep into its contacts
