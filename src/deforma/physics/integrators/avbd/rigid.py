@@ -505,20 +505,18 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h):
 
 
 @njit(cache=True)
-def rigid_passes(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, touch, planes, state, count, n_body, n_corner, h,
-                 passes, beta, k_max, last):
-    """``passes`` passes over the rigid blocks (:func:`rigid_sweep`), each after the friction
-    bounds of the rows between rigid bodies follow their normal force
+def rigid_pass(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, touch, planes, state, count, n_body, n_corner, h,
+               beta, k_max, last):
+    """One pass over the rigid blocks (:func:`rigid_sweep`), after the friction bounds of the
+    rows between rigid bodies follow their normal force
     (:func:`~deforma.physics.integrators.avbd.rows.freeze_rigid_bounds`) and before those rows'
     dual step (:func:`~deforma.physics.integrators.avbd.rows.update_rigid_rows`; not after the
-    ``last`` sweep's last pass, whose dual step is every row's). Returns the largest squared
+    ``last`` pass of a step, whose dual step is every row's). Returns the largest squared
     vertex move (m^2)."""
-    most = 0.0
-    for q in range(passes):
-        freeze_rigid_bounds(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner)
-        most = max(most, rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h))
-        if not last or q < passes - 1:
-            update_rigid_rows(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner, beta, k_max)
+    freeze_rigid_bounds(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner)
+    most = rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, h)
+    if not last:
+        update_rigid_rows(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner, beta, k_max)
     return most
 
 

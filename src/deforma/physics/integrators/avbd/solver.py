@@ -81,7 +81,7 @@ from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .gas import gas_areas, gas_block, gas_moved, gas_set
-from .rigid import rigid_active, rigid_blocks, rigid_correction, rigid_passes, rigid_place, rigid_rates, rigid_targets
+from .rigid import rigid_active, rigid_blocks, rigid_correction, rigid_pass, rigid_place, rigid_rates, rigid_targets
 from .rows import (
     BODY_COLUMNS,
     MEMORY_COLUMNS,
@@ -939,10 +939,10 @@ class AVBD(Integrator):
                 # soft vertices that touch them
                 for q in range(opts["rigid_passes"]):
                     last = it == sweeps - 1 and q == opts["rigid_passes"] - 1
-                    most = max(most, rigid_passes(x, x_n, self._zeros, model.rigid, blocks, control.grab_slot,
-                                                  control.grab_pull, rs, self._touch, self._planes, self._rows, count,
-                                                  n_body, self._n_corner, h, 1, opts["penalty_ramp"],
-                                                  opts["penalty_max"], last))
+                    most = max(most, rigid_pass(x, x_n, self._zeros, model.rigid, blocks, control.grab_slot,
+                                                control.grab_pull, rs, self._touch, self._planes, self._rows, count,
+                                                n_body, self._n_corner, h, opts["penalty_ramp"], opts["penalty_max"],
+                                                last))
                     if coupled is not None and len(coupled[0]):
                         sweep_serial(x, x_n, y, mass_h2, inv_mass, coupled[0], coupled[1], t_start, t_item, t_corner,
                                      tris.elem, tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start,
