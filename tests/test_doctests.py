@@ -19,7 +19,6 @@ no place for.
 
 import doctest
 import importlib
-import os
 import pkgutil
 import re
 from pathlib import Path

@@ -135,6 +135,80 @@ def test_a_weight_on_a_spring_stretches_it_by_mg_over_k_and_bounces_at_its_frequ
     assert np.hypot(*spring.force) > 0
 
 
+def chain(w, links, weight_ratio, length=0.1, width=0.02, gap=0.002):
+    """``links`` rigid links of ``length`` hanging from the world at the origin, each pinned
+    ``gap`` below the top of the one above, and a square weight of ``weight_ratio`` links
+    pinned under the last; returns the weight and its joint."""
+    bodies = []
+    for i in range(links):
+        m = deforma.mesh.box(((0, 0), (width, 0), (width, length - gap), (0, length - gap)), detail=1)
+        bodies.append(w.add_body(m, position=(0.0, -length / 2 - i * length), material=RIGID))
+    side = math.sqrt(weight_ratio * bodies[0].mass / RIGID.density)
+    m = deforma.mesh.box(((0, 0), (side, 0), (side, side), (0, side)), detail=1)
+    weight = w.add_body(m, position=(0.0, -links * length - side / 2 - gap), material=RIGID)
+    w.join(bodies[0], None, at=(0.0, -gap))
+    for i in range(1, links):
+        w.join(bodies[i], bodies[i - 1], at=(0.0, -i * length - gap))
+    return weight, w.join(weight, bodies[-1], at=(0.0, -links * length - 1.5 * gap))
+
+
+@pytest.mark.xfail(strict=True, reason="a new joint's rows start without a multiplier and as stiff as the light "
+                   "link's m / h^2: the weight sags 4.7 % of the chain in its first ten steps before the rows "
+                   "carry it, then holds within 0.8 % (a weight of 100 links: 3 %, then 0.06 %; issue 49)")
+def test_a_chain_of_twenty_links_holds_a_weight_of_a_thousand_links():
+    # the mass ratio a block sweep finds hardest: 0.196 kg links, a 196 kg weight
+    w = deforma.World(dt=1 / 60)
+    weight, joint = chain(w, 20, 1000.0)
+    assert weight.mass == pytest.approx(1000 * w.bodies[0].mass)
+    top0 = weight.center_of_mass[1]
+    stretch = []
+    for _ in range(300):
+        w.step()
+        stretch.append((top0 - weight.center_of_mass[1]) / 2.0)  # of the chain's 2 m
+    assert np.abs(stretch).max() < 0.01
+    assert abs(weight.center_of_mass[0]) < 0.01  # it hangs straight
+    # the last joint carries the weight (its swing about it aside)
+    assert joint.force[1] == pytest.approx(weight.mass * G, rel=0.02)
+
+
+def test_a_chain_of_twenty_equal_links_hangs_straight_and_carries_its_weight():
+    w = deforma.World(dt=1 / 60)
+    weight, joint = chain(w, 20, 1.0)
+    y0 = weight.center_of_mass[1]
+    for _ in range(300):
+        w.step()
+    assert abs(weight.center_of_mass[1] - y0) < 1e-4 and abs(weight.center_of_mass[0]) < 1e-6
+    assert joint.force[1] == pytest.approx(weight.mass * G, rel=0.05)
+
+
+def test_two_free_bodies_pinned_together_keep_their_momentum():
+    # no gravity: what the pin moves between them is theirs; BDF2 (the bodies' scheme away
+    # from contacts) keeps the linear momentum exactly and the angular within its error
+    w = deforma.World(dt=1 / 60, gravity=(0, 0))
+    m = deforma.mesh.box(((0, -0.025), (1, -0.025), (1, 0.025), (0, 0.025)), detail=2)
+    a = w.add_body(m, position=(0.5, 0.0), material=RIGID, velocity=(0.0, 1.0))
+    b = w.add_body(m, position=(-0.5, 0.0), angle=30.0, material=RIGID, angular_velocity=200.0, velocity=(0.3, -0.5))
+    hinge = w.join(a, b, at=(0.0, 0.0))
+
+    def momentum():
+        from deforma.physics.rigid.stage import rigid_set  # the bodies' true moments of inertia
+        inertia = rigid_set(w._model).inertia
+        p, spin = np.zeros(2), 0.0
+        for k, body in enumerate((a, b)):
+            c, v = body.center_of_mass, np.asarray(body.velocity)
+            p += body.mass * v
+            spin += body.mass * (c[0] * v[1] - c[1] * v[0]) + inertia[k] * math.radians(body.angular_velocity)
+        return p, spin
+
+    p0, spin0 = momentum()
+    for _ in range(300):
+        w.step()
+        p, spin = momentum()
+        assert np.abs(p - p0).max() < 1e-6 * np.abs(p0).max()
+        assert abs(spin - spin0) < 5e-3 * abs(spin0)
+        assert np.hypot(*(hinge.point - b.center_of_mass)) == pytest.approx(0.5, abs=1e-4)  # held
+
+
 def test_removing_a_joint_or_a_body_lets_go():
     w = deforma.World(dt=1 / 60)
     b = bar(w, 0.0, 0.0)

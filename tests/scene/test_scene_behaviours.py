@@ -1,7 +1,6 @@
 """Scene files with material behaviours (tear_strain, yield_strain, plastic_rate, max_stretch)
 and gas pressure: what they build, what they refuse, and round trips."""
 
-import numpy as np
 import pytest
 
 import deforma

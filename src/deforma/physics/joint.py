@@ -44,7 +44,7 @@ class Joint:
     """
 
     def __init__(self, world, a: Body, b: Body | None, kind: str, anchor, local, reference: float,
-                 stiffness, damping, motor_speed, max_torque):
+                 stiffness, damping, motor_speed, max_torque, frame=None):
         self._world = world
         self.a, self.b, self.kind = a, b, kind
         self.anchor = anchor
@@ -56,6 +56,12 @@ class Joint:
         self._acc = np.zeros(4)                        # warm starts (see rigid.joints)
         self._impulse = np.zeros(3)                    # over the step so far: point (N s), angle (N m s)
         self._force = np.zeros(3)                      # the last step's, per second
+        # avbd's rows (integrators.avbd.joints): each side's point on two of its body's
+        # vertices (body-local indices, -1 for the world) and its (alpha, beta) there (the
+        # world's point), the frames' reference angle, and the rows' warm start
+        self._frame = frame
+        self._lam = np.zeros(4)
+        self._pen = np.zeros(4)
 
     @property
     def point(self) -> np.ndarray:
@@ -108,6 +114,14 @@ class Joint:
                           self.stiffness or 0.0, self.damping or 0.0])
         return KINDS[self.kind], param, speed is not None
 
+    def _rows(self) -> tuple:
+        """``(frame vertices (4,) body-local, frame weights (4,), param (5,), motor on)`` for
+        avbd's rows: as :meth:`_pack`, with the frames' reference angle first."""
+        verts, weights, reference = self._frame
+        _, param, on = self._pack()
+        param[0] = reference
+        return verts, weights, param, on
+
     def __repr__(self) -> str:
         b = "the world" if self.b is None else f"body {self.b._index}"
         return f"Joint({self.kind} of body {self.a._index} and {b} at {self.anchor})"
@@ -140,6 +154,55 @@ def spring(kind: str, stiffness, damping) -> tuple[float | None, float | None]:
         raise ValueError("a spring joint needs stiffness (N/m, > 0)")
     return (_positive(stiffness, "stiffness", "N/m"),
             0.0 if damping is None else _non_negative(damping, "damping", "N*s/m"))
+
+
+def pack_rows(joints, model, bodies: np.ndarray):
+    """The joints as avbd's rows (:class:`~deforma.physics.integrators.avbd.joints.JointRows`)
+    of ``model``, whose rigid bodies are ``bodies`` (body indices, in block order), warm-started
+    from each joint's last step; None without joints."""
+    if not joints:
+        return None
+    from .integrators.avbd.joints import make_joint_rows
+
+    n = len(joints)
+    where = {int(b): k for k, b in enumerate(bodies)}
+    block = np.full((n, 2), -1, np.int64)
+    fv, fw, param = np.full((n, 4), -1, np.int64), np.zeros((n, 4)), np.zeros((n, 5))
+    kind, motor_on = np.zeros(n, np.int64), np.zeros(n, np.bool_)
+    lam, pen = np.zeros((n, 4)), np.zeros((n, 4))
+    off = model.body_vertex_offsets
+    for i, j in enumerate(joints):
+        verts, weights, param[i], motor_on[i] = j._rows()
+        kind[i] = KINDS[j.kind]
+        fw[i] = weights
+        for side, body in enumerate((j.a, j.b)):
+            if body is not None:
+                block[i, side] = where[body._index]
+                fv[i, 2 * side:2 * side + 2] = verts[2 * side:2 * side + 2] + off[body._index]
+        lam[i], pen[i] = j._lam, j._pen
+    return make_joint_rows(block, fv, fw, kind, param, motor_on, lam, pen, len(bodies))
+
+
+def read_rows(joints, rows, dt: float) -> None:
+    """After a step of ``dt`` s: each joint's force and torque (the rows' totals over the
+    step, per second) and its rows' warm start for the next."""
+    for i, j in enumerate(joints):
+        j._force[...] = rows.total[i] / dt
+        j._lam[...] = rows.lam[i]
+        j._pen[...] = rows.pen[i]
+
+
+def frame(x: np.ndarray, point) -> tuple[int, int, float, float, float]:
+    """Two of a rigid body's vertices ``x`` (body-local indices) and the point's ``(alpha,
+    beta)`` on them (``point = x_0 + alpha d + beta perp(d)``, ``d = x_1 - x_0``), and the
+    angle of ``d`` (rad): the point carried exactly as the body moves. The two are the
+    first vertex and the farthest from it (the best-conditioned pair)."""
+    d2 = ((x - x[0]) ** 2).sum(axis=1)
+    i1 = int(np.argmax(d2))
+    d = x[i1] - x[0]
+    w = np.asarray(point, np.float64) - x[0]
+    n2 = float(d @ d)
+    return 0, i1, float(w @ d) / n2, float(-w[0] * d[1] + w[1] * d[0]) / n2, math.atan2(d[1], d[0])
 
 
 def anchor(value) -> tuple[float, float]:

@@ -89,6 +89,10 @@ class Model:
         Every body as the contact stage reads it (outline and other vertices, outline edges,
         triangles, per-vertex contact thickness, per-body flags, thickness and friction);
         see :mod:`deforma.physics.contact`.
+    joints : JointRows or None
+        The world's joints as rows of avbd's sweep
+        (:class:`~deforma.physics.integrators.avbd.joints.JointRows`), set by the World before
+        each step while avbd moves its rigid bodies; None otherwise.
 
     The constructor takes the bodies' topologies and parameters (lists, one entry per body);
     ``torn``, a dict from a finite-element body to ``(Model before, its index there)`` when a
@@ -179,6 +183,7 @@ class Model:
         # a rigid body's vertices: the soft integrators hold them (infinite mass there) and
         # the rigid stage moves them (deforma.physics.rigid)
         self.rigid = np.zeros(n, bool)
+        self.joints = None
         for b, m in enumerate(materials):
             if m is not None and m.is_rigid:
                 self.rigid[self.body_vertex_offsets[b]:self.body_vertex_offsets[b + 1]] = True
@@ -233,7 +238,8 @@ class Model:
         self.contact = ContactTopology(i32(cv), i32(cb), vertex_cv, body_outline, body_interior, tri, body_tri,
                                        i32(ea), i32(eb), i32(ebody),
                                        np.zeros(v), np.zeros(v), np.zeros(nb, np.int32), np.zeros(nb),
-                                       np.zeros((nb, 2)), np.zeros(1))
+                                       np.zeros((nb, 2)), np.zeros(1), np.zeros(nb + 1, np.int64),
+                                       np.zeros(0, np.int32))
         for b in range(nb):
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])
@@ -420,6 +426,19 @@ class Model:
         # (so has a rigid body's, as the soft integrators see it: the rigid stage moves it)
         self.vertex_inv_mass[v0:v1] = np.where(self.pinned[v0:v1] | self.rigid[v0:v1], 0.0,
                                                1.0 / self.vertex_mass[v0:v1])
+
+    def set_joined(self, pairs) -> None:
+        """The pairs of bodies ``(a, b)`` a joint holds together: they do not collide with
+        each other (``contact.joined_start``, ``contact.joined``)."""
+        nb = len(self.contact.body_flags)
+        lists = [set() for _ in range(nb)]
+        for a, b in pairs:
+            lists[a].add(b)
+            lists[b].add(a)
+        start = np.zeros(nb + 1, np.int64)
+        start[1:] = np.cumsum([len(x) for x in lists])
+        joined = np.array([b for x in lists for b in sorted(x)], np.int32)
+        self.contact = self.contact._replace(joined_start=start, joined=joined)
 
     def set_contact_parameters(self, body: int, *, collide: bool, self_collision: bool, friction: float,
                                static_friction: float, thickness: float) -> None:

@@ -27,7 +27,8 @@ import numpy as np
 from . import behaviours
 from .behaviours import tearing
 from .colliders.response import clear_impulses
-from .rigid.stage import begin_joint_forces, end_joint_forces, step_rigid_bodies
+from .joint import pack_rows, read_rows
+from .rigid.stage import begin_joint_forces, end_joint_forces, rigid_set, step_rigid_bodies
 from .diagnostics import SHAPE_CHECK_EVERY, SimulationUnstable, lost_shape, runaway, trapped
 from .topology import BodyTopology
 
@@ -84,6 +85,9 @@ def step(world) -> None:
     poses = [(c, c.center, c.angle) for c in w._colliders if c.moving]
     # the rigid stage after each substep, unless the integrator solves the rigid bodies itself
     rigid = bool(w._model.n_vertices) and w._model.rigid.any() and not w._rigid_in_solve()
+    # the joints as rows of the integrator's sweep, where it moves the rigid bodies
+    rows = None if rigid or not w._joints else pack_rows(w._joints, w._model, rigid_set(w._model).bodies)
+    w._model.joints = rows
     moving = bool(poses) or rigid  # the rigid bodies' outlines move as colliders
     moved = w._colliders_changed() or rigid
     if moved:
@@ -151,6 +155,8 @@ def step(world) -> None:
         if moving:
             w._packed_colliders = None
         raise
+    if rows is not None:
+        read_rows(w._joints, rows, w.dt)
     w._forces.clear()
     w.time += w.dt
     w.step_count += 1

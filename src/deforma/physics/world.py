@@ -422,10 +422,10 @@ class World:
 
     def _rigid_in_solve(self) -> bool:
         """Whether the integrator solves the rigid bodies in its own sweep (avbd's blocks,
-        :mod:`deforma.physics.integrators.avbd.rigid`; not yet with joints): else the rigid
+        :mod:`deforma.physics.integrators.avbd.rigid`, and their joints as rows): else the rigid
         stage after each substep moves them and others meet their outlines as colliders'
         (:mod:`deforma.physics.rigid`)."""
-        return self._integrator.solves_rigid and not self._joints
+        return self._integrator.solves_rigid
 
     def _rigid_solve_changed(self) -> None:
         """Who moves the rigid bodies may have changed (the integrator, or the joints): their
@@ -433,6 +433,7 @@ class World:
         model = getattr(self, "_model", None)
         if model is None or not model.n_vertices or not model.rigid.any():
             return
+        model.set_joined([(j.a._index, j.b._index) for j in self._joints if j.b is not None])
         for body in self._bodies:
             if body.material.is_rigid:
                 model.set_contact_parameters(body._index, **self._contact_parameters(body))
@@ -667,6 +668,8 @@ class World:
         for body, shape in shapes.items():
             src = body._tear_source
             self._model.take_rest_shape(body._index, shape, None if isinstance(src, slice) else src)
+        if self._joints:
+            self._model.set_joined([(j.a._index, j.b._index) for j in self._joints if j.b is not None])
         self._model_bodies = list(self._bodies)
         self._state = State(x, v)
         packed = self._control.colliders
@@ -880,7 +883,15 @@ class World:
             dx, dy = point[0] - center[k, 0], point[1] - center[k, 1]
             local.append((c * dx + s_ * dy, -s_ * dx + c * dy))  # turned back to the body frame
             turn += angle[k] if side == 0 else -angle[k]
-        j = Joint(self, a, b, kind, point, np.concatenate(local), turn, stiffness, damping, motor_speed, max_torque)
+        verts, weights, ref = [-1, -1, -1, -1], [0.0, 0.0, point[0], point[1]], 0.0
+        for side, body in enumerate((a, b)):
+            if body is not None:
+                i0, i1, alpha, beta, theta = _joint.frame(body.positions, point)
+                verts[2 * side:2 * side + 2] = i0, i1
+                weights[2 * side:2 * side + 2] = alpha, beta
+                ref += theta if side == 0 else -theta
+        j = Joint(self, a, b, kind, point, np.concatenate(local), turn, stiffness, damping, motor_speed, max_torque,
+                  frame=(np.array(verts, np.int64), np.array(weights), ref))
         self._joints.append(j)
         self._rigid_solve_changed()
         return j

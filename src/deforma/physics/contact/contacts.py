@@ -66,6 +66,8 @@ ContactTopology = namedtuple("ContactTopology", [
     "body_thickness",   # (B,) float64: each body's contact thickness (m)
     "body_friction",    # (B, 2) float64: dynamic, static coefficient for body contacts
     "margin",           # (1,) float64: growth of the edge boxes (m): SPECULATIVE times the largest thickness
+    "joined_start",     # (B + 1,) int64: CSR, the bodies a joint holds to body b (which it does not collide with)
+    "joined",           # (P,) int32: ... are joined[joined_start[b]:joined_start[b + 1]]
 ])
 
 ContactScratch = namedtuple("ContactScratch", [
@@ -113,7 +115,8 @@ def empty_topology(n_bodies: int = 0) -> ContactTopology:
     i32, f64, offsets = np.zeros(0, np.int32), np.zeros(0), np.zeros(n_bodies + 1, np.int64)
     return ContactTopology(i32, i32, i32, offsets, offsets, np.zeros((0, 3), np.int32), offsets, i32, i32, i32, f64,
                            f64, np.zeros(n_bodies, np.int32),
-                           np.zeros(n_bodies), np.zeros((n_bodies, 2)), np.zeros(1))
+                           np.zeros(n_bodies), np.zeros((n_bodies, 2)), np.zeros(1), np.zeros(n_bodies + 1, np.int64),
+                           i32)
 
 
 def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScratch:

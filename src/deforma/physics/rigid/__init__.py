@@ -6,10 +6,10 @@ of inertia of its triangles at its density. Its state is its vertices' (``State.
 ``State.v``): the pose and velocity are read back from them each step (exact, as they move
 rigidly), so a failed step's undo, recordings and every reader of positions need nothing new.
 
-Under ``avbd`` (the default) without joints, a rigid body is instead one block of the
-integrator's own sweep (:mod:`deforma.physics.integrators.avbd.rigid`) and its outline a
-contact outline like any body's; what follows is the path of the other integrators, and of
-avbd while the world has joints.
+Under ``avbd`` (the default), a rigid body is instead one block of the integrator's own
+sweep (:mod:`deforma.physics.integrators.avbd.rigid`), its outline a contact outline like
+any body's and its joints rows of the sweep (:mod:`deforma.physics.integrators.avbd.joints`);
+what follows is the path of the other integrators.
 
 One soft substep, then the rigid stage over it (:func:`~deforma.physics.stepper.step` runs
 them in turn, so a soft body never meets an outline that stood still for a whole step):

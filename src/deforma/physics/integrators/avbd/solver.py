@@ -81,7 +81,17 @@ from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .gas import gas_areas, gas_block, gas_moved, gas_set
-from .rigid import rigid_active, rigid_blocks, rigid_correction, rigid_pass, rigid_place, rigid_rates, rigid_targets
+from .joints import joint_totals, make_joint_rows, start_joint_rows, update_joint_rows
+from .rigid import (
+    rigid_active,
+    rigid_blocks,
+    rigid_correction,
+    rigid_pass,
+    rigid_place,
+    rigid_rates,
+    rigid_second_order,
+    rigid_targets,
+)
 from .rows import (
     BODY_COLUMNS,
     MEMORY_COLUMNS,
@@ -522,6 +532,7 @@ class AVBD(Integrator):
         self._n_corner = 0
         self._gas = None  # (model, GasSet)
         self._rigid = None  # (model, RigidBlocks or None, per-vertex body mass or None)
+        self._no_joints = None  # the JointRows of a model without joints
         self._driver = DriverChoice()  # which sweep build runs (option mode)
         self._n = -1
         self._size = None
@@ -702,18 +713,22 @@ class AVBD(Integrator):
                                                 control.has_force, hs)
                     if free:
                         hd = 2.0 * hs / 3.0  # the damping's velocity, (x - anchor) / h'
+                if blocks is not None:
+                    start_joint_rows(x_n, blocks, self._joint_rows(model, blocks), opts["penalty_start"] / (hs * hs))
                 k_start = opts["penalty_start"] * (mass_h2 + self._stiffness(model, hd))
                 start_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows, k_start,
                            self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, hs)
                 rs = self._body_rows(model, ctopo, found, n_body, k_start, v)
                 if blocks is not None:
                     rigid_active(blocks, rs.rowed, control.grab_slot)
+                    rigid_second_order(blocks, self._joint_rows(model, blocks), keep, hs)
                     start_rigid_rows(model.rigid, opts["penalty_start"] * body_mass / (hs * hs), v, self._touch,
                                      self._planes, self._rows, count, rs, n_body, self._n_corner, hs)
                 self._solve(model, topo, control, x, anchor, mass_h2, inv_mass, count, n_body, rs, hd,
-                            opts["tolerance"] * hs)
+                            opts["tolerance"] * hs, hs)
                 if blocks is not None:
                     rigid_rates(blocks, hs)
+                    joint_totals(self._joint_rows(model, blocks), blocks, hs)
                 close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
                 close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
                 close_corner_rows(self._cpairs, self._n_corner, self._corner_memory[0], self._cstate)
@@ -769,6 +784,18 @@ class AVBD(Integrator):
                 self._zeros = np.zeros(model.n_vertices)
             self._rigid = (*key, blocks, body_mass)
         return self._rigid[2], self._rigid[3]
+
+    def _joint_rows(self, model, blocks):
+        """The Model's joints (``model.joints``), or an empty set of rows for ``blocks``."""
+        jr = model.joints
+        if jr is None:
+            if self._no_joints is None or len(self._no_joints.j_start) != len(blocks.lo) + 1:
+                z = np.zeros((0, 4))
+                self._no_joints = make_joint_rows(np.zeros((0, 2), np.int64), np.zeros((0, 4), np.int64), z,
+                                                  np.zeros(0, np.int64), np.zeros((0, 5)), np.zeros(0, np.bool_), z,
+                                                  z, len(blocks.lo))
+            return self._no_joints
+        return jr
 
     def _edge_size(self, model):
         """Per vertex, its shortest edge in its body's rest shape (m), once per Model (measured
@@ -881,10 +908,12 @@ class AVBD(Integrator):
                       self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas.start,
                       self._rowed)
 
-    def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol):
-        """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights."""
+    def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol, h_rigid):
+        """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights
+        (``h`` the soft vertices' damping step, ``2/3`` of the substep's ``h_rigid`` for BDF2)."""
         opts = self._options
         blocks = self._rigid[2]
+        jr = self._joint_rows(model, blocks) if blocks is not None else None
         coupled = None
         if blocks is not None and model.fused and not model.has_pressure:
             # the soft vertices with contact rows: swept again after each pass over the rigid
@@ -940,9 +969,9 @@ class AVBD(Integrator):
                 for q in range(opts["rigid_passes"]):
                     last = it == sweeps - 1 and q == opts["rigid_passes"] - 1
                     most = max(most, rigid_pass(x, x_n, self._zeros, model.rigid, blocks, control.grab_slot,
-                                                control.grab_pull, rs, self._touch, self._planes, self._rows, count,
-                                                n_body, self._n_corner, h, opts["penalty_ramp"], opts["penalty_max"],
-                                                last))
+                                                control.grab_pull, rs, jr, self._touch, self._planes, self._rows, count,
+                                                n_body, self._n_corner, h_rigid, opts["penalty_ramp"],
+                                                opts["penalty_max"], last))
                     if coupled is not None and len(coupled[0]):
                         sweep_serial(x, x_n, y, mass_h2, inv_mass, coupled[0], coupled[1], t_start, t_item, t_corner,
                                      tris.elem, tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start,
@@ -960,6 +989,8 @@ class AVBD(Integrator):
         update_body_rows(x, x_n, rs.bidx, rs.bgeo, rs.bstate, n_body, opts["penalty_ramp"], opts["penalty_max"])
         update_corner_rows(x, x_n, rs.cpairs, rs.cf, rs.cstate, self._n_corner, opts["penalty_ramp"],
                            opts["penalty_max"])
+        if blocks is not None:
+            update_joint_rows(jr, blocks, opts["penalty_ramp"], opts["penalty_max"], h_rigid)
         self.iterations_run += it + 1
         self.residual = math.sqrt(most) * inv_h
         if tol > 0.0 and most > tol * tol:
