@@ -67,3 +67,21 @@ def head_on(name, *, dt, substeps):
     b = w.add_body(grid_mesh(0.4, 0.6, 5, 7), position=(0.5, 0.1), mass=0.5)
     a.velocities, b.velocities = (2.0, 0.0), (-3.0, 0.5)
     return w, a, b
+
+
+def chain(w, links, weight_ratio, material, length=0.1, width=0.02, gap=0.002):
+    """``links`` links of ``length`` (m) and ``material`` (rigid) hanging from the world at the
+    origin, each pinned ``gap`` below the top of the one above, and a square weight of
+    ``weight_ratio`` links pinned under the last; returns the weight and its joint
+    (tests/physics/test_joints.py, benchmarks/bench_joints.py)."""
+    bodies = []
+    for i in range(links):
+        m = deforma.mesh.box(((0, 0), (width, 0), (width, length - gap), (0, length - gap)), detail=1)
+        bodies.append(w.add_body(m, position=(0.0, -length / 2 - i * length), material=material))
+    side = math.sqrt(weight_ratio * bodies[0].mass / material.density)
+    m = deforma.mesh.box(((0, 0), (side, 0), (side, side), (0, side)), detail=1)
+    weight = w.add_body(m, position=(0.0, -links * length - side / 2 - gap), material=material)
+    w.join(bodies[0], None, at=(0.0, -gap))
+    for i in range(1, links):
+        w.join(bodies[i], bodies[i - 1], at=(0.0, -i * length - gap))
+    return weight, w.join(weight, bodies[-1], at=(0.0, -links * length - 1.5 * gap))

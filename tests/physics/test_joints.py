@@ -7,6 +7,7 @@ import pytest
 from scipy.special import ellipk
 
 import deforma
+from physics_meshes import chain
 
 G = 9.81
 RIGID = deforma.Material("rigid", density=100.0)
@@ -135,45 +136,27 @@ def test_a_weight_on_a_spring_stretches_it_by_mg_over_k_and_bounces_at_its_frequ
     assert np.hypot(*spring.force) > 0
 
 
-def chain(w, links, weight_ratio, length=0.1, width=0.02, gap=0.002):
-    """``links`` rigid links of ``length`` hanging from the world at the origin, each pinned
-    ``gap`` below the top of the one above, and a square weight of ``weight_ratio`` links
-    pinned under the last; returns the weight and its joint."""
-    bodies = []
-    for i in range(links):
-        m = deforma.mesh.box(((0, 0), (width, 0), (width, length - gap), (0, length - gap)), detail=1)
-        bodies.append(w.add_body(m, position=(0.0, -length / 2 - i * length), material=RIGID))
-    side = math.sqrt(weight_ratio * bodies[0].mass / RIGID.density)
-    m = deforma.mesh.box(((0, 0), (side, 0), (side, side), (0, side)), detail=1)
-    weight = w.add_body(m, position=(0.0, -links * length - side / 2 - gap), material=RIGID)
-    w.join(bodies[0], None, at=(0.0, -gap))
-    for i in range(1, links):
-        w.join(bodies[i], bodies[i - 1], at=(0.0, -i * length - gap))
-    return weight, w.join(weight, bodies[-1], at=(0.0, -links * length - 1.5 * gap))
-
-
-@pytest.mark.xfail(strict=True, reason="a new joint's rows start without a multiplier and as stiff as the light "
-                   "link's m / h^2: the weight sags 4.7 % of the chain in its first ten steps before the rows "
-                   "carry it, then holds within 0.8 % (a weight of 100 links: 3 %, then 0.06 %; issue 49)")
 def test_a_chain_of_twenty_links_holds_a_weight_of_a_thousand_links():
     # the mass ratio a block sweep finds hardest: 0.196 kg links, a 196 kg weight
     w = deforma.World(dt=1 / 60)
-    weight, joint = chain(w, 20, 1000.0)
+    weight, joint = chain(w, 20, 1000.0, RIGID)
     assert weight.mass == pytest.approx(1000 * w.bodies[0].mass)
     top0 = weight.center_of_mass[1]
-    stretch = []
+    stretch, force = [], []
     for _ in range(300):
         w.step()
         stretch.append((top0 - weight.center_of_mass[1]) / 2.0)  # of the chain's 2 m
+        force.append(joint.force[1])
     assert np.abs(stretch).max() < 0.01
     assert abs(weight.center_of_mass[0]) < 0.01  # it hangs straight
-    # the last joint carries the weight (its swing about it aside)
-    assert joint.force[1] == pytest.approx(weight.mass * G, rel=0.02)
+    # the last joint carries the weight: over the last second on average (step by step it
+    # varies by 8 %, the weight buzzing at 1.3 cm/s)
+    assert np.mean(force[-60:]) == pytest.approx(weight.mass * G, rel=0.01)
 
 
 def test_a_chain_of_twenty_equal_links_hangs_straight_and_carries_its_weight():
     w = deforma.World(dt=1 / 60)
-    weight, joint = chain(w, 20, 1.0)
+    weight, joint = chain(w, 20, 1.0, RIGID)
     y0 = weight.center_of_mass[1]
     for _ in range(300):
         w.step()
@@ -192,7 +175,7 @@ def test_two_free_bodies_pinned_together_keep_their_momentum():
 
     def momentum():
         from deforma.physics.rigid.stage import rigid_set  # the bodies' true moments of inertia
-        inertia = rigid_set(w._model).inertia
+        inertia = rigid_set(w.model).inertia
         p, spin = np.zeros(2), 0.0
         for k, body in enumerate((a, b)):
             c, v = body.center_of_mass, np.asarray(body.velocity)
@@ -207,6 +190,36 @@ def test_two_free_bodies_pinned_together_keep_their_momentum():
         assert np.abs(p - p0).max() < 1e-6 * np.abs(p0).max()
         assert abs(spin - spin0) < 5e-3 * abs(spin0)
         assert np.hypot(*(hinge.point - b.center_of_mass)) == pytest.approx(0.5, abs=1e-4)  # held
+
+
+@pytest.mark.parametrize("integrator", ["avbd", "implicit-euler"])
+def test_a_joint_breaks_past_its_break_force_and_not_before(integrator):
+    # a hanging bar pulls its hinge with its weight (4.9 N): a joint rated above it holds, one
+    # rated below it breaks in the first step that pulls harder, and the bar falls
+    w = deforma.World(dt=1 / 60, integrator=integrator)
+    m = deforma.mesh.box(((0, -0.025), (1, -0.025), (1, 0.025), (0, 0.025)), detail=2)
+    strong = w.add_body(m, position=(0.0, -0.5), angle=-90.0, material=RIGID)
+    weak = w.add_body(m, position=(2.0, -0.5), angle=-90.0, material=RIGID)
+    weight = strong.mass * G
+    holds = w.join(strong, None, at=(0.0, 0.0), break_force=1.2 * weight)
+    breaks = w.join(weak, None, at=(2.0, 0.0), break_force=0.8 * weight)
+    assert (holds.break_force, holds.broken) == (1.2 * weight, False)
+    for _ in range(60):
+        w.step()
+    assert w.joints == [holds] and not holds.broken and breaks.broken
+    assert abs(strong.center_of_mass[1] + 0.5) < 1e-3
+    assert weak.center_of_mass[1] < -0.5 - 0.5 * G * 0.9 ** 2  # falling freely since the first steps
+    with pytest.raises(ValueError, match="unknown joint"):
+        w.remove_joint(breaks)
+
+
+def test_a_scene_joint_keeps_its_break_force(tmp_path):
+    p = tmp_path / "hinge.toml"
+    p.write_text(SCENE + "[[joint]]\na = 0\nat = [0, 0]\nbreak_force = 250.5\n")
+    (j,) = deforma.load_scene(p).joints
+    assert j.break_force == 250.5
+    (k,) = deforma.load_scene(deforma.scene.save_scene(deforma.load_scene(p), tmp_path / "again.toml")).joints
+    assert k.break_force == 250.5
 
 
 def test_removing_a_joint_or_a_body_lets_go():
@@ -240,6 +253,8 @@ def test_removing_a_joint_or_a_body_lets_go():
     (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), motor_speed=10.0, max_torque=-1.0),
      "max_torque must be"),
     (lambda w, a, b, s: w.join(a, None), "at must be the point"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), break_force=0.0), "break_force must be"),
+    (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), break_force=math.inf), "break_force must be"),
     (lambda w, a, b, s: w.join(a, None, at=(10**400, 0)),
      "at must be a pair of finite numbers, got a number too large"),
     (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="spring", stiffness=10**400),
@@ -320,6 +335,7 @@ def test_a_scene_joint_hinges_its_bar_and_saves_with_the_scene(tmp_path):
      "joint[0].damping: expected a finite"),
     ("a = 0\nat = [0, 0]\nmotor_speed = 1" + "0" * 400, "joint[0].motor_speed: expected a finite"),
     ("a = 0\nat = [0, 0]\nmotor_speed = 1\nmax_torque = 1" + "0" * 400, "joint[0].max_torque: expected a finite"),
+    ("a = 0\nat = [0, 0]\nbreak_force = -1", "joint[0].break_force"),
 ])
 def test_a_bad_scene_joint_is_refused_in_one_line_naming_it(tmp_path, joint, message):
     p = tmp_path / "bad.toml"

@@ -274,3 +274,17 @@ def test_spring_parameters_set_on_the_world_say_once_which_bodies_ignore_them():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         springs.stiffness = 3000.0  # every body reads it
+
+
+def test_the_model_state_and_control_are_public_views_of_the_step():
+    w = deforma.World(dt=1 / 60)
+    a = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2), position=(0, 2))
+    b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2), position=(3, 2))
+    w.step()
+    assert w.model.n_vertices == len(a.positions) + len(b.positions) == len(w.state.x)
+    np.testing.assert_array_equal(w.state.x[b.vertex_slice], b.positions)
+    np.testing.assert_array_equal(w.state.v[a.vertex_slice], a.velocities)
+    assert w.control.n_vertices == w.model.n_vertices
+    for name in ("model", "state", "control"):
+        with pytest.raises(AttributeError):
+            setattr(w, name, None)

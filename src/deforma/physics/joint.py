@@ -41,10 +41,12 @@ class Joint:
         Where it was made (m), the point both bodies hold.
     stiffness, damping : float or None
         A spring's N/m and N s/m (None on a pin or weld).
+    break_force : float or None
+        N: the force past which a step breaks it (None: never).
     """
 
     def __init__(self, world, a: Body, b: Body | None, kind: str, anchor, local, reference: float,
-                 stiffness, damping, motor_speed, max_torque, frame=None):
+                 stiffness, damping, motor_speed, max_torque, frame=None, break_force=None):
         self._world = world
         self.a, self.b, self.kind = a, b, kind
         self.anchor = anchor
@@ -60,6 +62,8 @@ class Joint:
         # vertices (body-local indices, -1 for the world) and its (alpha, beta) there (the
         # world's point), the frames' reference angle, and the rows' warm start
         self._frame = frame
+        self.break_force = break_force
+        self._broken = False
         self._lam = np.zeros(4)
         self._pen = np.zeros(4)
 
@@ -80,6 +84,11 @@ class Joint:
         """The force (N, x and y) the joint put on ``a`` over the last step, on average (``b``
         took the opposite)."""
         return self._force[:2].copy()
+
+    @property
+    def broken(self) -> bool:
+        """Whether a step broke it (its force past ``break_force``): it has left the world."""
+        return self._broken
 
     @property
     def torque(self) -> float:

@@ -157,6 +157,8 @@ def step(world) -> None:
         raise
     if rows is not None:
         read_rows(w._joints, rows, w.dt)
+    if w._joints:
+        w._break_joints()
     w._forces.clear()
     w.time += w.dt
     w.step_count += 1

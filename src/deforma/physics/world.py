@@ -803,6 +803,36 @@ class World:
         self._control.colliders = packed
         self._packed_colliders = None if rigid else self._collider_key()
 
+    # -- the step's data ---------------------------------------------------------------------
+    @property
+    def model(self) -> Model:
+        """The bodies' constant arrays as the integrators read them (:class:`~deforma.physics.model.Model`):
+        for reading (change parameters through the World and its bodies, which keep it
+        consistent). A new Model replaces it when bodies are added, removed or torn.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> _ = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=1))
+        >>> w.model.n_vertices, float(w.model.vertex_mass.sum())
+        (9, 1.0)
+        """
+        return self._model
+
+    @property
+    def state(self) -> State:
+        """Every vertex's position and velocity, ``state.x`` and ``state.v`` ((N, 2), m and
+        m/s; :class:`~deforma.physics.state.State`), bodies one after another as in
+        :attr:`model`: for reading (a body's own are ``body.positions``, ``body.velocities``)."""
+        return self._state
+
+    @property
+    def control(self) -> Control:
+        """The step's grabs, applied forces and packed colliders
+        (:class:`~deforma.physics.control.Control`): for reading."""
+        return self._control
+
     # -- joints -----------------------------------------------------------------------------
     @property
     def joints(self) -> list[Joint]:
@@ -810,7 +840,7 @@ class World:
         return list(self._joints)
 
     def join(self, a: Body, b: Body | None = None, at=None, *, kind: str = "pin", stiffness=None, damping=None,
-             motor_speed=None, max_torque=None) -> Joint:
+             motor_speed=None, max_torque=None, break_force=None) -> Joint:
         """Join rigid body ``a`` to rigid body ``b`` (None: to the world) at the point ``at``.
 
         Parameters
@@ -828,6 +858,9 @@ class World:
         motor_speed : float, optional
             A pin's motor: drives ``a``'s spin relative to ``b`` towards this many degrees/s
             (counter-clockwise), with at most ``max_torque`` N m (default: as much as it takes).
+        break_force : float, optional
+            N: a step whose :attr:`Joint.force` exceeds it breaks the joint (it leaves
+            :attr:`joints` and :attr:`Joint.broken` turns True). Default: it never breaks.
 
         Returns
         -------
@@ -865,6 +898,7 @@ class World:
         point = _joint.anchor(at)
         stiffness, damping = _joint.spring(kind, stiffness, damping)
         motor_speed, max_torque = _joint.motor(kind, motor_speed, max_torque)
+        break_force = None if break_force is None else _positive(break_force, "break_force", "N")
         on = [body for body in (a, b) if body is not None
               and triangles_under(body.positions, body.topology.triangles, point, tolerance=1e-12).any()]
         if not on:
@@ -891,10 +925,17 @@ class World:
                 weights[2 * side:2 * side + 2] = alpha, beta
                 ref += theta if side == 0 else -theta
         j = Joint(self, a, b, kind, point, np.concatenate(local), turn, stiffness, damping, motor_speed, max_torque,
-                  frame=(np.array(verts, np.int64), np.array(weights), ref))
+                  frame=(np.array(verts, np.int64), np.array(weights), ref), break_force=break_force)
         self._joints.append(j)
         self._rigid_solve_changed()
         return j
+
+    def _break_joints(self) -> None:
+        """Take out the joints whose force over the last step exceeded their ``break_force``."""
+        broken = [j for j in self._joints if j.break_force is not None and np.hypot(*j._force[:2]) > j.break_force]
+        for j in broken:
+            j._broken = True
+            self.remove_joint(j)
 
     def remove_joint(self, joint: Joint) -> None:
         """Take a joint out of the world.

@@ -268,7 +268,8 @@ def scene_of(world) -> Scene:
     colliders = tuple(collider_spec(r, *built.get(id(r), (None, None))) for r in world.colliders)
     joints = tuple(JointSpec(a=j.a._index, b=None if j.b is None else j.b._index, at=tuple(j.anchor), kind=j.kind,
                              stiffness=j.stiffness, damping=j.damping if j.kind == "spring" else None,
-                             motor_speed=j.motor_speed, max_torque=j.max_torque) for j in world.joints)
+                             motor_speed=j.motor_speed, max_torque=j.max_torque, break_force=j.break_force)
+                   for j in world.joints)
     return replace(scene, physics=physics, interaction=interaction, body=tuple(bodies), collider=colliders,
                    joint=joints)
 

@@ -203,7 +203,8 @@ def build(scene: Scene):
     for i, j in enumerate(scene.joint):
         try:
             world.join(made[j.a], None if j.b is None else made[j.b], at=j.at, kind=j.kind, stiffness=j.stiffness,
-                       damping=j.damping, motor_speed=j.motor_speed, max_torque=j.max_torque)
+                       damping=j.damping, motor_speed=j.motor_speed, max_torque=j.max_torque,
+                       break_force=j.break_force)
         except (ValueError, IndexError, TypeError) as e:  # a scene made in code is checked here
             raise SceneError(f"{source}: joint[{i}]: {e}") from None
     _REGISTRY[world] = BuildRecord(scene, bodies, colliders)

@@ -489,6 +489,8 @@ class JointSpec:
                                          "counter-clockwise; omit for a free hinge.")
     max_torque: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N*m",
                                     doc="The most torque the motor gives; omit for as much as it takes.")
+    break_force: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N",
+                                     doc="A step that pulls harder breaks the joint; omit for one that never breaks.")
 
 
 class MaterialKeyError(ValueError):

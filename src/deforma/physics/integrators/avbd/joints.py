@@ -38,8 +38,9 @@ rows' multipliers and penalties (x, y, angle, motor), and per substep ``arm`` (J
 arms (for the world, its point), ``err0`` (J, 3) the point's and angle's error at the
 start, ``total`` (J, 3) the force and torque on ``a`` times the time so far (N s, N m s);
 ``j_start`` (K + 1,) and ``j_entry`` (2 J,) list each block's joints as ``2 j + side``;
-``island`` (K,) labels the blocks joints hold together, and ``island_ok`` (K,) is scratch
-for :func:`~deforma.physics.integrators.avbd.rigid.rigid_second_order`.
+``island`` (K,) labels the blocks joints hold together, and ``island_ok``, ``island_touch``
+(K,) say per island whether it takes BDF2 and whether it has a contact row or grab this
+substep (:func:`~deforma.physics.integrators.avbd.rigid.rigid_second_order`).
 
 Units: m, kg, s, rad; N, N/m, N m.
 """
@@ -54,7 +55,7 @@ from numba import njit
 from ...rigid.joints import SPRING, WELD
 
 JointRows = namedtuple("JointRows", ["block", "fv", "fw", "kind", "param", "motor", "lam", "pen", "arm", "err0",
-                                     "total", "j_start", "j_entry", "island", "island_ok"])
+                                     "total", "j_start", "j_entry", "island", "island_ok", "island_touch"])
 
 
 def make_joint_rows(block, fv, fw, kind, param, motor, lam, pen, n_blocks: int) -> JointRows:
@@ -90,7 +91,8 @@ def make_joint_rows(block, fv, fw, kind, param, motor, lam, pen, n_blocks: int) 
     return JointRows(np.asarray(block, np.int64), np.asarray(fv, np.int64), np.asarray(fw, np.float64),
                      np.asarray(kind, np.int64), np.asarray(param, np.float64), np.asarray(motor, np.bool_),
                      np.asarray(lam, np.float64), np.asarray(pen, np.float64), np.zeros((n, 4)), np.zeros((n, 3)),
-                     np.zeros((n, 3)), j_start, j_entry, island, np.zeros(n_blocks, np.bool_))
+                     np.zeros((n, 3)), j_start, j_entry, island, np.zeros(n_blocks, np.bool_),
+                     np.zeros(n_blocks, np.bool_))
 
 
 @njit(cache=True, inline="always")
@@ -289,3 +291,18 @@ def joint_totals(jr, blocks, h):
         jr.total[j, 0] -= h * fx
         jr.total[j, 1] -= h * fy
         jr.total[j, 2] -= h * ((jr.lam[j, 2] if jr.kind[j] == WELD else 0.0) + (jr.lam[j, 3] if jr.motor[j] else 0.0))
+
+
+@njit(cache=True)
+def joint_gap(jr, blocks, h):
+    """The widest a pin's or weld's points are apart at the blocks' poses (m), over the
+    islands without contacts (``jr.island_touch``)."""
+    most = 0.0
+    for j in range(jr.kind.shape[0]):
+        ka = jr.block[j, 0]
+        if jr.kind[j] == SPRING or jr.island_touch[jr.island[ka]]:
+            continue
+        p = blocks.pose
+        cx_, cy_, _, _, _, _, _, _, _, _, _, _, _, _ = _rows(jr, blocks, j, ka, p[ka, 0], p[ka, 1], p[ka, 2], h)
+        most = max(most, np.sqrt(cx_ * cx_ + cy_ * cy_))
+    return most

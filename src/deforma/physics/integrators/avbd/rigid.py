@@ -465,17 +465,18 @@ def block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc)
 
 
 @njit(cache=True)
-def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h):
+def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_only):
     """One Newton step with a line search per rigid body, in turn (see the module
     docstring), over the vertices with a row or a grab (:func:`rigid_active`) and its joints
-    (``jr``: :class:`~deforma.physics.integrators.avbd.joints.JointRows`). ``zeros``
+    (``jr``: :class:`~deforma.physics.integrators.avbd.joints.JointRows`; with
+    ``joined_only``, only the bodies with joints in islands without contacts). ``zeros``
     (N,): no mass per vertex (the body's own inertia replaces its vertices'). Returns the
     largest squared vertex move (m^2)."""
     most = 0.0
     acc = np.zeros(9)
     act, act_start = blocks.act, blocks.act_start
     for k in range(blocks.lo.shape[0]):
-        if blocks.held[k]:
+        if blocks.held[k] or (joined_only and (jr.j_start[k + 1] == jr.j_start[k] or jr.island_touch[jr.island[k]])):
             continue
         inv_h2 = 1.0 / (blocks.h_eff[k] * blocks.h_eff[k])
         a, b = blocks.lo[k], blocks.hi[k]
@@ -527,16 +528,16 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h):
 
 @njit(cache=True)
 def rigid_pass(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, jr, touch, planes, state, count, n_body,
-               n_corner, h, beta, k_max, last):
+               n_corner, h, beta, k_max, last, joined_only=False):
     """One pass over the rigid blocks (:func:`rigid_sweep`), after the friction bounds of the
     rows between rigid bodies follow their normal force
     (:func:`~deforma.physics.integrators.avbd.rows.freeze_rigid_bounds`) and before those rows'
     dual step (:func:`~deforma.physics.integrators.avbd.rows.update_rigid_rows`) and the
     joints' (:func:`~deforma.physics.integrators.avbd.joints.update_joint_rows`; not after the
-    ``last`` pass of a step, whose dual step is every row's). Returns the largest squared
-    vertex move (m^2)."""
+    ``last`` pass of a step, whose dual step is every row's; ``joined_only``: a pass over the
+    bodies with joints alone). Returns the largest squared vertex move (m^2)."""
     freeze_rigid_bounds(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner)
-    most = rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h)
+    most = rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_only)
     if not last:
         update_rigid_rows(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner, beta, k_max)
         update_joint_rows(jr, blocks, beta, k_max, h)
@@ -572,10 +573,14 @@ def rigid_second_order(blocks, jr, keep, h):
     hp = 2.0 * h / 3.0
     island_ok = jr.island_ok
     island_ok[:] = True
+    jr.island_touch[:] = False
     for k in range(blocks.lo.shape[0]):
         if blocks.held[k]:
             continue  # held as the world is: no part of its island's choice
-        ok = blocks.hist[k] == h and blocks.act_start[k + 1] == blocks.act_start[k]
+        touched = blocks.act_start[k + 1] > blocks.act_start[k]
+        if touched:
+            jr.island_touch[jr.island[k]] = True
+        ok = blocks.hist[k] == h and not touched
         if ok:
             e, v = blocks.end[k], blocks.v_n[k]
             scale = 1e-9 * (1.0 + abs(v[0]) + abs(v[1]) + blocks.radius[k] * abs(v[2]))
