@@ -608,6 +608,20 @@ def rigid_second_order(blocks, jr, keep, h):
 
 
 @njit(cache=True)
+def rigid_passes(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, jr, touch, planes, state, count, n_body,
+                 n_corner, h, beta, k_max, passes, last_sweep):
+    """``passes`` passes of :func:`rigid_pass` in one call (the last of the ``last_sweep``
+    without its dual step), where no soft vertex is swept between them: called pass by pass
+    from Python, the calls' overhead was a third of a rigid pendulum's step. Returns the
+    largest squared vertex move (m^2)."""
+    most = 0.0
+    for q in range(passes):
+        most = max(most, rigid_pass(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, jr, touch, planes, state,
+                                    count, n_body, n_corner, h, beta, k_max, last_sweep and q == passes - 1))
+    return most
+
+
+@njit(cache=True)
 def rigid_rates(blocks, h):
     """The rigid bodies' velocities over the substep of ``h`` s, from their poses, into
     ``blocks.rate``: backward Euler's ``(c - c_n) / h`` and spin ``phi / h``, or BDF2's

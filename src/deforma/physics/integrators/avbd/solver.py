@@ -87,6 +87,7 @@ from .rigid import (
     rigid_blocks,
     rigid_correction,
     rigid_pass,
+    rigid_passes,
     rigid_place,
     rigid_rates,
     rigid_second_order,
@@ -967,7 +968,12 @@ class AVBD(Integrator):
                               control.grab_slot, control.grab_pull, rs, inv_h)
             rigid_correction(x, x_n, y, mass_h2, inv_mass, model.body_vertex_offsets, control.grab_slot,
                              control.grab_pull, rs)
-            if blocks is not None:
+            if blocks is not None and (coupled is None or not len(coupled[0])):
+                most = max(most, rigid_passes(x, x_n, self._zeros, model.rigid, blocks, control.grab_slot,
+                                              control.grab_pull, rs, jr, self._touch, self._planes, self._rows, count,
+                                              n_body, self._n_corner, h_rigid, opts["penalty_ramp"],
+                                              opts["penalty_max"], opts["rigid_passes"], it == sweeps - 1))
+            elif blocks is not None:
                 # the rigid blocks' passes, each followed by their rows' dual step and by the
                 # soft vertices that touch them
                 for q in range(opts["rigid_passes"]):
@@ -976,11 +982,10 @@ class AVBD(Integrator):
                                                 control.grab_pull, rs, jr, self._touch, self._planes, self._rows, count,
                                                 n_body, self._n_corner, h_rigid, opts["penalty_ramp"],
                                                 opts["penalty_max"], last))
-                    if coupled is not None and len(coupled[0]):
-                        sweep_serial(x, x_n, y, mass_h2, inv_mass, coupled[0], coupled[1], t_start, t_item, t_corner,
-                                     tris.elem, tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start,
-                                     s_item, s_corner, springs.i, springs.j, springs.rest, springs.ks, springs.kd,
-                                     control.grab_slot, control.grab_pull, rs, inv_h, self._moves)
+                    sweep_serial(x, x_n, y, mass_h2, inv_mass, coupled[0], coupled[1], t_start, t_item, t_corner,
+                                 tris.elem, tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start,
+                                 s_item, s_corner, springs.i, springs.j, springs.rest, springs.ks, springs.kd,
+                                 control.grab_slot, control.grab_pull, rs, inv_h, self._moves)
             if rho > 0.0:
                 omega = chebyshev_omega(it, rho, omega)
                 chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)
