@@ -112,8 +112,10 @@ def start_joint_rows(x_n, blocks, jr, k_floor):
 
     Unlike the contact rows' (``lambda * 0.98``, ``k * 0.99``), a joint's rows are carried
     whole: a joint holds for good, and its load changes smoothly. Decayed, the multipliers of
-    a chain of 20 equal links hanging still fell short of its weight every step, and under
-    BDF2 the chain swung up to 0.12 m/s; carried whole it hangs at 1e-10 m/s."""
+    a chain of 20 equal links hanging still fell short of its weight every step, and with the
+    chain on BDF2 throughout it swung up to 0.12 m/s; carried whole it hung at 1e-10 m/s
+    (with :func:`~deforma.physics.integrators.avbd.rigid.rigid_second_order`'s switching it
+    sways at up to 2 mm/s)."""
     for j in range(jr.kind.shape[0]):
         ka, kb = jr.block[j, 0], jr.block[j, 1]
         pax, pay, tha = frame_point(x_n, jr.fv[j, 0], jr.fv[j, 1], jr.fw[j, 0], jr.fw[j, 1])

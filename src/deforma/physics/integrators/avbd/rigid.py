@@ -568,7 +568,8 @@ def rigid_second_order(blocks, jr, keep, h):
     BDF2 does not damp what an unconverged solve leaves, and a chain of 20 links with a
     weight of 100 links swung at 0.6 m/s after 10 s. The blocks joints hold together
     (``jr.island``) take one scheme: mixed, the chain of 20 equal links never came to rest
-    (5 mm/s); all on BDF2 it hangs at 1e-10 m/s. With ``y = 4/3 q_n - 1/3 q_(n-1)``, ``w = 4/3 v_n - 1/3 v_(n-1)``:
+    (5 mm/s); all on BDF2 it hung at 1e-10 m/s. (Switching an island between the two as its
+    joints' error crosses :data:`JOINT_SLACK` still leaves that chain swaying at up to 2 mm/s.) With ``y = 4/3 q_n - 1/3 q_(n-1)``, ``w = 4/3 v_n - 1/3 v_(n-1)``:
     the target is ``y + h' w + h'^2 a`` for the inertia ``M / h'^2``, ``h' = 2h/3``."""
     hp = 2.0 * h / 3.0
     island_ok = jr.island_ok
