@@ -436,17 +436,34 @@ def test_unreachable_address_fails_fast():
     assert time.perf_counter() - t0 < 30
 
 
-@pytest.mark.parametrize("address", ["garbage", "unreachable"])
+@pytest.mark.parametrize("address", [
+    "1.2.3.4:\u00b2",                          # isdigit() but no int(): a ValueError of int()'s own
+    "127.0.0.1:0", "127.0.0.1:65536",          # no such port (the resolver wrapped 65536 + P to P)
+    "127.0.0.1:99999999999999999999",          # an OverflowError traceback from the resolver
+    "127.0.0.1:" + "1" * 5000,                 # past int()'s 4300 digits
+    "a" * 64 + ".example:6379", "x..y:6379",   # labels the resolver's IDNA codec refuses (UnicodeError)
+    "bad\nhost:6379",                          # a line break would make the message two lines
+], ids=["superscript", "port 0", "port 65536", "20 digits", "5000 digits", "long label", "empty label",
+        "line break"])
+def test_an_address_that_is_no_host_and_port_is_refused_at_once_in_one_line(address):
+    t0 = time.perf_counter()
+    with pytest.raises(sweeps.SweepError, match=r"^--address .*: expected HOST:PORT .*a port in 1-65535") as e:
+        sweeps._check_reachable(address)
+    assert "\n" not in str(e.value) and time.perf_counter() - t0 < 1
+
+
+@pytest.mark.parametrize("address", ["garbage", "unreachable", "127.0.0.1:99999999999999999999"])
 @pytest.mark.parametrize("existed", [False, True])
 def test_a_failed_address_leaves_nothing_behind(folder, tmp_path, address, existed):
-    """`deforma sweep --address` that cannot connect: one line, exit 1, and no folder made (the
-    table's folder was made before the connection and left behind); a folder that was there
-    stays, as it was. In a process of its own: this one may hold the module's cluster, and then
-    an address is not looked at."""
+    """`deforma sweep --address` that cannot connect: one line, exit 1, no traceback, and no
+    folder made (the table's folder was made before the connection and left behind); a folder
+    that was there stays, as it was. In a process of its own: this one may hold the module's
+    cluster, and then an address is not looked at."""
     import os
     import subprocess
     import sys
 
+    expected = None if address == "unreachable" else "expected HOST:PORT"
     address = f"127.0.0.1:{_free_port()}" if address == "unreachable" else address
     spec = _spec(folder, "address.toml", SWEEP)
     if existed:
@@ -459,7 +476,8 @@ def test_a_failed_address_leaves_nothing_behind(folder, tmp_path, address, exist
     assert time.perf_counter() - t0 < 60
     assert r.returncode == 1 and r.stdout == "", (r.stdout, r.stderr)
     assert r.stderr.startswith("deforma: error: ") and r.stderr.count("\n") == 1, r.stderr
-    assert ("expected HOST:PORT" if address == "garbage" else f"cannot reach a Ray cluster at {address}") in r.stderr
+    assert "Traceback" not in r.stderr
+    assert (expected or f"cannot reach a Ray cluster at {address}") in r.stderr
     assert sorted(os.listdir(tmp_path)) == (["out"] if existed else [])
     assert not existed or os.listdir(tmp_path / "out") == []
 

@@ -140,3 +140,8 @@ class StepBeyondStableWarning(RuntimeWarning):
     estimate with the new body, so a step will likely blow up (the message says what to set).
     Here, with the other checks at the boundary, so that the command line can filter it
     without importing the physics."""
+
+
+class CallbackWarning(RuntimeWarning):
+    """A listener registered with ``world.on_contact`` or ``world.on_joint_break`` raised: said
+    once per listener, with its name and error; the step it was called after stands."""

@@ -300,12 +300,21 @@ class _MeshExport:
 def _check_distinct_outputs(a) -> None:
     """Refuse two of ``-o``, ``--states`` and ``--export`` naming one path: the second to be
     put in place failed on the first (``--export o.mp4 -o o.mp4`` left a folder o.mp4 behind,
-    ``--export s.npz --states s.npz`` the states and a hidden temporary folder's name)."""
+    ``--export s.npz --states s.npz`` the states and a hidden temporary folder's name). Refuse
+    ``-o`` or ``--states`` inside the ``--export`` folder too: that folder is put in place
+    whole at the end and must then be empty (``--export d --states d/s.npz`` wrote the states,
+    then failed after the whole run on "Directory not empty")."""
     given = [(flag, Path(p)) for flag, p in (("-o", a.output), ("--states", a.states), ("--export", a.export)) if p]
     for i, (flag, path) in enumerate(given):
         for other, path2 in given[i + 1:]:
             if path.resolve() == path2.resolve():
                 raise CliError(f"{flag} and {other} both name {path}: give each output a path of its own")
+    if a.export:
+        folder = Path(a.export).resolve()
+        for flag, path in (("-o", a.output), ("--states", a.states)):
+            if path and folder in Path(path).resolve().parents:
+                raise CliError(f"{flag} {path} is inside --export {a.export}, a folder put in place whole when the run "
+                               f"ends: give {flag} a path outside it")
 
 
 def cmd_run(a) -> int:

@@ -493,12 +493,19 @@ def _check_reachable(address: str) -> None:
         return
     hostport = address.split("://", 1)[-1].rstrip("/")
     host, _, port = hostport.rpartition(":")
-    if not host or not port.isdigit():
-        raise SweepError(f"--address {address}: expected HOST:PORT (what `ray start --head` prints), "
-                         f"ray://HOST:PORT or auto")
+    # repr() for a line break or other control character: the message stays one line
+    garbage = SweepError(f"--address {address if address.isprintable() else repr(address)}: expected HOST:PORT "
+                         f"(what `ray start --head` prints; a port in 1-65535), ray://HOST:PORT or auto")
+    # the port as at most 5 ASCII digits: isdigit() alone takes "²", which int() refuses; the
+    # resolver wraps 99999 round to another port and overflows on 20 digits (a traceback)
+    if not (host and address.isprintable() and port.isascii() and port.isdigit() and len(port) <= 5
+            and 0 < int(port) <= 65535):
+        raise garbage
     try:
         with socket.create_connection((host.strip("[]"), int(port)), timeout=CONNECT_TIMEOUT):
             pass
+    except UnicodeError:  # no host name: the resolver's IDNA codec refuses a label empty or over 63 characters
+        raise garbage from None
     except OSError as e:
         raise SweepError(f"cannot reach a Ray cluster at {address} ({e.strerror or e}); start one with "
                          f"`ray start --head`, or leave out the address for a local cluster") from None

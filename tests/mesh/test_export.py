@@ -152,6 +152,11 @@ def test_run_exports_json_with_frame_and_time(tmp_path, capsys):
     ("none", ["--export", "{p}.mp4", "-o", "{p}.mp4"], "-o and --export both name"),
     ("none", ["--export", "{p}.npz", "--states", "{p}.npz"], "--states and --export both name"),
     ("none", ["-o", "{p}.npz", "--states", "{p}/../target.npz"], "-o and --states both name"),
+    # inside the export folder, which is put in place whole at the end: the states were written,
+    # then the run failed on "Directory not empty" after all its work
+    ("empty", ["--export", "{p}", "--states", "{p}/s.npz"], "--states {p}/s.npz is inside --export {p}, a folder"),
+    ("empty", ["--export", "{p}", "-o", "{p}/x.gif"], "-o {p}/x.gif is inside --export {p}, a folder"),
+    ("none", ["--export", "{p}", "-o", "{p}/frames/"], "-o {p}/frames/ is inside --export {p}, a folder"),
 ])
 def test_bad_export_arguments_are_refused_before_any_work(tmp_path, capsys, setup, args, message):
     p = tmp_path / "target"
@@ -160,10 +165,26 @@ def test_bad_export_arguments_are_refused_before_any_work(tmp_path, capsys, setu
     elif setup == "full":
         p.mkdir()
         (p / "keep.txt").write_text("keep")
+    elif setup == "empty":
+        p.mkdir()
     before = sorted(tmp_path.rglob("*"))
     code, _, err = run(capsys, "run", "jelly", "--seconds", "0.1", *[a.format(p=p) for a in args], "--quiet")
-    assert code == EXIT_ERROR and message in err and err.count("\n") == 1
+    assert code == EXIT_ERROR and message.format(p=p) in err and err.count("\n") == 1 and "Traceback" not in err
     assert sorted(tmp_path.rglob("*")) == before
+
+
+def test_no_meshes_are_an_empty_svg_as_they_are_an_empty_obj_and_json(tmp_path, capsys):
+    # a scene of colliders only: its SVG frames ended the run in NumPy's "need at least one array
+    # to concatenate"; OBJ and JSON wrote files without objects
+    write_meshes([], tmp_path / "none.svg")
+    root = ET.parse(tmp_path / "none.svg").getroot()
+    assert root.get("width") == root.get("height") == "800" and len(root) == 0
+    scene = tmp_path / "empty.toml"
+    scene.write_text("[[collider]]\ncenter = [0.0, 0.0]\nsize = [5.0, 0.5]\n")
+    code, _, err = run(capsys, "run", str(scene), "--seconds", "0.1", "--fps", "20", "--export", str(tmp_path / "m"),
+                       "--format", "svg", "--quiet")
+    assert code == 0 and err == ""
+    assert sorted(p.name for p in (tmp_path / "m").iterdir()) == [f"frame_0000{k}.svg" for k in range(2)]
 
 
 def test_an_unstable_run_exports_nothing(tmp_path, capsys):

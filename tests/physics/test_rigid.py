@@ -188,6 +188,22 @@ def test_rigid_bodies_change_back_to_avbd():
     assert max(heights) - min(heights) < 5e-3 and min(heights) > 0.295 and abs(angle) < 0.1
 
 
+@pytest.mark.parametrize("offset", [0.0, pytest.param(0.05, marks=pytest.mark.xfail(strict=True, reason=(
+    "landing off-centre at 2.5 m/s the top box ends tilted 28 degrees, a corner 4 cm inside the lower box "
+    "(issue 49)")))])
+def test_a_rigid_box_dropped_on_another_lands_flat_on_it(offset):
+    w = deforma.World()
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
+    box = lambda size: deforma.mesh.box(((0, 0), (size, 0), (size, size), (0, size)), detail=3, edges=True)  # noqa: E731
+    wood = deforma.Material("rigid", density=600.0)
+    w.add_body(box(0.4), position=(0, 0.22), material=wood)
+    top = w.add_body(box(0.25), position=(offset, 0.9), material=wood)
+    for _ in range(120):
+        w.step()
+    assert abs(top.angle) < 0.5 and abs(top.center_of_mass[1] - 0.525) < 3e-3
+    assert abs(top.center_of_mass[0] - offset) < 0.01 and np.abs(top.velocities).max() < 1e-3
+
+
 def test_a_jelly_block_stays_on_a_level_rigid_crate():
     # it slid off at 0.8 m/s under implicit Euler when the crate was a rigid stage's outline
     w = deforma.World(dt=1 / 60)

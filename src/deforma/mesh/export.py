@@ -72,7 +72,13 @@ def json_data(meshes: Sequence[Mesh], names: Sequence[str], **extra) -> dict:
 def svg_text(meshes: Sequence[Mesh], names: Sequence[str], colors: Sequence[str] = (), *,
              width: int = 800) -> str:
     """SVG of ``meshes`` filled with ``colors`` (CSS colours; grey by default), every triangle
-    outlined thinly, y up as in the world; ``width`` pixels wide, the height following."""
+    outlined thinly, y up as in the world; ``width`` pixels wide, the height following (no
+    meshes: an empty square picture)."""
+    if len(meshes) == 0:
+        # nothing to frame (a scene of colliders only): an empty picture, as OBJ and JSON write
+        # no objects; the bounds below would be NumPy's "need at least one array" instead
+        return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{width}" '
+                f'viewBox="0 0 {width} {width}">\n</svg>\n')
     pts = np.concatenate([m.vertices for m in meshes])
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     span = np.maximum(hi - lo, 1e-9)
@@ -99,7 +105,7 @@ def write_meshes(meshes: Sequence[Mesh], path, *, names: Sequence[str] | None = 
     Parameters
     ----------
     meshes : sequence of Mesh
-        Written in order, one object each.
+        Written in order, one object each (none: a file without objects, an empty picture).
     path : str or Path
         The file; its folder must exist.
     names : sequence of str, optional

@@ -134,6 +134,9 @@ def step(world) -> None:
             end_joint_forces(w, w.dt)
         else:
             _integrate(w, start, moving, w._substeps)
+        # the contacts as the integrator left them, in the numbering of the Model it stepped
+        # (a tear below may renumber the vertices)
+        record = (w._model, w._model_bodies, w._integrator.contact_impulses(w._model))
         for c, _, _ in poses:  # the kernels moved the packed copies; now the objects
             c.advance(w.dt)
         if moved or poses:
@@ -157,11 +160,14 @@ def step(world) -> None:
         raise
     if rows is not None:
         read_rows(w._joints, rows, w.dt)
-    if w._joints:
-        w._break_joints()
     w._forces.clear()
     w.time += w.dt
     w.step_count += 1
+    w._contact_record = record
+    if w._events.listening:
+        w._events.contacts(w._pairs(), w.step_count, w.time)
+    if w._joints:
+        w._break_joints()
 
 
 def _integrate(w, start, moving: bool, substeps: int) -> None:

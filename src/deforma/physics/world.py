@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import Any, Callable
 
 import numpy as np
 
@@ -31,9 +32,11 @@ from .body import Body, Grab, _fem_mesh_check, _material, _pressure, _spin
 from .colliders.shapes import INV_INERTIA, INV_MASS, SHAPES, Collider, pack_colliders
 from .contact.clearance import outlines_overlap
 from .contact.contacts import ContactPoints, Contacts
+from .contact.pairs import ContactPair, group_pairs, impulses_from_points
 from .control import Control
 from ..checks import IgnoredSettingWarning, StepBeyondStableWarning
 from .diagnostics import Energy, SimulationUnstable
+from .events import ContactEvent, Events
 from . import joint as _joint
 from .joint import Joint
 from .integrators import make_integrator
@@ -130,6 +133,9 @@ class World:
         self._lost_shape = {}  # id(body) -> checks in a row at which it had lost its shape
         self._forces = []  # (body, body-local vertices, forces): applied during the next step
         self._joints: list[Joint] = []
+        self._events = Events()  # on_contact, on_joint_break
+        self._contact_record = None  # (model, its bodies, ContactImpulses or None) of the last step
+        self._pair_cache = None  # (contact record, its pairs by key)
         self._gravity, self._air_drag = (0.0, -9.81), 0.0
         self._model = Model([], masses=[], stiffness=[], damping=[])
         self._model_bodies = []
@@ -180,6 +186,8 @@ class World:
         new._lost_shape = {ids[k]: n for k, n in self._lost_shape.items() if k in ids}
         if self._packed_colliders is not None:
             new._packed_colliders = tuple((ids.get(k, k), version) for k, version in self._packed_colliders)
+        new._events.touching = {(id(p.a), id(p.b)): p for p in new._events.touching.values()}
+        new._pair_cache = None
         return new
 
     # -- parameters -------------------------------------------------------------------------
@@ -740,6 +748,105 @@ class World:
         rigid = rigid_set(m).bodies if m.n_vertices and m.rigid.any() else np.zeros(0, np.int64)
         return self._contacts.points(m.contact, self._control.colliders, len(self._colliders), rigid)
 
+    def _pairs(self) -> dict:
+        """The last step's touching pairs by ``(id(a), id(b))`` (:func:`~deforma.physics.contact.pairs.group_pairs`),
+        worked out once per step: from the integrator's contact rows where it keeps their
+        forces (avbd), else from :attr:`contacts` (no impulses). None once a body was added or
+        removed since (their vertices no longer number as the step's did)."""
+        record = self._contact_record
+        if record is None:
+            return {}
+        model, bodies, imp = record
+        if model is not self._model:
+            return {}
+        if self._pair_cache is not None and self._pair_cache[0] is record:
+            return self._pair_cache[1]
+        offsets = model.body_vertex_offsets
+        vertex_body = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+        rigid_of = None
+        if imp is None:
+            imp, rigid_of = impulses_from_points(self.contacts, self._state.x)
+        pairs = group_pairs(imp, vertex_body, bodies, self._colliders, rigid_of)
+        self._pair_cache = (record, pairs)
+        return pairs
+
+    def contact_pairs(self) -> list[ContactPair]:
+        """Every body touching another body or a collider after the last step, as
+        :class:`~deforma.physics.contact.pairs.ContactPair` (``a`` a body; ``b`` a body of
+        higher index or a collider): the impulses between them over the step (N s, from the
+        contact rows' multipliers under avbd; NaN under the other integrators, which keep no
+        contact force) and the contact points. A body's contacts with itself are not listed;
+        after a body is added or removed, nothing is until the next step.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> floor = w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0.0))
+        >>> box = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2, edges=True),
+        ...                  position=(0, 0.6), material=deforma.Material("rigid", density=10.0))
+        >>> for _ in range(60):
+        ...     w.step()
+        >>> (p,) = w.contact_pairs()
+        >>> p.a is box, p.b is floor, round(p.normal_impulse / w.dt, 1)  # its weight, N
+        (True, True, 98.1)
+        """
+        return list(self._pairs().values())
+
+    def contacts_between(self, a, b) -> ContactPair | None:
+        """The contact of ``a`` and ``b`` (bodies or colliders, either order) over the last
+        step, seen from ``a`` (its ``impulse`` acts on ``a``), or None if they do not touch
+        (see :meth:`contact_pairs`)."""
+        pairs = self._pairs()
+        if (id(a), id(b)) in pairs:
+            return pairs[(id(a), id(b))]
+        if (id(b), id(a)) in pairs:
+            return pairs[(id(b), id(a))].flipped()
+        return None
+
+    def on_contact(self, callback: Callable[[ContactEvent], Any]) -> Callable[[ContactEvent], Any]:
+        """Call ``callback(event)`` after each step with a
+        :class:`~deforma.physics.events.ContactEvent` per pair that began (``event.kind ==
+        "begin"``) or ended (``"end"``) touching in it (pairs as :meth:`contact_pairs`); pairs
+        already touching when it is registered begin at the next step. Returns ``callback``,
+        so it can decorate. A callback that raises is reported once (a ``CallbackWarning``
+        naming it) and the step completes; :meth:`remove_listener` stops it.
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World()
+        >>> floor = w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0.0))
+        >>> _ = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2), position=(0, 1))
+        >>> seen = []
+        >>> @w.on_contact
+        ... def landed(event):
+        ...     seen.append((event.kind, event.b is floor, event.step))
+        >>> for _ in range(60):
+        ...     w.step()
+        >>> seen  # the seed's springs bounce once
+        [('begin', True, 19), ('end', True, 23), ('begin', True, 28)]
+        """
+        self._events.contact.append(Events.checked(callback, "on_contact"))
+        return callback
+
+    def on_joint_break(self, callback: Callable[[Joint], Any]) -> Callable[[Joint], Any]:
+        """Call ``callback(joint)`` after the step in which a joint's force exceeded its
+        ``break_force`` (the joint is then out of the world, ``joint.broken`` True). Returns
+        ``callback``; errors as :meth:`on_contact`'s."""
+        self._events.joint_break.append(Events.checked(callback, "on_joint_break"))
+        return callback
+
+    def remove_listener(self, callback) -> None:
+        """Stop calling a callback registered with :meth:`on_contact` or :meth:`on_joint_break`.
+
+        Raises
+        ------
+        ValueError
+            If it is not registered.
+        """
+        self._events.remove(callback)
+
     # -- colliders --------------------------------------------------------------------------
     @property
     def colliders(self) -> tuple:
@@ -936,6 +1043,8 @@ class World:
         for j in broken:
             j._broken = True
             self.remove_joint(j)
+        if broken:
+            self._events.joints_broken(broken)
 
     def remove_joint(self, joint: Joint) -> None:
         """Take a joint out of the world.

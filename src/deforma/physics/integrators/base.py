@@ -275,6 +275,12 @@ class Integrator:
         """Counters of the work done so far (per integrator; empty by default)."""
         return {}
 
+    def contact_impulses(self, model):
+        """The last step's contact rows with their impulses
+        (:class:`~deforma.physics.contact.pairs.ContactImpulses`), or None where the integrator
+        keeps no contact force (the World then lists its contacts without impulses)."""
+        return None
+
     def step(self, model, state_in, state_out, control, contacts, h: float, *, substeps: int = 1,
              max_speed: float = math.inf) -> StepReport:
         """Advance ``state_out`` by ``substeps`` substeps of ``h`` seconds (see the module docstring)."""

@@ -49,6 +49,7 @@ from ...colliders.response import (
     CORNER_STATIC,
     CORNER_TARGET,
 )
+from ...contact.pairs import ContactImpulses
 
 #: A step's contact rows as the sweeps read them: the collider rows (``vertex_row`` (N,),
 #: ``planes`` (N, 7), ``rows`` (N, ROW_COLUMNS)) and the body rows (their vertices ``bidx``
@@ -677,3 +678,26 @@ def start_rigid_rows(rigid, k_rigid, v, touch, planes, state, count, rs, n_body,
             rvy = (1.0 - s) * v[ia, 1] + s * v[ib, 1] - cf[c, CORNER_MY] / h
             rs.cstate[c, STICK] = 1.0 if _impact_sticks(rvx, rvy, cf[c, CORNER_NX], cf[c, CORNER_NY],
                                                          cf[c, CORNER_STATIC]) else 0.0
+
+
+def row_impulses(x, touch, plane_rows, planes, state, count, bidx, bgeo, bstate, n_body, cpairs, cf, cstate,
+                 n_corner, h):
+    """The impulses of a substep's rows (N s, their multipliers after the dual step times ``h``)
+    as a :class:`~deforma.physics.contact.pairs.ContactImpulses`: the collider rows
+    (``touch``, ``plane_rows``, ``planes``, ``state``), the body rows (``bidx``, ``bgeo``,
+    ``bstate``) and the corner rows (``cpairs``, ``cf``, ``cstate``), the first ``count``,
+    ``n_body`` and ``n_corner`` of each; the points at ``x``. Each row's force on its pushed
+    side is ``lambda_n n + lambda_t t`` (``t = (-n_y, n_x)``), as its block takes it."""
+    v = touch[:count].astype(np.int64)
+    bv = bidx[:n_body, 0]
+    return ContactImpulses(
+        vertex=np.concatenate([v, bv, np.full(n_corner, -1, np.int64)]),
+        edge=np.concatenate([np.full((count, 2), -1, np.int64), bidx[:n_body, 1:3], cpairs[:n_corner, 0:2]]),
+        collider=np.concatenate([plane_rows[:count].astype(np.int64), np.full(n_body, -1, np.int64),
+                                 cpairs[:n_corner, 3]]),
+        point=np.concatenate([x[v], x[bv], cf[:n_corner, CORNER_PX:CORNER_PY + 1]]),
+        normal=np.concatenate([planes[:count, 0:2], bgeo[:n_body, BODY_NX:BODY_NY + 1],
+                               cf[:n_corner, CORNER_NX:CORNER_NY + 1]]),
+        normal_impulse=h * np.concatenate([state[:count, LAM_N], bstate[:n_body, LAM_N], cstate[:n_corner, LAM_N]]),
+        friction_impulse=h * np.concatenate([state[:count, LAM_T], bstate[:n_body, LAM_T],
+                                             cstate[:n_corner, LAM_T]]))

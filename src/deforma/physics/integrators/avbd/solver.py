@@ -61,6 +61,7 @@ from ...colliders.response import CORNER_COLUMNS, contact_planes, corner_contact
 from ...contact.broad_phase import gather_start
 from ...contact.contacts import SPECULATIVE, make_buffer, make_scratch
 from ...contact.narrow_phase import detect_contacts
+from ...contact.pairs import ContactImpulses
 from ...contact.response import hold_start_distance
 from ...elements.springs import spring_vertex_block
 from ...elements.triangles import triangle_vertex_block
@@ -108,6 +109,7 @@ from .rows import (
     freeze_corner_bounds,
     mark_rowed,
     row_blocks,
+    row_impulses,
     start_body_rows,
     start_corner_rows,
     start_rigid_rows,
@@ -548,6 +550,12 @@ class AVBD(Integrator):
         self.residual = 0.0
         self.active_contacts = 0
         self.failsafe = 0
+        self._impulses = []  # the last step's rows' impulses, a ContactImpulses per substep
+
+    def contact_impulses(self, model) -> ContactImpulses:
+        """The contact rows of the last step and their impulses, from the multipliers
+        (:func:`~deforma.physics.integrators.avbd.rows.row_impulses`; every substep's rows)."""
+        return ContactImpulses.concatenate(self._impulses)
 
     def stats(self) -> dict:
         """``{"iterations", "unconverged", "residual", "contacts", "failsafe", "split"}``: sweeps
@@ -665,6 +673,7 @@ class AVBD(Integrator):
         rects, hits, ctopo, scr = control.colliders, contacts.hits, model.contact, contacts.scratch
         vmax2 = float(max_speed) ** 2
         reach = opts["reach"]
+        self._impulses = []
         for _ in range(substeps):
             parts, k = 1, 0
             while k < parts:
@@ -737,6 +746,9 @@ class AVBD(Integrator):
                 close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
                 close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
                 close_corner_rows(self._cpairs, self._n_corner, self._corner_memory[0], self._cstate)
+                self._impulses.append(row_impulses(x, self._touch, self._plane_rows, self._planes, self._rows, count,
+                                                   self._bidx, self._bgeo, self._bstate, n_body, self._cpairs,
+                                                   self._cf, self._cstate, self._n_corner, hs))
                 self.active_contacts = count + n_body + self._n_corner
                 solved = x.copy() if free else None
                 bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, hs, vmax2)
