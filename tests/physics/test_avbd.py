@@ -276,8 +276,14 @@ def test_an_impact_is_split_so_the_box_below_is_not_crushed():
     assert worst == 0
     assert least > 0.3
     assert w.integrator_stats["split"] > 0
-    _, worst_unsplit, least_unsplit = two_box_drop(reach=0.0)
-    assert worst_unsplit > 10 and least_unsplit < 0.25
+    # unsplit (reach = 0) it is crushed: since the rows hold out vertices that end a step a
+    # little inside another body, the crushed box is detected as having lost its shape
+    try:
+        _, worst_unsplit, least_unsplit = two_box_drop(reach=0.0)
+    except deforma.SimulationUnstable as error:
+        assert "lost its shape" in str(error)
+    else:
+        assert worst_unsplit > 10 and least_unsplit < 0.25
 
 
 def test_the_jelly_stack_settles():

@@ -239,7 +239,7 @@ class Model:
                                        i32(ea), i32(eb), i32(ebody),
                                        np.zeros(v), np.zeros(v), np.zeros(nb, np.int32), np.zeros(nb),
                                        np.zeros((nb, 2)), np.zeros(1), np.zeros(nb + 1, np.int64),
-                                       np.zeros(0, np.int32))
+                                       np.zeros(0, np.int32), np.zeros(1))
         for b in range(nb):
             if contact is not None:
                 self.set_contact_parameters(b, **contact[b])

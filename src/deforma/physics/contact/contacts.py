@@ -68,6 +68,9 @@ ContactTopology = namedtuple("ContactTopology", [
     "margin",           # (1,) float64: growth of the edge boxes (m): SPECULATIVE times the largest thickness
     "joined_start",     # (B + 1,) int64: CSR, the bodies a joint holds to body b (which it does not collide with)
     "joined",           # (P,) int32: ... are joined[joined_start[b]:joined_start[b + 1]]
+    "behind",           # (1,) float64: a vertex that starts behind another body's outline edge by
+                        #   less than this share of the pair's thickness, its foot on the edge, is
+                        #   taken as in front (0 here; 1 in avbd's row search: pair_contact)
 ])
 
 ContactScratch = namedtuple("ContactScratch", [
@@ -116,7 +119,7 @@ def empty_topology(n_bodies: int = 0) -> ContactTopology:
     return ContactTopology(i32, i32, i32, offsets, offsets, np.zeros((0, 3), np.int32), offsets, i32, i32, i32, f64,
                            f64, np.zeros(n_bodies, np.int32),
                            np.zeros(n_bodies), np.zeros((n_bodies, 2)), np.zeros(1), np.zeros(n_bodies + 1, np.int64),
-                           i32)
+                           i32, np.zeros(1))
 
 
 def make_scratch(n_vertices: int, n_edges: int, n_bodies: int = 0) -> ContactScratch:

@@ -26,7 +26,7 @@ def _cross_at(t, q0x, q0y, dqx, dqy, e0x, e0y, dex, dey):
 
 
 @njit(cache=True)
-def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thickness):
+def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thickness, behind=0.0):
     """Contact of a point moving ``p0 -> p1`` with an edge moving ``(a0, b0) -> (a1, b1)``.
 
     The edge's body lies on its left; ``d`` is the point's signed distance from the edge's
@@ -35,7 +35,11 @@ def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thi
     ``PROXIMITY`` (started in front, ended within ``thickness`` m in front of the segment)
     or ``CROSSING`` (crossed the segment, from either side); ``s`` the foot's position along the edge; ``(nx, ny)`` the unit normal toward
     the side the point must stay on; ``target`` the distance from the line along it that
-    the response restores, and ``depth`` how far the point is from it.
+    the response restores, and ``depth`` how far the point is from it. A point that starts
+    behind the line by less than ``behind`` (m), its foot on the edge, is taken as starting in
+    front: a vertex a little inside another body, which a solver's rows then hold out (two
+    rigid boxes that met at 2.5 m/s ended a step 0.03 mm into each other; seen as behind, the
+    pairs were no contacts from then on, and the top box sank in and tipped over).
 
     Examples
     --------
@@ -70,6 +74,9 @@ def pair_contact(p0x, p0y, p1x, p1y, a0x, a0y, a1x, a1y, b0x, b0y, b1x, b1y, thi
     q0y = p0y - a0y
     f0 = q0x * e0y - q0y * e0x          # d0 * |e0|
     front = f0 >= 0.0
+    if not front and f0 * f0 < behind * behind * l0:
+        s0 = (q0x * e0x + q0y * e0y) / l0
+        front = 0.0 <= s0 <= 1.0
     q1x = p1x - a1x
     q1y = p1y - a1y
     f1 = q1x * e1y - q1y * e1x          # d1 * |e1|
@@ -281,6 +288,7 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
     cv, body = topo.cv_vertex, topo.cv_body
     ce_a, ce_b, ce_body = topo.ce_a, topo.ce_b, topo.ce_body
     thick_other, thick_self, body_thick = topo.thick_other, topo.thick_self, topo.body_thickness
+    behind = topo.behind[0]
     n_outline = topo.body_interior[0]
     friction = topo.body_friction
     xp = scr.xp
@@ -326,7 +334,7 @@ def check_pairs(x, topo, scr, out, first, n_pairs, every, crossings_only):
         ib = cv[b]
         kind, s, nx, ny, depth, target = pair_contact(xp[k, 0], xp[k, 1], x[i, 0], x[i, 1], xp[a, 0], xp[a, 1],
                                                       x[ia, 0], x[ia, 1], xp[b, 0], xp[b, 1], x[ib, 0], x[ib, 1],
-                                                      thick)
+                                                      thick, 0.0 if own else behind * thick)
         if kind == 0 or (crossings_only and kind != CROSSING):
             continue
         if n < cap:

@@ -551,6 +551,10 @@ class AVBD(Integrator):
         self.active_contacts = 0
         self.failsafe = 0
         self._impulses = []  # the last step's rows' impulses, a ContactImpulses per substep
+        # the rows' search takes a vertex up to a thickness inside another body as a contact
+        # to hold out (narrow_phase.pair_contact): a rigid vertex there, which the contact
+        # stage after the solve does not move, was else lost to every later step
+        self._behind = np.ones(1)
 
     def contact_impulses(self, model) -> ContactImpulses:
         """The contact rows of the last step and their impulses, from the multipliers
@@ -863,7 +867,7 @@ class AVBD(Integrator):
         # its own outline there)
         margin = float(np.sqrt(((y - x_n) ** 2).sum(axis=1).max())) if len(y) else 0.0
         wide = ctopo._replace(thick_other=ctopo.thick_other + margin, body_thickness=ctopo.body_thickness + margin,
-                              margin=ctopo.margin + SPECULATIVE * margin)
+                              margin=ctopo.margin + SPECULATIVE * margin, behind=self._behind)
         if self._search is None or self._search[0] is not ctopo:
             self._search = (ctopo, make_scratch(len(ctopo.cv_vertex), len(ctopo.ce_a), len(ctopo.body_thickness)),
                             make_buffer(64, 64))
