@@ -64,6 +64,17 @@ def test_flat_body_covers_exactly_its_pixels(renderer):
     assert np.all(img[26:74, 51:124] == RED)
 
 
+def test_a_dimmed_body_is_darker_in_the_same_place(renderer):
+    # the viewer draws sleeping bodies so (WorldView.dim_sleeping)
+    pts, tris, uv = square_mesh(-1.0, -0.5, 0.5, 0.5)
+    h = renderer.add_mesh(tris, uv, color="#ff0000")
+    renderer.render([(h, pts, True)])
+    img = renderer.read()
+    assert np.all(img[26:74, 51:124] == [153, 0, 0])  # 0.6 of its red
+    renderer.render([(h, pts, False)])
+    assert np.all(renderer.read()[26:74, 51:124] == RED)
+
+
 def test_moving_the_body_moves_its_pixels(renderer):
     pts, tris, uv = square_mesh(-1.0, -0.5, 0.5, 0.5)
     h = renderer.add_mesh(tris, uv, color="#ff0000")

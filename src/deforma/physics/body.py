@@ -93,6 +93,8 @@ class Body:
         self.topology = topology
         self._overrides = overrides
         self._pinned = np.zeros(topology.n_vertices, bool)
+        self._asleep = False  # held still by the world's sleeping (physics.sleeping)
+        self._still = 0.0  # s it has been slower than sleeping.SLEEP_SPEED
         self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
         self._tear_fresh = np.zeros(0, np.int64)  # and the vertices whose springs, elements or mass it changed
@@ -177,6 +179,7 @@ class Body:
         world = self._check()
         if self._overrides["collide"]:
             world._check_no_overlap(self, x)
+        world._disturb(self)
         self.positions[...] = x
 
     @property
@@ -187,7 +190,9 @@ class Body:
     @velocities.setter
     def velocities(self, value):
         # a single (vx, vy) sets every vertex: the usual way to launch a body
-        self.velocities[...] = self._checked_array(value, "velocities", shapes=((self.n_vertices, 2), (2,)))
+        v = self._checked_array(value, "velocities", shapes=((self.n_vertices, 2), (2,)))
+        self._check()._disturb(self)
+        self.velocities[...] = v
 
     def _checked_array(self, value, name, *, shapes):
         try:
@@ -363,6 +368,7 @@ class Body:
         made = value if value is not None else (world.material or SPRINGS)
         world._check_joined_stay_rigid([self] if not made.is_rigid else [])
         self._overrides["material"] = value
+        world._disturb(self)
         world._material_changed()
 
     @property
@@ -379,6 +385,7 @@ class Body:
             raise ValueError(f"body {self._index} is made of {self.material.model!r} elements, which have no "
                              f"spring {name}: change its material (youngs_modulus, density, damping) instead")
         self._overrides[name] = None if value is None else check(value)
+        self._check()._disturb(self)
         self._check()._apply_body_parameters(self._index)
 
     def _mass(self):
@@ -398,6 +405,40 @@ class Body:
                        lambda self, v: self._set_param("damping", v,
                                                        lambda x: _non_negative(x, "damping", "N*s/m")),
                        doc="Spring damping kd of every spring, N*s/m (springs bodies).")
+
+    @property
+    def sleeping(self) -> bool:
+        """Whether the body sleeps (``World(sleep=True)``, :mod:`deforma.physics.sleeping`): at
+        rest with its island, not stepped, held as a pinned body is. Setting ``False`` wakes it
+        and its island; ``True`` puts its island to sleep now. Pushing, pulling, dragging,
+        pinning or setting its positions, velocities or parameters through their setters wakes
+        it too (writing into the ``positions`` or ``velocities`` views in place does not).
+
+        Examples
+        --------
+        >>> import deforma
+        >>> w = deforma.World(sleep=True)
+        >>> _ = w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0.0))
+        >>> b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2), position=(0, 0.5),
+        ...                material=deforma.Material("rigid", density=10.0))
+        >>> for _ in range(60):
+        ...     w.step()
+        >>> b.sleeping
+        True
+        >>> b.apply_impulse((0.0, 5.0))
+        >>> b.sleeping, b.velocity.round(3).tolist()
+        (False, [0.0, 0.5])
+        """
+        self._check()
+        return self._asleep
+
+    @sleeping.setter
+    def sleeping(self, value):
+        world = self._check()
+        if _switch(value, "sleeping"):
+            world._fall_asleep(world._island_of(self))
+        else:
+            world._disturb(self)
 
     @property
     def pinned(self) -> np.ndarray:
@@ -469,6 +510,7 @@ class Body:
         [0.02, 0.02, 0.02]
         """
         idx, f = self._loads(force, indices, "force", "N")
+        self._check()._disturb(self)
         self._check()._forces.append((self, idx, f))
 
     def apply_impulse(self, impulse, indices=None) -> None:
@@ -493,6 +535,7 @@ class Body:
         """
         idx, j = self._loads(impulse, indices, "impulse", "N*s")
         world = self._check()
+        world._disturb(self)  # before reading its masses: asleep, its vertices are held (no inverse mass)
         if self.material.is_rigid:  # the whole body takes it: its centre and its spin
             x, m = self.positions, self.vertex_masses
             r = x[idx] - rigid_motion.center_of_mass(x, m)
@@ -525,6 +568,7 @@ class Body:
         """
         world = self._check()
         idx = self._indices(indices, "pin indices")
+        world._disturb(self)
         self._pinned[idx] = True
         self.velocities[slice(None) if self.material.is_rigid and idx.size else idx] = 0.0
         world._model.set_pinned(self._index, self._pinned)
@@ -532,6 +576,7 @@ class Body:
     def unpin(self, indices=None) -> None:
         """Free vertices ``indices`` (default: all of them)."""
         world = self._check()
+        world._disturb(self)
         if indices is None:
             self._pinned[:] = False
         else:
@@ -570,6 +615,7 @@ class Body:
     def _set_switch(self, name, value):
         value = _switch(value, name)
         world = self._check()
+        world._disturb(self)
         if value and name == "collide":
             world._check_no_overlap(self)
         self._overrides[name] = value

@@ -96,7 +96,14 @@ def step(world) -> None:
         # the kernels move the packed copies: until the objects follow (at the end of a
         # step that succeeds), the packed array is not theirs
         w._packed_colliders = None
-    if not w._model.n_vertices:  # no body: moving colliders still move
+    if w._sleep:
+        key = w._world_key()
+        if key != w._sleep_key:  # a parameter, the bodies, the joints or a still collider changed
+            w._wake(w._bodies)
+            w._sleep_key = key
+    # no body, or every body asleep and no collider moving: nothing to integrate
+    idle = not w._model.n_vertices or (w._sleep and not poses and all(b._asleep for b in w._bodies))
+    if idle:  # moving colliders still move
         for c in w._colliders:
             c.advance(w.dt)
         w._forces.clear()
@@ -160,10 +167,13 @@ def step(world) -> None:
         raise
     if rows is not None:
         read_rows(w._joints, rows, w.dt)
+    kept_awake = {id(g.body) for g in w._grabs if g.body is not None} | {id(b) for b, _, _ in w._forces}
     w._forces.clear()
     w.time += w.dt
     w.step_count += 1
     w._contact_record = record
+    if w._sleep:
+        w._update_sleep(kept_awake)
     if w._events.listening:
         w._events.contacts(w._pairs(), w.step_count, w.time)
     if w._joints:

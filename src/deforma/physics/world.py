@@ -36,6 +36,7 @@ from .contact.pairs import ContactPair, group_pairs, impulses_from_points
 from .control import Control
 from ..checks import IgnoredSettingWarning, StepBeyondStableWarning
 from .diagnostics import Energy, SimulationUnstable
+from .sleeping import SLEEP_TIME, fastest_vertex, islands, sleep_changes
 from .events import ContactEvent, Events
 from . import joint as _joint
 from .joint import Joint
@@ -124,7 +125,7 @@ class World:
     def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 60, substeps="auto", mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
                  integrator="avbd", contact_thickness=None, air_drag=0.0, material=None,
-                 integrator_options=None):
+                 integrator_options=None, sleep=False):
         self._bodies: list[Body] = []
         self._colliders: list[Collider] = []
         self._packed_colliders: tuple | None = None  # what was packed: (id, version) per collider
@@ -136,6 +137,8 @@ class World:
         self._events = Events()  # on_contact, on_joint_break
         self._contact_record = None  # (model, its bodies, ContactImpulses or None) of the last step
         self._pair_cache = None  # (contact record, its pairs by key)
+        self._island = np.zeros(0, np.int64)  # each body's island after the last step (physics.sleeping)
+        self._sleep_key = None  # what a change of wakes every island (_world_key)
         self._gravity, self._air_drag = (0.0, -9.81), 0.0
         self._model = Model([], masses=[], stiffness=[], damping=[])
         self._model_bodies = []
@@ -163,6 +166,7 @@ class World:
         self.grab_strength = grab_strength
         self.max_speed = max_speed
         self.integrator = integrator
+        self.sleep = sleep
         if integrator_options is not None:
             self.integrator_options = integrator_options
         if isinstance(substeps, str) and substeps == "auto":
@@ -189,6 +193,83 @@ class World:
         new._events.touching = {(id(p.a), id(p.b)): p for p in new._events.touching.values()}
         new._pair_cache = None
         return new
+
+    # -- sleeping ---------------------------------------------------------------------------
+    @property
+    def sleep(self) -> bool:
+        """Whether bodies at rest fall asleep (:mod:`deforma.physics.sleeping`): an island of
+        bodies touching or joined, all slower than ``SLEEP_SPEED`` (5 mm/s) for ``SLEEP_TIME``
+        (0.5 s), stops being stepped, held as pinned, until something disturbs it (see
+        :attr:`Body.sleeping`). Off by default; setting it off wakes every body."""
+        return self._sleep
+
+    @sleep.setter
+    def sleep(self, value):
+        self._sleep = _switch(value, "sleep")
+        if not self._sleep:
+            self._wake(self._bodies)
+
+    def _world_key(self) -> tuple:
+        """What, changed, wakes every island: the world's parameters, integrator, bodies,
+        joints and still colliders (a moving one wakes only the bodies it touches)."""
+        return (self._gravity, self._air_drag, self._contact_thickness, self._max_speed, self._grab_strength,
+                self.mass, self.stiffness, self.damping, self.friction, self.static_friction, id(self._material),
+                id(self._integrator), id(self._model), tuple(id(j) for j in self._joints),
+                tuple((id(c), c._version) for c in self._colliders if not c.moving))
+
+    def _island_of(self, body) -> list:
+        """The bodies in ``body``'s island after the last step (itself alone if unknown)."""
+        i = body._index
+        if len(self._island) != len(self._bodies):
+            return [body]
+        return [b for b, label in zip(self._bodies, self._island) if label == self._island[i]]
+
+    def _hold(self, bodies) -> None:
+        """Hold the vertices of ``bodies`` as their pins and sleep say (Model.pinned)."""
+        for b in bodies:
+            self._model.set_pinned(b._index, b._pinned | b._asleep)
+
+    def _wake(self, bodies) -> None:
+        woken = [b for b in bodies if b._asleep]
+        for b in woken:
+            b._asleep = False
+            b._still = 0.0
+        self._hold(woken)
+
+    def _fall_asleep(self, bodies) -> None:
+        for b in bodies:
+            b._asleep = True
+            b._still = SLEEP_TIME
+            self._state.v[b.vertex_slice] = 0.0
+        self._hold(bodies)
+
+    def _disturb(self, body) -> None:
+        """Something acts on ``body``: it wakes, with its island."""
+        if any(b is body for b in self._bodies) and any(b._asleep for b in self._island_of(body)):
+            self._wake(self._island_of(body))
+
+    def _update_sleep(self, kept_awake) -> None:
+        """After a step: which islands fall asleep and which wake (:func:`~deforma.physics.sleeping.sleep_changes`);
+        ``kept_awake``: ids of bodies grabbed or pushed this step."""
+        bodies = self._bodies
+        index = {id(b): k for k, b in enumerate(bodies)}
+        links = []
+        kept = np.array([id(b) in kept_awake for b in bodies], bool)
+        for p in self._pairs().values():
+            if id(p.b) in index:
+                links.append((index[id(p.a)], index[id(p.b)]))
+            elif getattr(p.b, "moving", False):
+                kept[index[id(p.a)]] = True  # on a moving collider
+        links += [(j.a._index, j.b._index) for j in self._joints if j.b is not None]
+        self._island = islands(len(bodies), np.array(links, np.int64).reshape(-1, 2))
+        asleep = np.array([b._asleep for b in bodies], bool)
+        speed = fastest_vertex(self._state.v, self._model.body_vertex_offsets)
+        fall, wake, still = sleep_changes(asleep, np.array([b._still for b in bodies]), speed, self._island, kept,
+                                          self.dt)
+        for b, t in zip(bodies, still):
+            b._still = float(t)
+        self._wake([b for b, w in zip(bodies, wake) if w])
+        self._fall_asleep([b for b, f in zip(bodies, fall) if f])
 
     # -- parameters -------------------------------------------------------------------------
     @property
@@ -653,6 +734,8 @@ class World:
         # the rest shapes plasticity moved live in the Model's arrays: take them over, body by
         # body (a torn body's vertices through the tear's source), so dents survive a rebuild
         old = self._model
+        for b in self._bodies:  # a body added, removed, torn or remade: every island wakes
+            b._asleep, b._still = False, 0.0
         shapes, torn = {}, {}
         if old is not None:
             for i, body in enumerate(self._model_bodies):
@@ -1092,6 +1175,7 @@ class World:
             if center is None:
                 raise ValueError("radius needs a center: explode(strength, center=(x, y), radius=r)")
             reach = _positive(radius, "radius", "m")
+        self._wake(self._bodies)
         v, x = self._state.v, self._state.x
         if center is None:
             v[:, 1] += s
@@ -1159,6 +1243,8 @@ class World:
                 break
         else:
             g = Grab(self, None, [], (float(p[0]), float(p[1])), s)
+        if g.body is not None:
+            self._disturb(g.body)
         self._grabs.append(g)
         self._grabs_dirty = True
         return g

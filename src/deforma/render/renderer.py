@@ -105,6 +105,10 @@ class Camera:
         return np.stack([x, y], axis=-1)
 
 
+#: What a dimmed body's colour is multiplied by (a sleeping body in the viewer).
+DIM = 0.6
+
+
 def _as_rgba(color) -> tuple[float, float, float, float]:
     """A colour as RGBA floats: accepts '#rrggbb', '#rrggbbaa', or 3/4 numbers in [0, 1]."""
     if isinstance(color, str):
@@ -602,8 +606,10 @@ class Renderer:
             handle.texture.filter = ((moderngl.LINEAR_MIPMAP_NEAREST if mip else moderngl.LINEAR), moderngl.LINEAR)
             handle.mipmapped = mip
 
-    def draw_mesh(self, handle: MeshHandle, positions, *, wireframe: bool = False, wire_color=None) -> None:
-        """Draw one body at ``positions`` (N, 2) metres: textured or flat, optionally its springs."""
+    def draw_mesh(self, handle: MeshHandle, positions, *, wireframe: bool = False, wire_color=None,
+                  dim: bool = False) -> None:
+        """Draw one body at ``positions`` (N, 2) metres: textured or flat, optionally its springs;
+        ``dim`` darkens it (the viewer's sleeping bodies)."""
         import moderngl
 
         handle.upload(positions)
@@ -615,7 +621,9 @@ class Renderer:
             ctx.blend_func = _blend()
         p = self._body_prog
         self._set_camera(p)
-        p["u_color"].value = handle.color
+        r, g, b, a = handle.color
+        shade = DIM if dim else 1.0
+        p["u_color"].value = (shade * r, shade * g, shade * b, a)
         p["u_textured"].value = handle.texture is not None
         if handle.texture is not None:
             self._choose_filter(handle)
@@ -631,8 +639,7 @@ class Renderer:
             handle.wire_vao.render(moderngl.LINES)
         elif handle.texture is None and handle.outline_vao is not None:
             self._set_camera(f)
-            r, g, b, a = handle.color
-            f["u_color"].value = (0.6 * r, 0.6 * g, 0.6 * b, a)
+            f["u_color"].value = (0.6 * shade * r, 0.6 * shade * g, 0.6 * shade * b, a)
             handle.outline_vao.render(moderngl.LINES)
 
     def draw_image(self, image, position=(0, 0)) -> None:
@@ -696,14 +703,15 @@ class Renderer:
 
     def render(self, bodies: Iterable = (), colliders: Iterable = (), *, wireframe: bool = False,
                collider_colors: Sequence | None = None) -> None:
-        """One whole frame: background, colliders, then each ``(handle, positions)`` body."""
+        """One whole frame: background, colliders, then each ``(handle, positions)`` or ``(handle,
+        positions, dim)`` body (:meth:`draw_mesh`)."""
         # the background covers every pixel, so binding is enough: a clear would be a wasted pass
         self.framebuffer.use()
         self.ctx.viewport = (0, 0, *self.size)
         self.draw_background()
         self.draw_colliders(colliders, colors=collider_colors)
-        for handle, positions in bodies:
-            self.draw_mesh(handle, positions, wireframe=wireframe)
+        for handle, positions, *dim in bodies:
+            self.draw_mesh(handle, positions, wireframe=wireframe, dim=bool(dim and dim[0]))
 
     def __enter__(self):
         return self

@@ -68,6 +68,7 @@ class WorldView:
         renderer.background_bottom = _as_rgba(cam.background[1])[:3]
         self.wireframe = cam.wireframe
         self.overlay = bool(overlay)
+        self.dim_sleeping = False  # draw sleeping bodies darker (the viewer turns it on)
         self.collider_colors = None
         self._handles = []
         self._bodies = []
@@ -148,7 +149,8 @@ class WorldView:
                 or len(self.world.colliders) != self._n_colliders:
             self.sync()
         r = self.renderer
-        r.render([(h, b.positions) for h, b in zip(self._handles, self._bodies)], self.world.colliders,
+        r.render([(h, b.positions, self.dim_sleeping and b.sleeping) for h, b in zip(self._handles, self._bodies)],
+                 self.world.colliders,
                  wireframe=self.wireframe, collider_colors=self.collider_colors)
         self._draw_joints()
         if not read:

@@ -220,7 +220,7 @@ def scene_of(world) -> Scene:
         friction=float(world.friction), static_friction=float(world.static_friction),
         max_speed=float(world.max_speed), integrator=world.integrator,
         contact_thickness=None if world.contact_thickness is None else float(world.contact_thickness),
-        air_drag=float(world.air_drag), integrator_options=_integrator_option_keys(world),
+        air_drag=float(world.air_drag), sleep=bool(world.sleep), integrator_options=_integrator_option_keys(world),
         **_material_keys(world, scene.physics),
     )
     interaction = InteractionSettings(explosive_force=scene.interaction.explosive_force,

@@ -153,6 +153,7 @@ def build(scene: Scene):
                       damping=p.damping, friction=p.friction, static_friction=p.static_friction,
                       grab_strength=scene.interaction.mouse_strength, max_speed=p.max_speed,
                       integrator=p.integrator, contact_thickness=p.contact_thickness, air_drag=p.air_drag,
+                      sleep=p.sleep,
                       material=_material(material_settings(p), world=True))
     except MaterialKeyError as e:
         raise SceneError(f"{source}: physics{'' if e.key is None else '.' + e.key}: {e}") from None

@@ -179,6 +179,9 @@ class PhysicsSettings:
     air_drag: float = spec("float", 0.0, lo=0.0, unit="1/s",
                            doc="Every velocity decays as dv/dt = -air_drag v; a little lets stacks and heaps come "
                                "to rest.")
+    sleep: bool = spec("bool", False, doc="Bodies at rest fall asleep: an island of bodies touching or joined, "
+                                          "all slower than 5 mm/s for 0.5 s, stops being stepped until something "
+                                          "disturbs it (docs/physics.md, Sleeping).")
     material: str = spec("str", "springs", choices=material_names,
                          doc="What bodies are made of unless they say: springs (the original's springs on the mesh "
                              "edges, with mass, stiffness, damping), or finite elements on the triangles: corotated "

@@ -144,6 +144,7 @@ class Viewer:
         self._Camera = Camera
         self.renderer = Renderer(self.ctx, self.window_size, target=self.ctx.screen)
         self.view = WorldView(self.renderer, session.world)
+        self.view.dim_sleeping = True
         self.overlay = Overlay(self.ctx)
         name = session.scene.scene.name or "scene"
         self.save_path = save_path or f"{name}-edited.toml"
