@@ -224,6 +224,23 @@ def test_torn_sheet_is_drawn_with_its_texture_on_every_piece(gl_ctx, tmp_path):
     r.release()
 
 
+def test_cards_stand_by_friction_until_the_wheel_comes():
+    # fifteen rigid cards, leaning 18 degrees in pairs (friction 0.8 at their feet, where a
+    # pair needs tan(18) / 2 = 0.16); the wheel reaches them after 2.5 s
+    world = scenes.load_scene("cards")
+    cards = world.bodies[:15]
+    start = [(b.center_of_mass.copy(), b.angle) for b in cards]
+    for _ in range(150):
+        world.step()
+    for b, (c, a) in zip(cards, start):
+        assert np.abs(b.center_of_mass - c).max() < 0.01 and abs(b.angle - a) < 3.0
+    for _ in range(210):
+        world.step()
+    heights = sorted(b.center_of_mass[1] for b in cards)
+    assert heights[-1] < start[-1][0][1] - 0.1  # the top storey came down
+    assert heights[10] > 0.3  # the two below stand
+
+
 def test_dent_keeps_its_dent():
     from deforma.physics.elements.triangles import signed_areas
 
