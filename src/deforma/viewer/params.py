@@ -84,6 +84,7 @@ GROUPS: tuple[tuple[str, tuple[Param, ...]], ...] = (
         Param("gravity_y", "Gravity y", "float", -20, 20, unit="m/s²"),
         Param("damping", "Damping", "float", 0.0, 10.0, unit="N·s/m", tip="spring damping kd"),
         Param("air_drag", "Air drag", "float", 0.0, 5.0, unit="1/s", tip="velocities decay as -air_drag v"),
+        Param("sleep", "Sleep", "bool", tip="bodies at rest fall asleep (drawn darker) until disturbed"),
         Param("mass", "Mass", "float", 0.1, 20.0, log=True, unit="kg", tip="total mass of a body"),
         Param("stiffness", "Stiffness", "float", 10.0, 20000.0, log=True, unit="N/m", tip="spring constant ks"),
         Param("static_friction", "Static friction", "float", 0.0, 2.0),

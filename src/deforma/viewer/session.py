@@ -257,7 +257,8 @@ class Session:
         w = self.world
         if name in ("gravity_x", "gravity_y"):
             return w.gravity[0 if name == "gravity_x" else 1]
-        if name in ("dt", "substeps", "damping", "mass", "stiffness", "friction", "static_friction", "air_drag"):
+        if name in ("dt", "substeps", "damping", "mass", "stiffness", "friction", "static_friction", "air_drag",
+                    "sleep"):
             return getattr(w, name)
         if name == "contact_thickness":  # the world's, or the selected body's automatic one
             if w.contact_thickness is not None or not w.bodies:
@@ -317,6 +318,8 @@ class Session:
                     self.note, self.note_is_warning = str(warning.message), True
                 else:
                     warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+        elif name == "sleep":
+            w.sleep = bool(value)
         elif name in ("collide", "self_collision"):
             if w.bodies:
                 setattr(w.bodies[self.body_index], name, bool(value))
