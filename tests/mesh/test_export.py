@@ -12,6 +12,7 @@ import pytest
 import deforma
 from deforma.cli import EXIT_ERROR, EXIT_UNSTABLE, main
 from deforma.mesh import read_meshes, write_meshes
+from deforma.mesh.export import write_materials
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "physics"))
 from physics_meshes import Chain  # noqa: E402
@@ -108,6 +109,26 @@ def test_names_not_one_per_mesh_are_refused_and_nothing_is_written(tmp_path, suf
     write_meshes([m, m], tmp_path / f"x{suffix}", names=["one", "two"])
     if suffix != ".svg":
         assert len(read_meshes(tmp_path / f"x{suffix}")) == 2
+
+
+@pytest.mark.parametrize("bad", ["two words", "line\nbreak", 'say "hi"', "../up", ".hidden", "", 3, None])
+def test_names_that_would_break_a_file_are_refused_and_nothing_is_written(tmp_path, bad):
+    # a line break made extra OBJ lines, a quote broke the SVG, "../x" wrote a picture outside
+    # the folder (write_materials names its pictures so)
+    m = deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]], texture=np.zeros((2, 2, 4), np.uint8))
+    for write in (lambda: write_meshes([m, m], tmp_path / "x.obj", names=["ok", bad]),
+                  lambda: write_materials([m, m], tmp_path, names=["ok", bad])):
+        with pytest.raises(ValueError, match=r"names\[1\] = .*: a name is letters, digits") as e:
+            write()
+        assert "\n" not in str(e.value)
+    assert not list(tmp_path.iterdir())
+
+
+def test_one_mesh_alone_is_written_as_a_list_of_one(tmp_path):
+    m = deforma.mesh.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]])
+    write_meshes(m, tmp_path / "one.obj", names=["tri.1"])
+    (back,) = read_meshes(tmp_path / "one.obj")
+    assert back.vertices.tolist() == m.vertices.tolist()
 
 
 def run(capsys, *args):

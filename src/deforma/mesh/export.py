@@ -25,6 +25,7 @@ True
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Sequence
 
@@ -36,6 +37,28 @@ __all__ = ["FORMATS", "read_meshes", "write_materials", "write_meshes"]
 
 #: The formats :func:`write_meshes` writes (its file name's suffix, without the dot).
 FORMATS = ("obj", "json", "svg")
+
+
+#: What an object's name may hold: it becomes an OBJ object's name (no spaces or line
+#: breaks), an SVG element's id (no quotes) and a picture's file name (no folders).
+NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9_.-]*")
+
+
+def _meshes_and_names(meshes, names, where) -> tuple[list, list[str]]:
+    """``meshes`` as a list (one Mesh alone is a list of one) and their names, checked: one
+    per mesh, each matching :data:`NAME` (else ``ValueError`` in one line, nothing written)."""
+    meshes = [meshes] if isinstance(meshes, Mesh) else list(meshes)
+    # a list once: a generator would be used up by the count
+    names = list(names) if names is not None else [f"body{k}" for k in range(len(meshes))]
+    if len(names) != len(meshes):
+        # zip() would drop the meshes past the last name without a word
+        raise ValueError(f"{where}: names has {len(names)} entries for {len(meshes)} meshes; give one name "
+                         f"per mesh, or none (body0, body1, ...)")
+    for k, n in enumerate(names):
+        if not isinstance(n, str) or not NAME.fullmatch(n):
+            raise ValueError(f"{where}: names[{k}] = {n!r}: a name is letters, digits, '_', '-' and '.' (not "
+                             f"first), as it names an OBJ object, an SVG id and a picture file")
+    return meshes, names
 
 
 def _num(x: float) -> str:
@@ -104,12 +127,13 @@ def write_meshes(meshes: Sequence[Mesh], path, *, names: Sequence[str] | None = 
 
     Parameters
     ----------
-    meshes : sequence of Mesh
+    meshes : sequence of Mesh, or one Mesh
         Written in order, one object each (none: a file without objects, an empty picture).
     path : str or Path
         The file; its folder must exist.
     names : sequence of str, optional
-        Object names (default ``body0``, ``body1``, ...).
+        Object names (default ``body0``, ``body1``, ...): letters, digits, ``_``, ``-`` and
+        ``.`` (not first).
     colors : sequence of str, optional
         SVG fill colours, one per mesh.
     materials : str, optional
@@ -121,17 +145,12 @@ def write_meshes(meshes: Sequence[Mesh], path, *, names: Sequence[str] | None = 
     Raises
     ------
     ValueError
-        A suffix other than those of :data:`FORMATS`, or ``names`` not one per mesh
-        (nothing is written).
+        A suffix other than those of :data:`FORMATS`, or ``names`` not one per mesh or not
+        names (:data:`NAME`; nothing is written).
     """
     path = Path(path)
     fmt = path.suffix[1:].lower()
-    # a list once: a generator would be used up by the count
-    names = list(names) if names is not None else [f"body{k}" for k in range(len(meshes))]
-    if len(names) != len(meshes):
-        # zip() would drop the meshes past the last name without a word
-        raise ValueError(f"{path}: names has {len(names)} entries for {len(meshes)} meshes; give one name "
-                         f"per mesh, or none (body0, body1, ...)")
+    meshes, names = _meshes_and_names(meshes, names, path)
     if fmt == "obj":
         text = obj_text(meshes, names, materials, [m.texture is not None for m in meshes])
     elif fmt == "json":
@@ -147,11 +166,12 @@ def write_materials(meshes: Sequence[Mesh], folder, *, names: Sequence[str] | No
                     name: str = "materials.mtl") -> str | None:
     """Write each textured mesh's picture as ``NAME.png`` into ``folder`` and a material
     library ``name`` naming them (OBJ's ``map_Kd``); returns ``name``, or ``None`` (nothing
-    written) when no mesh has a texture."""
+    written) when no mesh has a texture. ``names`` as :func:`write_meshes` takes them (a
+    name with a folder in it would write outside ``folder``: refused)."""
     from PIL import Image
 
     folder = Path(folder)
-    names = list(names) if names is not None else [f"body{k}" for k in range(len(meshes))]
+    meshes, names = _meshes_and_names(meshes, names, folder)
     lines = []
     for m, n in zip(meshes, names):
         if m.texture is not None:
