@@ -62,6 +62,16 @@ def test_a_woken_island_moves_exactly_as_without_sleep():
     assert step == 59  # it moved the whole second
 
 
+def test_a_copy_of_a_sleeping_world_sleeps_on_as_it_does():
+    w = _stack(3)
+    _run(w, 2.0)
+    twin = copy.deepcopy(w)
+    _run(w, 1.0)
+    _run(twin, 1.0)
+    assert all(b.sleeping for b in w.bodies) and all(b.sleeping for b in twin.bodies)
+    assert np.array_equal(w.state.x, twin.state.x)
+
+
 def test_a_body_landing_on_a_sleeping_stack_wakes_it_and_all_sleep_again():
     w = _stack(3)
     _run(w, 2.0)

@@ -192,6 +192,8 @@ class World:
             new._packed_colliders = tuple((ids.get(k, k), version) for k, version in self._packed_colliders)
         new._events.touching = {(id(p.a), id(p.b)): p for p in new._events.touching.values()}
         new._pair_cache = None
+        if self._sleep_key is not None and self._sleep_key == self._world_key():
+            new._sleep_key = new._world_key()  # of the copies' ids: nothing changed, nothing wakes
         return new
 
     # -- sleeping ---------------------------------------------------------------------------
