@@ -78,10 +78,10 @@ def test_hostile_scene_values_are_refused_in_one_line_or_run(physics, body, coll
     except deforma.SimulationUnstable as e:
         event("reported unstable")
         one_line(e)
-        assert e.hint and np.isfinite(world._state.x).all()  # put back as it was
+        assert e.hint and np.isfinite(world.state.x).all()  # put back as it was
         return
     event("ran")
-    assert np.isfinite(world._state.x).all()
+    assert np.isfinite(world.state.x).all()
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -79,7 +79,7 @@ def crossings(world, *, exact=False):
     """(K, 2) global vertex indices... of crossing outline segments: (K, 2, 2) ends of each pair."""
     seg, _ = outline_segments(world)
     out = np.zeros((64, 2), np.int64)
-    n = _crossing_pairs(world._state.x, seg, exact, out)
+    n = _crossing_pairs(world.state.x, seg, exact, out)
     return seg[out[:min(n, 64)]], n
 
 
@@ -119,7 +119,7 @@ def _inside_counts(x, seg, seg_start, vertex_body, nb):
 def vertices_inside_other_bodies(world):
     """Indices of vertices (any vertex, not only outline ones) inside another body's outline."""
     seg, owner = outline_segments(world)
-    x = world._state.x
+    x = world.state.x
     nb = len(world.bodies)
     vb = np.full(len(x), -1, np.int64)
     for b in world.bodies:

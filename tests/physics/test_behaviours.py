@@ -22,12 +22,12 @@ def strip(length=1.0, width=0.1, detail=(20, 2)):
 
 def worst_stretch(world, body):
     """Largest stretch ratio of the body's springs or elements right now."""
-    m = world._model
+    m = world.model
     if body.is_fem:
         t = slice(int(m.body_elem_offsets[body.index]), int(m.body_elem_offsets[body.index + 1]))
-        return float(stretch_field(world._state.x, m.elem[t], m.elem_b[t])[0].max())
+        return float(stretch_field(world.state.x, m.elem[t], m.elem_b[t])[0].max())
     s = slice(int(m.body_spring_offsets[body.index]), int(m.body_spring_offsets[body.index + 1]))
-    return 1.0 + float(spring_strains(world._state.x, m.spring_i[s], m.spring_j[s], m.spring_rest_length[s]).max())
+    return 1.0 + float(spring_strains(world.state.x, m.spring_i[s], m.spring_j[s], m.spring_rest_length[s]).max())
 
 
 # -- strain limiting ---------------------------------------------------------------------------
@@ -148,7 +148,7 @@ def bend(yield_strain, push, settle=1800):
     w.release(g)
     for _ in range(settle):
         w.step()
-    m = w._model
+    m = w.model
     change = float(np.abs(m.elem_area / m.elem_area0 - 1).max())
     return float(body.positions[tip, 1].mean() - 0.05), change
 
@@ -192,7 +192,7 @@ def test_plastic_springs_keep_a_dent():
     body.positions = x0 * [1.2, 1.0]  # stretched 20%
     for _ in range(600):
         w.step()
-    m = w._model
+    m = w.model
     assert (m.spring_rest_length / m.spring_rest_length0).max() > 1.1
     assert np.ptp(body.positions[:, 0]) > 1.1  # it stays longer
 
@@ -215,18 +215,18 @@ def test_a_dent_survives_a_rebuilt_model(model):
     bar.positions = x
     for _ in range(5):
         w.step()
-    dent = w._model.rest_shape(1)
+    dent = w.model.rest_shape(1)
     assert any(part is not None for part in dent)
     w.remove_body(other)  # the bar moves to index 0
     w.add_body(strip(0.2, 0.2, (2, 2)), position=(3.0, 3.0))
     w.material = dataclasses.replace(mat, yield_strain=0.03)  # a new material of the same kind
-    kept = w._model.rest_shape(0)
+    kept = w.model.rest_shape(0)
     for a, b in zip(dent, kept):
         assert (a is None) == (b is None)
         if a is not None:
             for u, v in zip(a, b):
                 np.testing.assert_array_equal(u, v)
-    m = w._model
+    m = w.model
     if model == "springs":
         assert (m.spring_rest_length != m.spring_rest_length0).any()
     else:
@@ -248,10 +248,10 @@ def test_a_dent_survives_a_tear(patched_matrices):
         x = body.positions
         x[right, 0] += 0.5 / 600 * (1 + k / 100)
         body.positions = x
-        old, n = w._model, body.n_vertices
+        old, n = w.model, body.n_vertices
         w.step()
         if body.n_vertices != n:
-            before, after = old.rest_shape(0)[1], w._model.rest_shape(0)[1]
+            before, after = old.rest_shape(0)[1], w.model.rest_shape(0)[1]
             assert before is not None  # it had flowed
             np.testing.assert_array_equal(before[0], after[0])
             np.testing.assert_array_equal(before[1], after[1])

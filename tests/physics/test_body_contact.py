@@ -58,7 +58,7 @@ def test_a_box_dropped_on_another_comes_to_rest_on_top(name):
     # it landed 10 cm off centre: its overhang droops over the lower box's corner and presses on
     # its side, which pushes the two apart a little (on a frictionless floor they separate)
     assert abs(high.center_of_mass[0] - low.center_of_mass[0]) < 0.2
-    assert np.hypot(*w._state.v.T).max() < 0.02  # every vertex: at rest
+    assert np.hypot(*w.state.v.T).max() < 0.02  # every vertex: at rest
 
 
 def test_a_stack_of_five_boxes_rests():
@@ -72,7 +72,7 @@ def test_a_stack_of_five_boxes_rests():
         w.step()
         if k % 50 == 0:
             assert_apart(w, k)
-    assert np.hypot(*w._state.v.T).max() < 0.02  # every vertex, after 5 s
+    assert np.hypot(*w.state.v.T).max() < 0.02  # every vertex, after 5 s
     settled = np.mean([b.center_of_mass for b in boxes], axis=0)
     for _ in range(int(5.0 / w.dt)):
         w.step()
@@ -85,15 +85,15 @@ def test_a_stack_of_five_boxes_rests():
 @pytest.mark.parametrize("name", ALL)
 def test_head_on_collision_keeps_momentum_and_never_gains_energy(name):
     w, a, b = head_on(name, dt=1 / 1000, substeps=2)
-    m = w._model.vertex_mass[:, None]
-    p0 = (m * w._state.v).sum(axis=0)
-    scale = (m * np.abs(w._state.v)).sum()
+    m = w.model.vertex_mass[:, None]
+    p0 = (m * w.state.v).sum(axis=0)
+    scale = (m * np.abs(w.state.v)).sum()
     energy = [w.energy().total]
     touched = False
     for k in range(600):
         w.step()
         touched |= len(w.contacts) > 0
-        p = (m * w._state.v).sum(axis=0)
+        p = (m * w.state.v).sum(axis=0)
         assert np.abs(p - p0).max() < 1e-9 * scale, k
         energy.append(w.energy().total)
         assert_apart(w, k)
@@ -271,7 +271,7 @@ def test_a_contact_buffer_too_small_grows_and_the_step_runs_again_from_its_start
         roomy.step()
         tight.step()
     assert len(tight._contacts.buffer.pair_vertex) > 16 and len(tight._contacts.buffer.vertex) > 16
-    assert np.array_equal(tight._state.x, roomy._state.x)  # the same steps, bit for bit
+    assert np.array_equal(tight.state.x, roomy.state.x)  # the same steps, bit for bit
 
 
 # -- switches and bad input ---------------------------------------------------------------------
@@ -303,19 +303,19 @@ def test_bad_contact_thickness_is_refused_and_nothing_changes(value, message):
 def test_a_body_placed_overlapping_another_is_refused_and_nothing_changes():
     w = deforma.World()
     w.add_body(grid_mesh(1.0, 1.0, 5, 5), position=(0, 0))
-    x = w._state.x.copy()
+    x = w.state.x.copy()
     with pytest.raises(ValueError, match=r"the new body \(1\) would overlap body 0"):
         w.add_body(grid_mesh(1.0, 1.0, 5, 5), position=(0.5, 0.5))
     with pytest.raises(ValueError, match="would overlap body 0"):  # inside it counts too
         w.add_body(grid_mesh(0.2, 0.2, 3, 3), position=(0, 0))
-    assert len(w.bodies) == 1 and np.array_equal(w._state.x, x)
+    assert len(w.bodies) == 1 and np.array_equal(w.state.x, x)
     ghost = w.add_body(grid_mesh(0.2, 0.2, 3, 3), position=(0, 0), collide=False)  # allowed: it passes through
     with pytest.raises(ValueError, match="would overlap body 0"):
         ghost.collide = True
     assert ghost.collide is False
     other = w.add_body(grid_mesh(0.2, 0.2, 3, 3), position=(2, 0))
-    x = w._state.x.copy()
+    x = w.state.x.copy()
     with pytest.raises(ValueError, match="body 2 would overlap body 0"):  # moved into it by hand
         other.positions = other.positions - (2.0, 0.0)
-    assert np.array_equal(w._state.x, x)
+    assert np.array_equal(w.state.x, x)
     other.positions = other.positions + (0.5, 0.0)  # clear of it: fine

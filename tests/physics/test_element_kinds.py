@@ -131,7 +131,7 @@ def body_area(b):
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_a_kind_written_outside_the_package_runs_under_every_integrator(area_kind, integrator):
     w, b = squashed_area_body(integrator)
-    assert type(w._model.elements[-1]) is AreaKind and not w._model.fused
+    assert type(w.model.elements[-1]) is AreaKind and not w.model.fused
     assert b.mass == pytest.approx(1.0)  # density * area, as finite elements weigh
     a0 = body_area(b)
     largest = a0
@@ -208,7 +208,7 @@ def test_triangle_gradients_and_hessians_match_their_energy(model):
     b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2))
     rng = np.random.default_rng(1)
     x = b.positions @ np.array([[1.1, 0.05], [-0.03, 0.95]]) + rng.normal(0, 0.004, b.positions.shape)
-    kind = w._model.triangles
+    kind = w.model.triangles
     if model == "corotated":  # stretched, its Hessian needs no projection: all of it is checked
         finite_difference_check(kind, x)
     else:  # Neo-Hookean's turning mode sits at zero curvature and tips below it: the gradient only
@@ -229,8 +229,8 @@ def test_triangle_gradients_and_hessians_match_their_energy(model):
 def test_spring_gradients_and_hessians_match_their_energy():
     w = deforma.World(stiffness=300.0)
     b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=2))
-    finite_difference_check(w._model.springs, b.positions * 1.2)  # every spring stretched
-    _, hess = w._model.springs.gradient_hessian(b.positions * 0.7)  # compressed: projected
+    finite_difference_check(w.model.springs, b.positions * 1.2)  # every spring stretched
+    _, hess = w.model.springs.gradient_hessian(b.positions * 0.7)  # compressed: projected
     assert np.linalg.eigvalsh(hess).min() >= -1e-9 * np.abs(hess).max()
 
 
@@ -239,7 +239,7 @@ def test_the_toy_kinds_gradient_matches_its_energy(area_kind):
     x = b.positions / 0.8 * np.array([1.05, 0.97])
     # J is bilinear: stretched or squashed, its curvature has a negative part, which the
     # projection removes; the gradient is checked, the Hessian for being positive semi-definite
-    hess = finite_difference_check(w._model.elements[-1], x, hessian=False)
+    hess = finite_difference_check(w.model.elements[-1], x, hessian=False)
     assert np.linalg.eigvalsh(hess).min() >= -1e-9 * np.abs(hess).max()
 
 
@@ -250,7 +250,7 @@ def test_a_built_in_kinds_forces_are_minus_its_energy_gradient(model):
     w = deforma.World(material=material, damping=0.0)
     b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=3))
     x = b.positions @ np.array([[1.1, 0.2], [0.0, 0.9]])
-    for kind in w._model.elements:
+    for kind in w.model.elements:
         f = np.zeros_like(x)
         kind.forces(x, np.zeros_like(x), f)
         g = np.zeros_like(x)
@@ -263,7 +263,7 @@ def run_scene(name, integrator, steps, *, fused):
 
     scene = scenes.load(name)
     w = scene.build()
-    assert w._model.fused is fused
+    assert w.model.fused is fused
     w.integrator = integrator
     # (avbd's coarse level reads the built-in kinds' arrays itself: the loop over the kinds
     # runs without it, so both are compared without it)
@@ -296,7 +296,7 @@ def test_a_registered_kind_is_a_material_of_scene_files_too(area_kind, tmp_path)
     path.write_text('[physics]\nmaterial = "test-area"\nyoungs_modulus = 200.0\npoisson_ratio = 0.3\ndensity = 1.0\n'
                     'gravity = [0.0, 0.0]\n\n[[body]]\nshape = "box"\ndetail = 3\n')
     w = deforma.load_scene(str(path))
-    assert type(w._model.elements[-1]) is AreaKind and w.bodies[0].material.model == "test-area"
+    assert type(w.model.elements[-1]) is AreaKind and w.bodies[0].material.model == "test-area"
     w.step()
     unregister_element_kind(AreaKind)
     with pytest.raises(ValueError, match="physics.material: unknown value 'test-area'"):

@@ -358,7 +358,7 @@ def test_pull_gives_the_same_momentum_to_first_order(name):
     held = b.vertex_slice.start + g.vertices
     impulse = np.zeros(2)
     for _ in range(100):
-        impulse += w.dt * 20.0 * ((1.0, 0.0) + g.offsets - w._state.x[held]).sum(axis=0)
+        impulse += w.dt * 20.0 * ((1.0, 0.0) + g.offsets - w.state.x[held]).sum(axis=0)
         w.step()
     m = b.mass / b.n_vertices
     assert m * b.velocities.sum(axis=0) == pytest.approx(impulse, rel=0.02, abs=1e-4)

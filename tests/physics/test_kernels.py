@@ -35,7 +35,7 @@ def perturbed_world(n=12):
 
 def test_the_spring_force_matches_the_textbook_formula():
     w, b = perturbed_world()
-    m, s = w._model, w._state
+    m, s = w.model, w.state
     f = np.zeros_like(s.x)
     for e in range(m.n_springs):
         i, j = m.spring_i[e], m.spring_j[e]
@@ -51,7 +51,7 @@ def test_the_spring_force_matches_the_textbook_formula():
 
 def test_one_step_matches_a_numpy_symplectic_euler_step():
     w, b = perturbed_world()
-    m = w._model
+    m = w.model
     x, v = b.positions.copy(), b.velocities.copy()
     h = w.dt
     f = numpy_forces(x, v, m.vertex_mass, m.spring_i, m.spring_j, m.spring_rest_length, m.spring_stiffness,
@@ -77,7 +77,7 @@ def test_parallel_and_serial_steps_agree_exactly(material):
         h = min(1e-3, 0.5 * w.stable_dt())  # within the elements' stable step
         w._pack_colliders()
         w._rebuild_grabs()
-        m, s, control, contacts = w._model, w._state, w._control, w._contacts
+        m, s, control, contacts = w.model, w.state, w.control, w._contacts
         fbuf = np.zeros((3, m.n_vertices, 2))  # the same 3 chunks of springs and elements for both
         chunks, elem_chunks, verts = symplectic.merged_chunks(m.spring_i, m.spring_j, m.elem, 3)
         for _ in range(50):
@@ -160,7 +160,7 @@ def test_the_implicit_matrix_assembly_matches_a_dense_sum():
     fem = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.5), (0, 0.5)), detail=2), position=(2, 1),
                      material=rubber)
     fem.pin([0, 3])
-    m, h = w._model, 0.01
+    m, h = w.model, 0.01
     n = m.n_vertices
     rng = np.random.default_rng(7)
     grab_slot = np.full(n, -1, np.int32)

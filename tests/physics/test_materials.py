@@ -181,10 +181,10 @@ def test_switching_material_live_keeps_the_state_and_changes_the_model():
         w.step()
     x, v = b.positions.copy(), b.velocities.copy()
     b.material = material("neo-hookean")
-    assert b.is_fem and w._model.n_springs == 0 and w._model.n_elements == len(b.triangles)
+    assert b.is_fem and w.model.n_springs == 0 and w.model.n_elements == len(b.triangles)
     assert np.array_equal(b.positions, x) and np.array_equal(b.velocities, v)
     b.material = None  # back to the world's: springs
-    assert not b.is_fem and w._model.n_elements == 0
+    assert not b.is_fem and w.model.n_elements == 0
 
 
 def test_elastic_energy_is_reported():
@@ -266,4 +266,4 @@ def test_pin_mask_matches_the_indices(indices):
     b = w.add_body(grid_mesh(1.0, 1.0, 3, 3))
     b.pin(indices)
     assert sorted(np.flatnonzero(b.pinned).tolist()) == sorted(indices)
-    assert (w._model.vertex_inv_mass[b.vertex_slice] == 0).tolist() == b.pinned.tolist()
+    assert (w.model.vertex_inv_mass[b.vertex_slice] == 0).tolist() == b.pinned.tolist()

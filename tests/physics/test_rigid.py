@@ -270,7 +270,7 @@ def crate_and_ball(integrator: str, crate_density: float, ball: deforma.Material
 @pytest.mark.parametrize("integrator", ["symplectic-euler", "implicit-euler", "xpbd"])
 def test_a_soft_body_pushes_a_rigid_one_keeping_linear_momentum(integrator):
     w, crate, ball = crate_and_ball(integrator, 100.0, deforma.Material.preset("jelly"))
-    mass = rigid_set(w._model).mass[0]
+    mass = rigid_set(w.model).mass[0]
 
     def momentum():
         return ball.vertex_masses @ ball.velocities + mass * crate.velocity
@@ -292,13 +292,13 @@ def test_angular_momentum_is_kept_and_energy_never_rises(crate_density):
     # the material is undamped because the corotated damping of a deformed, turning triangle
     # takes a little spin (2.5e-5 of a jelly disc's in a second)
     w, crate, ball = crate_and_ball("symplectic-euler", crate_density, UNDAMPED)
-    rs = rigid_set(w._model)
+    rs = rigid_set(w.model)
 
     def cross(a, b):
         return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
     def totals():
-        center = rs.poses(w._model, w._state.x, w._state.v)[0][0]
+        center = rs.poses(w.model, w.state.x, w.state.v)[0][0]
         spin = math.radians(crate.angular_velocity)
         momentum = (ball.vertex_masses * cross(ball.positions, ball.velocities)).sum() \
             + rs.inertia[0] * spin + rs.mass[0] * cross(center, crate.velocity)
@@ -332,7 +332,7 @@ def test_a_position_based_solver_gains_no_energy_from_a_rigid_body(integrator, c
     # at one 1/60 s step the ball went 5 cm into the crate and bounced off with 22 % more energy
     w, crate, ball = crate_and_ball(integrator, crate_density, UNDAMPED)
     assert w.substeps == 4
-    rs = rigid_set(w._model)
+    rs = rigid_set(w.model)
 
     def energy():
         e = w.energy(ball)

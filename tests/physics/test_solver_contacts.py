@@ -21,7 +21,7 @@ H = 1 / 60
 
 
 def largest_strain(w):
-    m, x = w._model, w._state.x
+    m, x = w.model, w.state.x
     length = np.linalg.norm(x[m.spring_j] - x[m.spring_i], axis=1)
     return float(np.abs(length / m.spring_rest_length - 1).max())
 
@@ -192,7 +192,7 @@ def test_the_jelly_stack_rests_at_a_display_step_under_implicit_euler():
     for k in range(360):
         w.step()
         assert crossings(w)[1] == 0, k
-    assert np.hypot(*w._state.v.T).max() < 0.01
+    assert np.hypot(*w.state.v.T).max() < 0.01
     heights = sorted(b.center_of_mass[1] for b in w.bodies)
     assert np.all(np.diff(heights) > 0.8)  # still a stack, each box on the one below
     assert inverted_triangles(w) == 0
@@ -245,13 +245,13 @@ def test_the_pile_comes_to_rest_without_crossing_from_another_start():
 def test_body_contacts_in_the_implicit_solve_keep_momentum_at_a_display_step():
     # springs between each vertex and its edge point, whose forces sum to zero
     w, a, b = head_on("implicit-euler", dt=H, substeps=1)
-    m = w._model.vertex_mass[:, None]
-    p0 = (m * w._state.v).sum(axis=0)
-    scale = (m * np.abs(w._state.v)).sum()
+    m = w.model.vertex_mass[:, None]
+    p0 = (m * w.state.v).sum(axis=0)
+    scale = (m * np.abs(w.state.v)).sum()
     factored = w.integrator_stats["factorizations"] + w.integrator_stats["updates"]
     for _ in range(40):
         w.step()
-        assert np.abs((m * w._state.v).sum(axis=0) - p0).max() < 1e-9 * scale
+        assert np.abs((m * w.state.v).sum(axis=0) - p0).max() < 1e-9 * scale
     assert w.integrator_stats["factorizations"] + w.integrator_stats["updates"] > factored + 1  # they met: contacts went into the matrix
     assert a.center_of_mass[0] < b.center_of_mass[0]
 

@@ -130,7 +130,7 @@ def torn_sheet(model, integrator, steps, detail=12):
 
     def checked_apply(self, cut):
         old, tt = self.topology, tearing.TearTopology.of(self.topology.rest_positions, self.topology.triangles)
-        x = w._state.x[self.vertex_slice]
+        x = w.state.x[self.vertex_slice]
         tips = [int(v) for v in self._crack_tips()]
         ref = reference_tear(tt, x, mat.tear_strain, tips)
         assert ref is not None
@@ -193,7 +193,7 @@ def test_incremental_rebuild_equals_rebuild_from_scratch(model, integrator, patc
     scratch = BodyTopology.from_arrays(t.rest_positions, edges, t.triangles, mass_share=t.mass_share)
     args = dict(masses=[body._param("mass")], stiffness=[body.stiffness], damping=[body.damping],
                 materials=[body.material], pinned=[body._pinned], contact=[w._contact_parameters(body)])
-    a, b = w._model, Model([scratch], **args)
+    a, b = w.model, Model([scratch], **args)
     # a torn body's elements keep their order, a new one's are sorted: the same rows of the
     # topology's triangles, with the same numbers
     rows_a, rows_b = np.argsort(a.elem_source), np.argsort(b.elem_source)
@@ -204,7 +204,7 @@ def test_incremental_rebuild_equals_rebuild_from_scratch(model, integrator, patc
         assert same(got, want), name
     for name in CONTACT_FIELDS:
         assert same(getattr(a.contact, name), getattr(b.contact, name)), name
-    assert len(body.mesh.uv) == body.n_vertices and len(w._state.x) == body.n_vertices
+    assert len(body.mesh.uv) == body.n_vertices and len(w.state.x) == body.n_vertices
 
 
 def test_stable_order_is_numpys_stable_argsort():

@@ -31,7 +31,7 @@ def torn_sheet_world(integrator):
 def snapshot(w):
     """What a step may change, as arrays (the Model's rest shape read from the Model itself:
     it is what plasticity moves, and no public attribute shows it whole)."""
-    m = w._model
+    m = w.model
     out = [np.array([w.time, w.step_count, len(w.bodies)])]
     for b in w.bodies:
         out += [b.positions, b.velocities, b.triangles, b.springs, b.pinned]
@@ -66,17 +66,17 @@ def test_a_step_failing_after_plastic_flow_a_tear_and_a_moving_collider_puts_eve
     else:
         pytest.fail("the strip never tore")
     # the step also moves the rest shape (plasticity) and the collider
-    rest_before, rest_after = w._model.rest_shape(0)[1], probe._model.rest_shape(0)[1]
+    rest_before, rest_after = w.model.rest_shape(0)[1], probe.model.rest_shape(0)[1]
     assert rest_before is not None and not np.array_equal(rest_before[0], rest_after[0])
     assert probe.colliders[0].center != w.colliders[0].center
-    before, model, topology = snapshot(w), w._model, w.bodies[0].topology
+    before, model, topology = snapshot(w), w.model, w.bodies[0].topology
     twin, twin_grab = copy.deepcopy((w, grab))  # one memo: the twin's own grab
     armed.append(True)
     with pytest.raises(deforma.SimulationUnstable, match="made to fail"):
         w.step()
     for a, b in zip(snapshot(w), before, strict=True):
         np.testing.assert_array_equal(a, b)  # bit for bit
-    assert w._model is model and w.bodies[0].topology is topology
+    assert w.model is model and w.bodies[0].topology is topology
     assert grab.active and grab.target == twin_grab.target and np.array_equal(grab.vertices, twin_grab.vertices)
     # and it goes on as if the failed step never was
     armed.clear()

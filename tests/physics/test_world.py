@@ -161,10 +161,10 @@ def test_positions_and_velocities_are_views_into_one_contiguous_state():
     w = deforma.World()
     a = w.add_body(grid_mesh(0.2, 0.1, 3, 2), position=(0, 0))
     b = w.add_body(grid_mesh(0.2, 0.1, 4, 2), position=(1, 0))
-    assert np.shares_memory(a.positions, w._state.x) and np.shares_memory(b.velocities, w._state.v)
+    assert np.shares_memory(a.positions, w.state.x) and np.shares_memory(b.velocities, w.state.v)
     assert (a.vertex_slice, b.vertex_slice) == (slice(0, 6), slice(6, 14))
     b.positions[0] = (5.0, 5.0)
-    assert tuple(w._state.x[6]) == (5.0, 5.0)
+    assert tuple(w.state.x[6]) == (5.0, 5.0)
     w.remove_body(a)
     assert w.bodies == [b] and b.index == 0 and tuple(b.positions[0]) == (5.0, 5.0)
     with pytest.raises(ValueError, match="unknown body"):
@@ -179,8 +179,8 @@ def test_body_parameters_follow_the_world_unless_overridden():
     b = w.add_body(grid_mesh(0.2, 0.1, 3, 2), position=(1.0, 0.0), stiffness=50.0, mass=6.0)
     w.stiffness = 300.0
     assert (a.stiffness, b.stiffness) == (300.0, 50.0)
-    assert w._model.spring_stiffness[: a.n_springs].tolist() == [300.0] * a.n_springs
-    assert w._model.vertex_mass[a.n_vertices:].tolist() == [1.0] * b.n_vertices
+    assert w.model.spring_stiffness[: a.n_springs].tolist() == [300.0] * a.n_springs
+    assert w.model.vertex_mass[a.n_vertices:].tolist() == [1.0] * b.n_vertices
     b.stiffness = None
     assert b.stiffness == 300.0
     assert w.energy(a).kinetic == 0.0
