@@ -1,7 +1,9 @@
 """One ``World.step``, stage by stage (``docs/architecture.md`` draws it):
 
 1. **inputs**: pack the colliders if they changed, set the grabs and applied forces in the
-   :class:`~deforma.physics.control.Control`, copy the State into the step's start;
+   :class:`~deforma.physics.control.Control`, copy the State into the step's start; with
+   ``world.sleep``, wake every island if the world changed, and integrate nothing when every
+   body sleeps (:mod:`~deforma.physics.sleeping`);
 2. **gas**: the pressure kick (:func:`~deforma.physics.behaviours.apply_pressure`), unless the
    integrator holds the gas in its solve (``solves_pressure``: avbd);
 3. **integrate**: ``integrator.step(model, start, state, control, contacts, h)``, run again
@@ -10,7 +12,11 @@
    (:func:`~deforma.physics.rigid.stage.step_rigid_bodies`: the rigid bodies and joints);
 4. **colliders**: the collider objects follow their motion; nothing may be left inside one;
 5. **behaviours**: stretch limit and plasticity, then tearing (a torn body gets a new Model);
-6. **checks**: every ``SHAPE_CHECK_EVERY`` steps, no body may have lost its shape.
+6. **checks**: every ``SHAPE_CHECK_EVERY`` steps, no body may have lost its shape;
+7. **after**: the step stands; the contacts it ended with are kept for
+   ``world.contact_pairs()``, islands fall asleep or wake, the contact listeners hear of pairs
+   that began or ended touching (:mod:`~deforma.physics.events`), and joints past their
+   ``break_force`` break.
 
 A stage that finds the step gone wrong raises :class:`~deforma.physics.diagnostics.SimulationUnstable`;
 the World is then put back exactly as it was before the step (:class:`Undo`): positions,
