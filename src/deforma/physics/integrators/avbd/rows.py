@@ -680,6 +680,31 @@ def start_rigid_rows(rigid, k_rigid, v, touch, planes, state, count, rs, n_body,
                                                          cf[c, CORNER_STATIC]) else 0.0
 
 
+@njit(cache=True)
+def _fill_impulses(x, touch, plane_rows, planes, state, count, bidx, bgeo, bstate, n_body, cpairs, cf, cstate,
+                   n_corner, h, vertex, edge, collider, point, normal, jn, jt):
+    """:func:`row_impulses`' columns, row by row (one loop: as NumPy's concatenations it cost
+    2.5 % of a 10-box stack's step, every step, read or not)."""
+    for k in range(count):
+        i = touch[k]
+        vertex[k], edge[k, 0], edge[k, 1], collider[k] = i, -1, -1, plane_rows[k]
+        point[k, 0], point[k, 1] = x[i, 0], x[i, 1]
+        normal[k, 0], normal[k, 1] = planes[k, 0], planes[k, 1]
+        jn[k], jt[k] = h * state[k, LAM_N], h * state[k, LAM_T]
+    for c in range(n_body):
+        r, i = count + c, bidx[c, 0]
+        vertex[r], edge[r, 0], edge[r, 1], collider[r] = i, bidx[c, 1], bidx[c, 2], -1
+        point[r, 0], point[r, 1] = x[i, 0], x[i, 1]
+        normal[r, 0], normal[r, 1] = bgeo[c, BODY_NX], bgeo[c, BODY_NY]
+        jn[r], jt[r] = h * bstate[c, LAM_N], h * bstate[c, LAM_T]
+    for c in range(n_corner):
+        r = count + n_body + c
+        vertex[r], edge[r, 0], edge[r, 1], collider[r] = -1, cpairs[c, 0], cpairs[c, 1], cpairs[c, 3]
+        point[r, 0], point[r, 1] = cf[c, CORNER_PX], cf[c, CORNER_PY]
+        normal[r, 0], normal[r, 1] = cf[c, CORNER_NX], cf[c, CORNER_NY]
+        jn[r], jt[r] = h * cstate[c, LAM_N], h * cstate[c, LAM_T]
+
+
 def row_impulses(x, touch, plane_rows, planes, state, count, bidx, bgeo, bstate, n_body, cpairs, cf, cstate,
                  n_corner, h):
     """The impulses of a substep's rows (N s, their multipliers after the dual step times ``h``)
@@ -688,16 +713,10 @@ def row_impulses(x, touch, plane_rows, planes, state, count, bidx, bgeo, bstate,
     ``bstate``) and the corner rows (``cpairs``, ``cf``, ``cstate``), the first ``count``,
     ``n_body`` and ``n_corner`` of each; the points at ``x``. Each row's force on its pushed
     side is ``lambda_n n + lambda_t t`` (``t = (-n_y, n_x)``), as its block takes it."""
-    v = touch[:count].astype(np.int64)
-    bv = bidx[:n_body, 0]
-    return ContactImpulses(
-        vertex=np.concatenate([v, bv, np.full(n_corner, -1, np.int64)]),
-        edge=np.concatenate([np.full((count, 2), -1, np.int64), bidx[:n_body, 1:3], cpairs[:n_corner, 0:2]]),
-        collider=np.concatenate([plane_rows[:count].astype(np.int64), np.full(n_body, -1, np.int64),
-                                 cpairs[:n_corner, 3]]),
-        point=np.concatenate([x[v], x[bv], cf[:n_corner, CORNER_PX:CORNER_PY + 1]]),
-        normal=np.concatenate([planes[:count, 0:2], bgeo[:n_body, BODY_NX:BODY_NY + 1],
-                               cf[:n_corner, CORNER_NX:CORNER_NY + 1]]),
-        normal_impulse=h * np.concatenate([state[:count, LAM_N], bstate[:n_body, LAM_N], cstate[:n_corner, LAM_N]]),
-        friction_impulse=h * np.concatenate([state[:count, LAM_T], bstate[:n_body, LAM_T],
-                                             cstate[:n_corner, LAM_T]]))
+    n = count + n_body + n_corner
+    out = ContactImpulses(np.empty(n, np.int64), np.empty((n, 2), np.int64), np.empty(n, np.int64),
+                          np.empty((n, 2)), np.empty((n, 2)), np.empty(n), np.empty(n))
+    _fill_impulses(x, touch, plane_rows, planes, state, count, bidx, bgeo, bstate, n_body, cpairs, cf, cstate,
+                   n_corner, h, *(getattr(out, f) for f in ("vertex", "edge", "collider", "point", "normal",
+                                                             "normal_impulse", "friction_impulse")))
+    return out
