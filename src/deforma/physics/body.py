@@ -385,8 +385,9 @@ class Body:
             raise ValueError(f"body {self._index} is made of {self.material.model!r} elements, which have no "
                              f"spring {name}: change its material (youngs_modulus, density, damping) instead")
         self._overrides[name] = None if value is None else check(value)
-        self._check()._disturb(self)
-        self._check()._apply_body_parameters(self._index)
+        world = self._check()
+        world._disturb(self)
+        world._apply_body_parameters(self._index)
 
     def _mass(self):
         if self.is_fem:
@@ -510,8 +511,9 @@ class Body:
         [0.02, 0.02, 0.02]
         """
         idx, f = self._loads(force, indices, "force", "N")
-        self._check()._disturb(self)
-        self._check()._forces.append((self, idx, f))
+        world = self._check()
+        world._disturb(self)
+        world._forces.append((self, idx, f))
 
     def apply_impulse(self, impulse, indices=None) -> None:
         """Change the body's velocities now by ``impulse`` (N s): ``impulse / mass`` per vertex.
@@ -571,7 +573,7 @@ class Body:
         world._disturb(self)
         self._pinned[idx] = True
         self.velocities[slice(None) if self.material.is_rigid and idx.size else idx] = 0.0
-        world._model.set_pinned(self._index, self._pinned)
+        world._hold([self])
 
     def unpin(self, indices=None) -> None:
         """Free vertices ``indices`` (default: all of them)."""
@@ -581,7 +583,7 @@ class Body:
             self._pinned[:] = False
         else:
             self._pinned[self._indices(indices, "unpin indices")] = False
-        world._model.set_pinned(self._index, self._pinned)
+        world._hold([self])
     friction = property(lambda self: self._param("friction"),
                         lambda self, v: self._set_param("friction", v,
                                                         lambda x: _non_negative(x, "friction", "(dimensionless)")),

@@ -247,7 +247,7 @@ class World:
 
     def _disturb(self, body) -> None:
         """Something acts on ``body``: it wakes, with its island."""
-        if any(b is body for b in self._bodies) and any(b._asleep for b in self._island_of(body)):
+        if any(b is body for b in self._bodies):
             self._wake(self._island_of(body))
 
     def _update_sleep(self, kept_awake) -> None:
@@ -837,7 +837,7 @@ class World:
         """The last step's touching pairs by ``(id(a), id(b))`` (:func:`~deforma.physics.contact.pairs.group_pairs`),
         worked out once per step: from the integrator's contact rows where it keeps their
         forces (avbd), else from :attr:`contacts` (no impulses). None once a body was added or
-        removed since (their vertices no longer number as the step's did)."""
+        removed since (their vertices no longer number as the step's did): empty."""
         record = self._contact_record
         if record is None:
             return {}

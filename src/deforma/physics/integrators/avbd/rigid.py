@@ -545,11 +545,6 @@ def rigid_pass(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, jr, touch
 
 
 #: A joint whose points (or a weld's angle, at the body's reach) began a substep further
-#: apart than this (m) keeps its blocks on backward Euler (:func:`rigid_second_order`).
-JOINT_SLACK = 1e-6
-
-
-#: A joint whose points (or a weld's angle, at the body's reach) began a substep further
 #: apart than this (m) keeps its island on backward Euler (:func:`rigid_second_order`).
 JOINT_SLACK = 1e-6
 
