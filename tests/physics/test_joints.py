@@ -242,7 +242,11 @@ def test_removing_a_joint_or_a_body_lets_go():
 @pytest.mark.parametrize("call, message", [
     (lambda w, a, b, s: w.join(a, b, at=(5.0, 5.0)), r"at = \(5.0, 5.0\) is not on body 0 or body 1"),
     (lambda w, a, b, s: w.join(a, a, at=(0.1, 0.02)), "a joint between body 0 and itself holds nothing"),
-    (lambda w, a, b, s: w.join(s, None, at=(0.1, 3.0)), "joints hold rigid bodies: a .body 2. is soft"),
+    (lambda w, a, b, s: w.join(s, None, at=(0.1, 3.0), kind="weld"),
+     r"a weld holds a rigid body's turn, and a \(body 2\) is soft: join a soft body with pins or springs"),
+    (lambda w, a, b, s: w.join(a, s, at=(0.1, 3.0), motor_speed=30.0),
+     r"a motor holds a rigid body's turn, and b \(body 2\) is soft"),
+    (lambda w, a, b, s: w.join(a, s, at=(0.1, 0.02)), r"at = \(0.1, 0.02\) is not on b \(body 2\), a soft body"),
     (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="hinge"), "kind must be one of pin, weld, spring"),
     (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="spring"), "a spring joint needs stiffness"),
     (lambda w, a, b, s: w.join(a, None, at=(0.1, 0.02), kind="weld", motor_speed=10.0),
@@ -325,7 +329,7 @@ def test_a_scene_joint_hinges_its_bar_and_saves_with_the_scene(tmp_path):
     ("a = 0\nb = 0\nat = [0, 0]", "joint[0].b: a joint between body 0 and itself holds nothing"),
     ("a = 0", "joint[0].at: missing: the point both hold"),
     ("a = 0\nat = [3, 3]", r"joint[0]: at = (3.0, 3.0) is not on body 0"),
-    ("a = 1\nat = [0, 3]", "joint[0]: joints hold rigid bodies: a (body 1) is soft"),
+    ("a = 1\nat = [0, 3]\nkind = \"weld\"", "joint[0]: a weld holds a rigid body's turn, and a (body 1) is soft"),
     ("a = 0\nat = [0, 0]\nkind = \"hinge\"", "joint[0].kind"),
     ("a = 0\nat = [0, 0]\nkind = \"spring\"", "joint[0]: a spring joint needs stiffness"),
     # TOML integers are unbounded: one beyond any float is refused where it is read, not an OverflowError
@@ -345,20 +349,35 @@ def test_a_bad_scene_joint_is_refused_in_one_line_naming_it(tmp_path, joint, mes
     assert message in str(e.value) and "\n" not in str(e.value)
 
 
-def test_a_jointed_body_cannot_be_made_soft_while_the_joint_holds_it():
+def test_a_jointed_body_cannot_be_made_soft_where_its_joint_cannot_hold_it_soft():
+    # a weld holds a turn (refused on a soft body), and under implicit Euler no joint holds one
+    for kind, integrator in (("weld", "avbd"), ("pin", "implicit-euler")):
+        w = deforma.World(dt=1 / 60, material=RIGID, integrator=integrator)
+        b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.05), (0, 0.05)), detail=2), position=(0.5, 0.0))
+        w.join(b, None, at=(0.0, 0.0), kind=kind)
+        for change in (lambda: setattr(b, "material", deforma.Material.preset("jelly")),
+                       lambda: setattr(w, "material", deforma.Material.preset("jelly")),
+                       lambda: setattr(w, "material", None)):
+            with pytest.raises(ValueError, match="is held by a joint .* cannot hold it soft: .* remove the joint "
+                                                 "first") as e:
+                change()
+            assert "\n" not in str(e.value) and b.material == RIGID
+        w.material = deforma.Material("rigid", density=50.0)  # rigid to rigid is fine
+        w.remove_joint(w.joints[0])
+        b.material = deforma.Material.preset("jelly")
+        assert not b.material.is_rigid
+
+
+def test_a_pinned_rigid_bar_made_soft_hangs_on_by_its_triangle():
     w = deforma.World(dt=1 / 60, material=RIGID)
-    b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.05), (0, 0.05)), detail=2), position=(0.5, 0.0))
-    w.join(b, None, at=(0.0, 0.0))
-    for change in (lambda: setattr(b, "material", deforma.Material.preset("jelly")),
-                   lambda: setattr(w, "material", deforma.Material.preset("jelly")),
-                   lambda: setattr(w, "material", None)):
-        with pytest.raises(ValueError, match="is held by a joint .* remove the joint first") as e:
-            change()
-        assert "\n" not in str(e.value) and b.material == RIGID
-    w.material = deforma.Material("rigid", density=50.0)  # rigid to rigid is fine
-    w.remove_joint(w.joints[0])
-    b.material = deforma.Material.preset("jelly")
-    assert not b.material.is_rigid
+    b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 0.05), (0, 0.05)), detail=4), position=(0.5, 0.0))
+    j = w.join(b, None, at=(0.05, 0.0))
+    for _ in range(10):
+        w.step()
+    b.material = deforma.Material("corotated", youngs_modulus=1e6, poisson_ratio=0.3, density=100.0)
+    for _ in range(120):
+        w.step()
+    assert np.abs(j.point - (0.05, 0.0)).max() < 1e-3 and b.center_of_mass[1] < -0.3  # swung down, held
 
 
 def test_the_picture_shows_a_dot_where_each_joint_is(gl_ctx):

@@ -1,10 +1,13 @@
 """Handles onto a world's joints: what :meth:`World.join` returns.
 
-A :class:`Joint` holds a point of one rigid body on a point of another, or on the world:
-a ``"pin"`` (a hinge, optionally driven by a motor), a ``"weld"`` (no relative turning
-either) or a ``"spring"`` (a zero-length spring and damper). The rigid solver does the work
-(:mod:`deforma.physics.rigid.joints`); the handle keeps what the user gave, the anchors in
-the bodies' frames, the warm-start impulses, and the force of the last step.
+A :class:`Joint` holds a point of one body on a point of another, or on the world: a
+``"pin"`` (a hinge, optionally driven by a motor), a ``"weld"`` (no relative turning
+either) or a ``"spring"`` (a zero-length spring and damper). Welds and motors hold rigid
+bodies; pins and springs hold soft ones too, by the triangle under the point. avbd solves
+them as rows of its sweep (:mod:`deforma.physics.integrators.avbd.joints`), the other
+integrators' rigid stage those of rigid bodies (:mod:`deforma.physics.rigid.joints`); the
+handle keeps what the user gave, the anchors in the bodies' frames, the warm-start
+impulses, and the force of the last step.
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ class Joint:
     Attributes
     ----------
     a, b : Body, Body or None
-        The bodies it joins (``b`` None: the world).
+        The bodies it joins (``b`` None: the world), rigid or (a pin or a spring) soft.
     kind : str
         ``"pin"``, ``"weld"`` or ``"spring"``.
     anchor : (float, float)
@@ -58,9 +61,9 @@ class Joint:
         self._acc = np.zeros(4)                        # warm starts (see rigid.joints)
         self._impulse = np.zeros(3)                    # over the step so far: point (N s), angle (N m s)
         self._force = np.zeros(3)                      # the last step's, per second
-        # avbd's rows (integrators.avbd.joints): each side's point on two of its body's
-        # vertices (body-local indices, -1 for the world) and its (alpha, beta) there (the
-        # world's point), the frames' reference angle, and the rows' warm start
+        # avbd's rows (integrators.avbd.joints): per side its point as a rigid body carries
+        # it and as a soft body does (see frame_rows), the frames' reference angle, and the
+        # rows' warm start
         self._frame = frame
         self.break_force = break_force
         self._broken = False
@@ -70,8 +73,12 @@ class Joint:
     @property
     def point(self) -> np.ndarray:
         """Where ``a`` holds the joint now (m): its anchor carried with it since the joint
-        was made (``b``'s point is there too, up to the solver's drift)."""
+        was made (``b``'s point is there too, up to the solver's drift); on a soft body, the
+        point of the triangle it was made on."""
         a = self.a
+        if not a.material.is_rigid:
+            tri, weights = self._frame[1][0], self._frame[2][0]
+            return weights @ a.positions[tri]
         x, m = a.positions, a.vertex_masses
         center = rigid_motion.center_of_mass(x, m)
         angle = rigid_motion.fit_angle(a.topology.rest_positions, x, m)
@@ -123,13 +130,12 @@ class Joint:
                           self.stiffness or 0.0, self.damping or 0.0])
         return KINDS[self.kind], param, speed is not None
 
-    def _rows(self) -> tuple:
-        """``(frame vertices (4,) body-local, frame weights (4,), param (5,), motor on)`` for
-        avbd's rows: as :meth:`_pack`, with the frames' reference angle first."""
-        verts, weights, reference = self._frame
+    def _rows(self) -> tuple[np.ndarray, bool]:
+        """``(param (6,), motor on)`` for avbd's rows: as :meth:`_pack`, with the frames'
+        reference angle first (and the substep's length, set by the solver, last)."""
         _, param, on = self._pack()
-        param[0] = reference
-        return verts, weights, param, on
+        param[0] = self._frame[3]
+        return np.append(param, 0.0), on
 
     def __repr__(self) -> str:
         b = "the world" if self.b is None else f"body {self.b._index}"
@@ -168,7 +174,8 @@ def spring(kind: str, stiffness, damping) -> tuple[float | None, float | None]:
 def pack_rows(joints, model, bodies: np.ndarray):
     """The joints as avbd's rows (:class:`~deforma.physics.integrators.avbd.joints.JointRows`)
     of ``model``, whose rigid bodies are ``bodies`` (body indices, in block order), warm-started
-    from each joint's last step; None without joints."""
+    from each joint's last step; None without joints. A side on a rigid body is its frame
+    (two vertices), on a soft body its triangle (its weights), on the world its point."""
     if not joints:
         return None
     from .integrators.avbd.joints import make_joint_rows
@@ -176,20 +183,29 @@ def pack_rows(joints, model, bodies: np.ndarray):
     n = len(joints)
     where = {int(b): k for k, b in enumerate(bodies)}
     block = np.full((n, 2), -1, np.int64)
-    fv, fw, param = np.full((n, 4), -1, np.int64), np.zeros((n, 4)), np.zeros((n, 5))
+    fv, fw, param = np.full((n, 6), -1, np.int64), np.zeros((n, 6)), np.zeros((n, 6))
     kind, motor_on = np.zeros(n, np.int64), np.zeros(n, np.bool_)
     lam, pen = np.zeros((n, 4)), np.zeros((n, 4))
     off = model.body_vertex_offsets
     for i, j in enumerate(joints):
-        verts, weights, param[i], motor_on[i] = j._rows()
+        param[i], motor_on[i] = j._rows()
         kind[i] = KINDS[j.kind]
-        fw[i] = weights
+        frames, tris, weights = j._frame[0], j._frame[1], j._frame[2]
+        fw[i, 3:5] = j.anchor  # the world's point, unless b is a body
         for side, body in enumerate((j.a, j.b)):
-            if body is not None:
+            if body is None:
+                continue
+            c = slice(3 * side, 3 * side + 3)
+            if body.material.is_rigid:
                 block[i, side] = where[body._index]
-                fv[i, 2 * side:2 * side + 2] = verts[2 * side:2 * side + 2] + off[body._index]
+                i0, i1, alpha, beta = frames[side]
+                fv[i, c] = off[body._index] + i0, off[body._index] + i1, -1
+                fw[i, c] = alpha, beta, 0.0
+            else:
+                fv[i, c] = off[body._index] + tris[side]
+                fw[i, c] = weights[side]
         lam[i], pen[i] = j._lam, j._pen
-    return make_joint_rows(block, fv, fw, kind, param, motor_on, lam, pen, len(bodies))
+    return make_joint_rows(block, fv, fw, kind, param, motor_on, lam, pen, len(bodies), model.n_vertices)
 
 
 def read_rows(joints, rows, dt: float) -> None:
@@ -212,6 +228,24 @@ def frame(x: np.ndarray, point) -> tuple[int, int, float, float, float]:
     w = np.asarray(point, np.float64) - x[0]
     n2 = float(d @ d)
     return 0, i1, float(w @ d) / n2, float(-w[0] * d[1] + w[1] * d[0]) / n2, math.atan2(d[1], d[0])
+
+
+def triangle_weights(x: np.ndarray, triangles: np.ndarray, point) -> tuple[np.ndarray, np.ndarray]:
+    """The triangle of a soft body (vertices ``x``, ``triangles``) that holds ``point`` and
+    the point's barycentric weights on it, ``(vertices (3,), weights (3,))``: of the
+    triangles under the point (on a shared edge or vertex, several) the one whose least
+    weight is largest, the point deepest inside. A point off the body (within rounding of
+    its outline) takes the nearest triangle's weights clipped to it."""
+    a, b, c = x[triangles[:, 0]], x[triangles[:, 1]], x[triangles[:, 2]]
+    p = np.asarray(point, np.float64)
+    e1, e2, q = b - a, c - a, p - a
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    u = (q[:, 0] * e2[:, 1] - q[:, 1] * e2[:, 0]) / det
+    v = (e1[:, 0] * q[:, 1] - e1[:, 1] * q[:, 0]) / det
+    w = np.stack([1.0 - u - v, u, v], axis=1)
+    best = int(np.argmax(w.min(axis=1)))
+    weights = np.clip(w[best], 0.0, None)
+    return triangles[best].astype(np.int64), weights / weights.sum()
 
 
 def anchor(value) -> tuple[float, float]:

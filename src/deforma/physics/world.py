@@ -489,12 +489,16 @@ class World:
         self._material_changed()
 
     def _check_joined_stay_rigid(self, softened) -> None:
-        """Refuse to make a body a joint holds soft (joints hold rigid bodies)."""
+        """Refuse to make a body a joint holds soft where the joint cannot hold a soft body
+        (a weld, a motor, or an integrator other than avbd: :meth:`_check_soft_joint`)."""
         for j in self._joints:
             for body in (j.a, j.b):
                 if body is not None and any(body is s for s in softened):
-                    raise ValueError(f"body {body._index} is held by a joint ({j!r}), and joints hold rigid bodies: "
-                                     f"remove the joint first (world.remove_joint)")
+                    try:
+                        self._check_soft_joint(j.kind, j.motor_speed, f"body {body._index}")
+                    except ValueError as e:
+                        raise ValueError(f"body {body._index} is held by a joint ({j!r}) that cannot hold it soft: "
+                                         f"{e}; remove the joint first (world.remove_joint)") from None
 
     def _material_changed(self) -> None:
         # springs and elements are different arrays: rebuild the Model, keep the state
@@ -508,7 +512,15 @@ class World:
 
     @integrator.setter
     def integrator(self, name):
-        self._integrator = make_integrator(name)
+        made = make_integrator(name)
+        if not made.solves_rigid:
+            for j in self._joints:
+                soft = [body for body in (j.a, j.b) if body is not None and not body.material.is_rigid]
+                if soft:
+                    raise ValueError(f"body {soft[0]._index} is soft and held by a joint ({j!r}): joints on soft "
+                                     f"bodies are solved by integrator='avbd'; remove the joint first "
+                                     f"(world.remove_joint) to use {name!r}")
+        self._integrator = made
         self._rigid_solve_changed()
 
     def _rigid_in_solve(self) -> bool:
@@ -790,14 +802,18 @@ class World:
         self._model.set_contact_parameters(b, **self._contact_parameters(body))
 
     def _check_no_overlap(self, body, x=None) -> None:
-        """Refuse a colliding body that overlaps another colliding body (bodies must start apart)."""
+        """Refuse a colliding body that overlaps another colliding body (bodies must start
+        apart); a body a joint holds to it may overlap it (joined bodies do not collide: the
+        links of a chain overlap at their pins)."""
         topo = body.topology
         if not len(topo.boundary_edges):
             return
         if x is None:
             x = body.positions
+        joined = {id(j.b if j.a is body else j.a) for j in self._joints if body is j.a or body is j.b}
         for other in self._bodies:
-            if other is body or not other._overrides["collide"] or not len(other.topology.boundary_edges):
+            if (other is body or id(other) in joined or not other._overrides["collide"]
+                    or not len(other.topology.boundary_edges)):
                 continue
             if outlines_overlap(x, topo.boundary_edges, other.positions, other.topology.boundary_edges):
                 which = f"body {body._index}" if body in self._bodies else f"the new body ({len(self._bodies)})"
@@ -1033,23 +1049,29 @@ class World:
 
     def join(self, a: Body, b: Body | None = None, at=None, *, kind: str = "pin", stiffness=None, damping=None,
              motor_speed=None, max_torque=None, break_force=None) -> Joint:
-        """Join rigid body ``a`` to rigid body ``b`` (None: to the world) at the point ``at``.
+        """Join body ``a`` to body ``b`` (None: to the world) at the point ``at``.
 
         Parameters
         ----------
         a, b : Body, Body or None
-            Rigid bodies of this world (``Material("rigid", ...)``), ``b`` None for the world.
+            Bodies of this world, ``b`` None for the world. A rigid body (``Material("rigid",
+            ...)``) holds the point as it moves and turns; a soft body holds it by the
+            triangle under it, whose three vertices share the joint's force by their
+            barycentric weights (a hinge tears no hole). Joints on soft bodies are solved by
+            ``integrator="avbd"`` (the default).
         at : (float, float)
-            The point both hold (m), on ``a`` or ``b`` now.
+            The point both hold (m): on ``a`` or ``b`` now, and on every soft body it joins.
         kind : {"pin", "weld", "spring"}
             A hinge (the bodies turn freely about the point), a weld (they do not turn
-            either), or a zero-length spring and damper between the two points.
+            either; rigid bodies), or a zero-length spring and damper between the two points.
+            Several pins hold a soft body as a weld would (as a tyre on its rim).
         stiffness, damping : float, optional
             A spring's N/m (needed) and N s/m (default 0). Solved implicitly: any stiffness
             is stable.
         motor_speed : float, optional
-            A pin's motor: drives ``a``'s spin relative to ``b`` towards this many degrees/s
-            (counter-clockwise), with at most ``max_torque`` N m (default: as much as it takes).
+            A pin's motor between rigid bodies (or one and the world): drives ``a``'s spin
+            relative to ``b`` towards this many degrees/s (counter-clockwise), with at most
+            ``max_torque`` N m (default: as much as it takes).
         break_force : float, optional
             N: a step whose :attr:`Joint.force` exceeds it breaks the joint (it leaves
             :attr:`joints` and :attr:`Joint.broken` turns True). Default: it never breaks.
@@ -1072,6 +1094,17 @@ class World:
         ...     w.step()
         >>> round(float(bar.center_of_mass[1]), 2)  # a quarter swing (0.48 s) later: hanging down
         -0.5
+
+        A jelly block hung from the world by a pin at its top edge stays there:
+
+        >>> w = deforma.World(dt=1 / 60)
+        >>> jelly = w.add_body(deforma.mesh.box(((0, 0), (0.2, 0), (0.2, 0.2), (0, 0.2)), detail=3),
+        ...                    position=(0.0, 0.0), material=deforma.Material.preset("jelly"))
+        >>> top = w.join(jelly, None, at=(0.0, 0.1))
+        >>> for _ in range(60):
+        ...     w.step()
+        >>> bool(abs(top.point - (0.0, 0.1)).max() < 1e-3)
+        True
         """
         if not isinstance(kind, str) or kind not in _joint.KINDS:
             raise ValueError(f"kind must be one of {', '.join(_joint.KINDS)}, got {kind!r}")
@@ -1079,9 +1112,6 @@ class World:
             if body is None and name == "b":
                 continue
             self._own_body(body)
-            if not body.material.is_rigid:
-                raise ValueError(f"joints hold rigid bodies: {name} (body {body._index}) is soft; make it of "
-                                 f"deforma.Material('rigid', density=...) (joints on soft bodies are to come)")
         if a is b:
             raise ValueError(f"a joint between body {a._index} and itself holds nothing: join it to another body "
                              f"or to the world (b=None)")
@@ -1091,11 +1121,17 @@ class World:
         stiffness, damping = _joint.spring(kind, stiffness, damping)
         motor_speed, max_torque = _joint.motor(kind, motor_speed, max_torque)
         break_force = None if break_force is None else _positive(break_force, "break_force", "N")
-        on = [body for body in (a, b) if body is not None
-              and triangles_under(body.positions, body.topology.triangles, point, tolerance=1e-12).any()]
-        if not on:
+        under = {id(body): triangles_under(body.positions, body.topology.triangles, point, tolerance=1e-9).any()
+                 for body in (a, b) if body is not None}
+        if not any(under.values()):
             where = "body " + str(a._index) + ("" if b is None else f" or body {b._index}")
             raise ValueError(f"at = {point} is not on {where}: a joint point must lie on a body it joins")
+        for name, body in (("a", a), ("b", b)):
+            if body is not None and not body.material.is_rigid:
+                self._check_soft_joint(kind, motor_speed, f"{name} (body {body._index})")
+                if not under[id(body)]:
+                    raise ValueError(f"at = {point} is not on {name} (body {body._index}), a soft body: it holds a "
+                                     f"joint by the triangle under the point; put at on it")
         model = self._model
         rs = rigid_set(model)
         center, angle, _, _ = rs.poses(model, self._state.x, self._state.v)
@@ -1104,23 +1140,43 @@ class World:
             if body is None:
                 local.append(point)
                 continue
+            if not body.material.is_rigid:
+                local.append(point)  # (the rigid stage's frame: a soft side is avbd's alone)
+                continue
             k = int(np.flatnonzero(rs.bodies == body._index)[0])
             c, s_ = math.cos(angle[k]), math.sin(angle[k])
             dx, dy = point[0] - center[k, 0], point[1] - center[k, 1]
             local.append((c * dx + s_ * dy, -s_ * dx + c * dy))  # turned back to the body frame
             turn += angle[k] if side == 0 else -angle[k]
-        verts, weights, ref = [-1, -1, -1, -1], [0.0, 0.0, point[0], point[1]], 0.0
+        # each side's point as a rigid body carries it (a frame of two vertices) and as a soft
+        # body does (the triangle under it): a body's material may change while joined
+        frames, tris, weights, ref = [None, None], [None, None], [None, None], 0.0
         for side, body in enumerate((a, b)):
-            if body is not None:
-                i0, i1, alpha, beta, theta = _joint.frame(body.positions, point)
-                verts[2 * side:2 * side + 2] = i0, i1
-                weights[2 * side:2 * side + 2] = alpha, beta
-                ref += theta if side == 0 else -theta
+            if body is None:
+                continue
+            i0, i1, alpha, beta, theta = _joint.frame(body.positions, point)
+            frames[side] = (i0, i1, alpha, beta)
+            ref += theta if side == 0 else -theta
+            tris[side], weights[side] = _joint.triangle_weights(body.positions, body.topology.triangles, point)
         j = Joint(self, a, b, kind, point, np.concatenate(local), turn, stiffness, damping, motor_speed, max_torque,
-                  frame=(np.array(verts, np.int64), np.array(weights), ref), break_force=break_force)
+                  frame=(frames, tris, weights, ref), break_force=break_force)
         self._joints.append(j)
+        self._model.set_joined([(j.a._index, j.b._index) for j in self._joints if j.b is not None])
         self._rigid_solve_changed()
         return j
+
+    def _check_soft_joint(self, kind: str, motor_speed, which: str) -> None:
+        """Refuse a joint this world cannot hold on the soft body ``which``: a weld or a
+        motor (they hold a turn, which a soft body has only as a whole), or any joint under
+        an integrator that does not solve joints on soft bodies (all but avbd)."""
+        if kind == "weld" or motor_speed is not None:
+            what = "a weld" if kind == "weld" else "a motor"
+            raise ValueError(f"{what} holds a rigid body's turn, and {which} is soft: join a soft body with pins or "
+                             f"springs (several pins hold it as a weld), or pin it to a rigid hub that has the "
+                             f"{'weld' if kind == 'weld' else 'motor'}")
+        if not self._rigid_in_solve():
+            raise ValueError(f"{which} is soft, and joints on soft bodies are solved by integrator='avbd' (the "
+                             f"default); this world uses {self._integrator.name!r}")
 
     def _break_joints(self) -> None:
         """Take out the joints whose force over the last step exceeded their ``break_force``."""

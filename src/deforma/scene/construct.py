@@ -166,12 +166,16 @@ def build(scene: Scene):
         except ValueError as e:  # the message names the option and what it allows
             raise SceneError(f"{source}: physics.integrator_options: {e}") from None
     bodies = []
+    # bodies a joint holds to another may overlap it (the links of a chain, at their pins):
+    # they join the world without collisions, and take them once their joints are made
+    joined = {k for j in scene.joint if j.a is not None and j.b is not None for k in (j.a, j.b)}
     for i, spec in enumerate(scene.body):
         try:
             material = _material(material_settings(p, spec))
             m = make_mesh(spec)
             b = world.add_body(m, position=spec.position, material=material, mass=spec.mass,
-                               stiffness=spec.stiffness, damping=spec.damping, collide=spec.collide,
+                               stiffness=spec.stiffness, damping=spec.damping,
+                               collide=spec.collide and i not in joined,
                                self_collision=spec.self_collision, friction=spec.friction,
                                static_friction=spec.static_friction, angle=spec.angle, velocity=spec.velocity,
                                angular_velocity=spec.angular_velocity)
@@ -208,6 +212,12 @@ def build(scene: Scene):
                        break_force=j.break_force)
         except (ValueError, IndexError, TypeError) as e:  # a scene made in code is checked here
             raise SceneError(f"{source}: joint[{i}]: {e}") from None
+    for i, spec in enumerate(scene.body):
+        if spec.collide and i in joined:
+            try:
+                made[i].collide = True
+            except ValueError as e:  # it overlaps a body no joint holds it to
+                raise SceneError(f"{source}: body[{i}]: {e}") from None
     _REGISTRY[world] = BuildRecord(scene, bodies, colliders)
     return world
 

@@ -474,22 +474,24 @@ class Pull:
 
 @dataclass(frozen=True)
 class JointSpec:
-    """``[[joint]]``: two rigid bodies, or a rigid body and the world, held together at a point
-    (``World.join``)."""
+    """``[[joint]]``: two bodies, or a body and the world, held together at a point
+    (``World.join``): rigid bodies, or soft ones by a pin or a spring."""
 
     a: int | None = spec("int", None, lo=0, doc="The body it holds (required): its place among the [[body]] "
-                                                 "tables, from 0; a rigid body.")
+                                                 "tables, from 0; rigid, or soft with a pin or a spring.")
     b: int | None = spec("int", None, lo=0, doc="The other body's place; omit to hold `a` to the world.")
     at: tuple | None = spec("vec2", None, unit="m",
-                            doc="The point both hold (required), on `a` or `b` where the scene places them.")
+                            doc="The point both hold (required), on `a` or `b` where the scene places them, "
+                                "and on each soft body it joins.")
     kind: str = spec("str", "pin", choices=("pin", "weld", "spring"),
-                     doc="pin: a hinge; weld: no turning either; spring: a zero-length spring and damper.")
+                     doc="pin: a hinge; weld: no turning either (rigid bodies); spring: a zero-length spring "
+                         "and damper.")
     stiffness: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N/m",
                                    doc="A spring's stiffness (required with kind = \"spring\", only then).")
     damping: float | None = spec("float", None, lo=0.0, unit="N*s/m", doc="A spring's damping; default 0.")
     motor_speed: float | None = spec("float", None, lo=-1e6, hi=1e6, unit="deg/s",
-                                     doc="A pin's motor: the spin of `a` relative to `b` it drives towards, "
-                                         "counter-clockwise; omit for a free hinge.")
+                                     doc="A pin's motor (rigid bodies): the spin of `a` relative to `b` it drives "
+                                         "towards, counter-clockwise; omit for a free hinge.")
     max_torque: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N*m",
                                     doc="The most torque the motor gives; omit for as much as it takes.")
     break_force: float | None = spec("float", None, lo=0.0, lo_open=True, unit="N",

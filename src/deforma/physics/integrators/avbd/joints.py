@@ -1,46 +1,63 @@
 """Joints as rows of the avbd sweep (Giles, Diaz, Yuksel, "Augmented Vertex Block Descent",
 SIGGRAPH 2025: a joint is a set of augmented-Lagrangian rows on the blocks it joins).
 
-A joint holds a point of rigid block ``a`` on a point of block ``b`` or of the world. Each
-side's point is carried by its body: at the start of a substep it is read from two of the
-body's vertices (``p = x_0 + alpha d + beta perp(d)``, ``d = x_1 - x_0``: exact for a rigid
-body, and where the joint was made), and within the substep it turns and moves with the
-block's pose, ``p = c + R(phi) r`` (``r`` its arm from the centre at the start).
+A joint holds a point of body ``a`` on a point of body ``b`` or of the world. A side's point
+is carried by its body:
+
+- on a rigid block, at the start of a substep it is read from two of the body's vertices
+  (``p = x_0 + alpha d + beta perp(d)``, ``d = x_1 - x_0``: exact for a rigid body, and where
+  the joint was made), and within the substep it turns and moves with the block's pose,
+  ``p = c + R(phi) r`` (``r`` its arm from the centre at the start);
+- on a soft body, it is the point of the triangle it was made on, by its barycentric
+  weights, ``p = sum w_i x_i``: the three vertices share the joint's force by their weights,
+  so a hinge in a soft body pulls no single vertex out of it (no hole, no tear). The row is
+  then part of each of those vertices' blocks in the vertex sweep (:func:`joint_vertex_block`,
+  through the :class:`~deforma.physics.integrators.avbd.rows.RowSet`), and those vertices are
+  swept with the contact rows' (one by one, after their colour's others).
 
 Rows, with ``C`` the constraint, ``k`` its penalty and ``lambda`` its multiplier, the force
 ``f = k C + lambda`` acting on ``a`` as ``-f`` and on ``b`` as ``+f``:
 
 - the point (a pin, a weld): ``C = p_a - p_b`` (2 rows);
-- the angle (a weld): ``C = (theta_a - theta_b) - theta_0``, the bodies' relative turn since
-  the weld was made;
-- a motor (on a pin): ``C = (phi_a - phi_b) - h omega``, ``a``'s turn relative to ``b`` over
-  the substep against the motor's; its force (a torque) is bounded by ``max_torque``;
+- the angle (a weld of rigid bodies): ``C = (theta_a - theta_b) - theta_0``, the bodies'
+  relative turn since the weld was made;
+- a motor (on a pin of rigid bodies): ``C = (phi_a - phi_b) - h omega``, ``a``'s turn relative
+  to ``b`` over the substep against the motor's; its force (a torque) is bounded by
+  ``max_torque``;
 - a spring is not a row but an energy: ``(k_s / 2) |C|^2`` and the damper's
   ``(c / 2h) |C - C_n|^2`` (backward Euler's dissipation of ``c |dC/dt|^2 / 2``), exact
   and stable at any stiffness.
 
-A block's share of each row enters its Newton step as ``J^T f`` and ``k J^T J`` with
+A rigid block's share of each row enters its Newton step as ``J^T f`` and ``k J^T J`` with
 ``J = +-[I | perp(R r)]``, and a turn's curvature as ``|f . R r|`` on the angle (the
 absolute value keeps the 3 x 3 system positive definite, as the paper's diagonal
-approximation of the geometric stiffness does). After each pass over the rigid blocks the
-rows take their dual step: ``lambda = k C + lambda`` (a motor's clamped to its bound) and
-``k += beta |C|`` up to ``k_max`` (a clamped motor's stays). Between steps ``lambda`` and ``k``
-are carried whole (:func:`start_joint_rows`), ``k`` no softer than the lighter body's
-``m / h^2``.
+approximation of the geometric stiffness does); a soft vertex's, with weight ``w``, as
+``+-w f`` and ``k w^2 I``. The rows of rigid bodies alone take their dual step after each
+pass over the rigid blocks: ``lambda = k C + lambda`` (a motor's clamped to its bound) and
+``k += beta |C|`` up to ``k_max`` (a clamped motor's stays); those with a soft side after
+each step, as the contact rows' (:func:`update_joint_rows`). Between steps ``lambda`` and
+``k`` are carried whole (:func:`start_joint_rows`), ``k`` no softer than the softer side's
+start: a rigid block's ``m / h^2``, a soft side's its vertices' contact rows start at (their
+inertia and their elements' stiffness, summed over the triangle).
 
-Arrays of :class:`JointRows` per joint ``j``: ``block`` (J, 2) the blocks (``-1``: the world),
-``fv`` (J, 4) the two frame vertices of ``a`` then of ``b`` (``-1`` for the world), ``fw``
-(J, 4) their ``(alpha, beta)`` (for the world, ``b``'s point), ``kind`` (J,)
-(:data:`~deforma.physics.rigid.joints.KINDS`), ``param`` (J, 5) the reference angle of the
-frames ``theta_a - theta_b`` (rad), the motor's speed (rad/s) and torque bound (N m),
-spring stiffness (N/m) and damping (N s/m), ``motor`` (J,), ``lam`` and ``pen`` (J, 4) the
-rows' multipliers and penalties (x, y, angle, motor), and per substep ``arm`` (J, 4) the
-arms (for the world, its point), ``err0`` (J, 3) the point's and angle's error at the
-start, ``total`` (J, 3) the force and torque on ``a`` times the time so far (N s, N m s);
-``j_start`` (K + 1,) and ``j_entry`` (2 J,) list each block's joints as ``2 j + side``;
-``island`` (K,) labels the blocks joints hold together, and ``island_ok``, ``island_touch``
-(K,) say per island whether it takes BDF2 and whether it has a contact row or grab this
-substep (:func:`~deforma.physics.integrators.avbd.rigid.rigid_second_order`).
+Arrays of :class:`JointRows` per joint ``j``: ``block`` (J, 2) the rigid blocks (``-1``: a
+soft body or the world), ``fv`` (J, 6) per side three vertices (global indices): a rigid
+block's two frame vertices (and -1), a soft side's triangle, or -1 for the world; ``fw``
+(J, 6) per side: the frame's ``(alpha, beta, 0)``, the triangle's weights, or the world's
+point ``(x, y, 0)``; ``kind`` (J,) (:data:`~deforma.physics.rigid.joints.KINDS`), ``param``
+(J, 6) the reference angle of the frames ``theta_a - theta_b`` (rad), the motor's speed
+(rad/s) and torque bound (N m), spring stiffness (N/m) and damping (N s/m), and the
+substep's ``h`` (s, set by :func:`start_joint_rows`), ``motor`` (J,), ``lam`` and ``pen``
+(J, 4) the rows' multipliers and penalties (x, y, angle, motor), ``soft`` (J,) whether a
+side is soft, and per substep ``arm`` (J, 4) the rigid sides' arms, ``err0`` (J, 3) the point's and angle's
+error at the start, ``point`` (J, 4) the rigid sides' points now (kept by the passes over
+the rigid blocks, for the soft vertices' blocks), ``total`` (J, 3) the force and torque on
+``a`` times the time so far (N s, N m s); ``j_start`` (K + 1,) and ``j_entry`` (2 J,) list
+each rigid block's joints as ``2 j + side``, ``v_start`` (N + 1,) and ``v_entry`` each soft
+vertex's as ``6 j + 3 side + slot``; ``island`` (K,) labels the blocks joints hold together,
+and ``island_ok``, ``island_touch`` (K,) say per island whether it takes BDF2 and whether it
+has a contact row, grab or soft joint this substep
+(:func:`~deforma.physics.integrators.avbd.rigid.rigid_second_order`).
 
 Units: m, kg, s, rad; N, N/m, N m.
 """
@@ -54,28 +71,48 @@ from numba import njit
 
 from ...rigid.joints import SPRING, WELD
 
-JointRows = namedtuple("JointRows", ["block", "fv", "fw", "kind", "param", "motor", "lam", "pen", "arm", "err0",
-                                     "total", "j_start", "j_entry", "island", "island_ok", "island_touch"])
+JointRows = namedtuple("JointRows", ["block", "fv", "fw", "kind", "param", "motor", "lam", "pen", "soft", "arm",
+                                     "err0", "point", "total", "j_start", "j_entry", "v_start", "v_entry", "island",
+                                     "island_ok", "island_touch"])
+
+#: Which joints :func:`update_joint_rows` steps: those of rigid bodies and the world alone,
+#: or those with a soft side.
+RIGID_JOINTS, SOFT_JOINTS = 0, 1
 
 
-def make_joint_rows(block, fv, fw, kind, param, motor, lam, pen, n_blocks: int) -> JointRows:
+def _incidence(owner, n_owners, codes):
+    """``(start (n_owners + 1,), entry)``: for each owner the codes listed with it."""
+    owner = np.asarray(owner, np.int64)
+    codes = np.asarray(codes, np.int64)
+    order = np.argsort(owner, kind="stable")
+    start = np.zeros(n_owners + 1, np.int64)
+    np.add.at(start, owner + 1, 1)
+    entry = codes[order] if len(codes) else np.zeros(1, np.int64)
+    return np.cumsum(start), entry
+
+
+def make_joint_rows(block, fv, fw, kind, param, motor, lam, pen, n_blocks: int, n_vertices: int) -> JointRows:
     """:class:`JointRows` from the packed arrays (``lam``, ``pen``: the warm start), with
-    each block's joints listed."""
+    each rigid block's and each soft vertex's joints listed."""
+    block, fv = np.asarray(block, np.int64), np.asarray(fv, np.int64)
     n = len(kind)
-    j_start = np.zeros(n_blocks + 1, np.int64)
+    owners, codes = [], []
     for j in range(n):
         for side in range(2):
             if block[j, side] >= 0:
-                j_start[block[j, side] + 1] += 1
-    j_start = np.cumsum(j_start)
-    fill = j_start[:-1].copy()
-    j_entry = np.zeros(max(int(j_start[-1]), 1), np.int64)
+                owners.append(block[j, side])
+                codes.append(2 * j + side)
+    j_start, j_entry = _incidence(owners, n_blocks, codes)
+    owners, codes = [], []
+    soft = np.zeros(n, np.bool_)
     for j in range(n):
         for side in range(2):
-            k = block[j, side]
-            if k >= 0:
-                j_entry[fill[k]] = 2 * j + side
-                fill[k] += 1
+            if block[j, side] < 0 and fv[j, 3 * side] >= 0:
+                soft[j] = True
+                for slot in range(3):
+                    owners.append(fv[j, 3 * side + slot])
+                    codes.append(6 * j + 3 * side + slot)
+    v_start, v_entry = _incidence(owners, n_vertices, codes)
     # the islands: blocks joints hold together (through other blocks)
     island = np.arange(n_blocks)
 
@@ -88,11 +125,19 @@ def make_joint_rows(block, fv, fw, kind, param, motor, lam, pen, n_blocks: int) 
         if block[j, 0] >= 0 and block[j, 1] >= 0:
             island[root(block[j, 0])] = root(block[j, 1])
     island = np.array([root(k) for k in range(n_blocks)], np.int64)
-    return JointRows(np.asarray(block, np.int64), np.asarray(fv, np.int64), np.asarray(fw, np.float64),
-                     np.asarray(kind, np.int64), np.asarray(param, np.float64), np.asarray(motor, np.bool_),
-                     np.asarray(lam, np.float64), np.asarray(pen, np.float64), np.zeros((n, 4)), np.zeros((n, 3)),
-                     np.zeros((n, 3)), j_start, j_entry, island, np.zeros(n_blocks, np.bool_),
-                     np.zeros(n_blocks, np.bool_))
+    return JointRows(block, fv, np.asarray(fw, np.float64), np.asarray(kind, np.int64),
+                     np.asarray(param, np.float64), np.asarray(motor, np.bool_), np.asarray(lam, np.float64),
+                     np.asarray(pen, np.float64), soft, np.zeros((n, 4)),
+                     np.zeros((n, 3)), np.zeros((n, 4)), np.zeros((n, 3)), j_start, j_entry, v_start, v_entry,
+                     island, np.zeros(n_blocks, np.bool_), np.zeros(n_blocks, np.bool_))
+
+
+def no_joint_rows(n_blocks: int, n_vertices: int) -> JointRows:
+    """:class:`JointRows` without joints."""
+    z = np.zeros((0, 4))
+    return make_joint_rows(np.zeros((0, 2), np.int64), np.zeros((0, 6), np.int64), np.zeros((0, 6)),
+                           np.zeros(0, np.int64), np.zeros((0, 6)), np.zeros(0, np.bool_), z, z, n_blocks,
+                           n_vertices)
 
 
 @njit(cache=True, inline="always")
@@ -103,49 +148,136 @@ def frame_point(x, i0, i1, alpha, beta):
     return x[i0, 0] + alpha * dx - beta * dy, x[i0, 1] + alpha * dy + beta * dx, np.arctan2(dy, dx)
 
 
-@njit(cache=True)
-def start_joint_rows(x_n, blocks, jr, k_floor):
-    """Start a substep: each joint's arms from its blocks' centres ``blocks.c_n``, its errors
-    there, and its rows warm-started: ``lambda`` and ``k`` as the last substep left them, ``k``
-    at least ``k_floor`` times the lighter body's mass (``penalty_start / h^2``).
-    ``jr.total`` is kept (the step's sum).
+@njit(cache=True, inline="always")
+def held_point(x, block, fv, fw, point, j, side):
+    """Side ``side`` of joint ``j`` where it is now, for a soft vertex's block: a rigid side
+    at its kept ``point``, a soft side by its triangle's weights, the world's where it is."""
+    if block[j, side] >= 0:
+        return point[j, 2 * side], point[j, 2 * side + 1]
+    b = 3 * side
+    if fv[j, b] < 0:
+        return fw[j, b], fw[j, b + 1]
+    px = py = 0.0
+    for s in range(3):
+        i, w = fv[j, b + s], fw[j, b + s]
+        px += w * x[i, 0]
+        py += w * x[i, 1]
+    return px, py
 
-    Unlike the contact rows' (``lambda * 0.98``, ``k * 0.99``), a joint's rows are carried
-    whole: a joint holds for good, and its load changes smoothly. Decayed, the multipliers of
-    a chain of 20 equal links hanging still fell short of its weight every step, and with the
-    chain on BDF2 throughout it swung up to 0.12 m/s; carried whole it hung at 1e-10 m/s
-    (with :func:`~deforma.physics.integrators.avbd.rigid.rigid_second_order`'s switching it
-    sways at up to 2 mm/s)."""
+
+@njit(cache=True, inline="always")
+def point_force(kind, param, lam, pen, err0, j, cx, cy):
+    """The point rows' force ``(fx, fy)`` (N) and stiffness (N/m) at the error ``(cx, cy)``:
+    ``k C + lambda``, or a spring's gradient."""
+    if kind[j] == SPRING:
+        damp = param[j, 4] / param[j, 5]
+        kp = param[j, 3] + damp
+        return kp * cx - damp * err0[j, 0], kp * cy - damp * err0[j, 1], kp
+    kp = pen[j, 0]
+    return kp * cx + lam[j, 0], kp * cy + lam[j, 1], kp
+
+
+@njit(cache=True, inline="always")
+def joint_point_energy(kind, param, lam, pen, err0, j, cx, cy):
+    """The point rows' energy (J) at the error ``(cx, cy)``, up to a constant: ``|k C +
+    lambda|^2 / 2k``, or a spring's own."""
+    if kind[j] == SPRING:
+        damp = param[j, 4] / param[j, 5]
+        return 0.5 * param[j, 3] * (cx * cx + cy * cy) + 0.5 * damp * ((cx - err0[j, 0]) ** 2
+                                                                        + (cy - err0[j, 1]) ** 2)
+    kp = pen[j, 0]
+    if not kp > 0.0:
+        return 0.0
+    fx, fy = kp * cx + lam[j, 0], kp * cy + lam[j, 1]
+    return 0.5 * (fx * fx + fy * fy) / kp
+
+
+@njit(cache=True, inline="always")
+def joint_vertex_block(x, i, v_start, v_entry, block, fv, fw, kind, param, lam, pen, err0, point):
+    """Soft vertex ``i``'s share of its joints' point rows: ``(gx, gy, hxx, hxy, hyy)``."""
+    gx = gy = hh = 0.0
+    for p in range(v_start[i], v_start[i + 1]):
+        e = v_entry[p]
+        j, side, slot = e // 6, (e // 3) % 2, e % 3
+        pax, pay = held_point(x, block, fv, fw, point, j, 0)
+        pbx, pby = held_point(x, block, fv, fw, point, j, 1)
+        fx, fy, kp = point_force(kind, param, lam, pen, err0, j, pax - pbx, pay - pby)
+        w = fw[j, 3 * side + slot]
+        sw = w if side == 0 else -w
+        gx += sw * fx
+        gy += sw * fy
+        hh += kp * w * w
+    return gx, gy, hh, 0.0, hh
+
+
+@njit(cache=True)
+def start_joint_rows(x_n, blocks, jr, k_floor, vertex_mass, inv_mass, carry, soften, h):
+    """Start a substep of ``h`` s: each rigid side's arm from its block's centre
+    ``blocks.c_n`` and its point at the block's starting pose, each joint's errors at the
+    start, and its rows warm-started, ``k`` at least the softer side's inertia: a rigid
+    block's mass times ``k_floor`` (``penalty_start / h^2``), a soft side's its free
+    vertices' masses ``vertex_mass`` summed. ``jr.total`` is kept (the step's sum).
+
+    A joint of rigid bodies alone carries ``lambda`` and ``k`` whole: a joint holds for good,
+    and its load changes smoothly. Decayed, the multipliers of a chain of 20 equal links
+    hanging still fell short of its weight every step, and with the chain on BDF2 throughout
+    it swung up to 0.12 m/s; carried whole it hung at 1e-10 m/s (with
+    :func:`~deforma.physics.integrators.avbd.rigid.rigid_second_order`'s switching it sways
+    at up to 2 mm/s). A joint with a soft side decays them as the contact rows do
+    (``lambda * carry``, ``k * soften``), and starts no stiffer than the inertia: two soft
+    links hinged end to end swung with 7-9 J more energy than they began with where the
+    rows started as stiff as the elements around them, and blew up where ``k`` grew without
+    decay; with both they settle, their pin 30 micrometres apart."""
     for j in range(jr.kind.shape[0]):
-        ka, kb = jr.block[j, 0], jr.block[j, 1]
-        pax, pay, tha = frame_point(x_n, jr.fv[j, 0], jr.fv[j, 1], jr.fw[j, 0], jr.fw[j, 1])
-        jr.arm[j, 0], jr.arm[j, 1] = pax - blocks.c_n[ka, 0], pay - blocks.c_n[ka, 1]
-        floor = blocks.mass[ka]
-        if kb >= 0:
-            pbx, pby, thb = frame_point(x_n, jr.fv[j, 2], jr.fv[j, 3], jr.fw[j, 2], jr.fw[j, 3])
-            jr.arm[j, 2], jr.arm[j, 3] = pbx - blocks.c_n[kb, 0], pby - blocks.c_n[kb, 1]
-            if not blocks.held[kb]:
-                floor = min(floor, blocks.mass[kb])
-        else:
-            pbx, pby, thb = jr.fw[j, 2], jr.fw[j, 3], 0.0
-            jr.arm[j, 2], jr.arm[j, 3] = pbx, pby
-        jr.err0[j, 0], jr.err0[j, 1] = pax - pbx, pay - pby
-        turn = tha - thb - jr.param[j, 0]
+        jr.param[j, 5] = h
+        floor = np.inf
+        ph = np.zeros(2)
+        pts = np.zeros(4)
+        for side in range(2):
+            kb = jr.block[j, side]
+            b = 3 * side
+            if kb >= 0:
+                px, py, ph[side] = frame_point(x_n, jr.fv[j, b], jr.fv[j, b + 1], jr.fw[j, b], jr.fw[j, b + 1])
+                rx, ry = px - blocks.c_n[kb, 0], py - blocks.c_n[kb, 1]
+                jr.arm[j, 2 * side], jr.arm[j, 2 * side + 1] = rx, ry
+                if not blocks.held[kb]:
+                    floor = min(floor, blocks.mass[kb])
+                # where the block starts the substep
+                co, si = np.cos(blocks.pose[kb, 2]), np.sin(blocks.pose[kb, 2])
+                jr.point[j, 2 * side] = blocks.pose[kb, 0] + co * rx - si * ry
+                jr.point[j, 2 * side + 1] = blocks.pose[kb, 1] + si * rx + co * ry
+            else:
+                px, py = held_point(x_n, jr.block, jr.fv, jr.fw, jr.point, j, side)
+                if jr.fv[j, b] >= 0:
+                    k_side = 0.0
+                    for slot in range(3):
+                        i = jr.fv[j, b + slot]
+                        if inv_mass[i] != 0.0:
+                            k_side += vertex_mass[i]
+                    if k_side > 0.0:
+                        floor = min(floor, k_side)
+            pts[2 * side], pts[2 * side + 1] = px, py
+        jr.err0[j, 0], jr.err0[j, 1] = pts[0] - pts[2], pts[1] - pts[3]
+        turn = ph[0] - ph[1] - jr.param[j, 0]
         jr.err0[j, 2] = np.arctan2(np.sin(turn), np.cos(turn))  # wrapped to (-pi, pi]
-        k0 = k_floor * floor
+        k0 = k_floor * floor if floor < np.inf else 0.0
         for r in range(4):
+            if jr.soft[j]:
+                jr.lam[j, r] *= carry
+                jr.pen[j, r] *= soften
             jr.pen[j, r] = max(k0, jr.pen[j, r])
 
 
 @njit(cache=True, inline="always")
-def _side(jr, blocks, j, side, k, cx, cy, phi):
-    """Side ``side`` of joint ``j``: its point and its arm ``R(phi) r`` now, with block ``k``
-    at the pose ``(cx, cy, phi)`` and any other block at its own pose (the world's point
-    where it is)."""
+def _side(jr, blocks, x, j, side, k, cx, cy, phi):
+    """Side ``side`` of joint ``j``: its point, its arm ``R(phi) r`` and its block's turn
+    now, with block ``k`` at the pose ``(cx, cy, phi)`` and any other block at its own pose
+    (a soft side where its triangle is, the world's point where it is; no arm, no turn)."""
     kb = jr.block[j, side]
-    rx0, ry0 = jr.arm[j, 2 * side], jr.arm[j, 2 * side + 1]
     if kb < 0:
-        return rx0, ry0, 0.0, 0.0, 0.0
+        px, py = held_point(x, jr.block, jr.fv, jr.fw, jr.point, j, side)
+        return px, py, 0.0, 0.0, 0.0
+    rx0, ry0 = jr.arm[j, 2 * side], jr.arm[j, 2 * side + 1]
     if kb == k:
         px, py, ph = cx, cy, phi
     else:
@@ -157,32 +289,23 @@ def _side(jr, blocks, j, side, k, cx, cy, phi):
 
 
 @njit(cache=True, inline="always")
-def _rows(jr, blocks, j, k, cx, cy, phi, h):
-    """Joint ``j``'s constraints with block ``k`` at ``(cx, cy, phi)``: the point's ``C``,
-    the forces ``f`` of its point, angle and motor rows, their stiffnesses, whether the
-    motor is clamped, and the arms of both sides."""
-    pax, pay, rax, ray, pha = _side(jr, blocks, j, 0, k, cx, cy, phi)
-    pbx, pby, rbx, rby, phb = _side(jr, blocks, j, 1, k, cx, cy, phi)
+def _rows(jr, blocks, x, j, k, cx, cy, phi):
+    """Joint ``j``'s constraints with block ``k`` at ``(cx, cy, phi)`` (``k = -1``: every
+    block at its pose): the point's ``C``, the forces ``f`` of its point, angle and motor
+    rows, their stiffnesses, whether the motor is clamped, and the arms of both sides."""
+    pax, pay, rax, ray, pha = _side(jr, blocks, x, j, 0, k, cx, cy, phi)
+    pbx, pby, rbx, rby, phb = _side(jr, blocks, x, j, 1, k, cx, cy, phi)
     cx_, cy_ = pax - pbx, pay - pby
-    kind = jr.kind[j]
-    if kind == SPRING:
-        stiff, damp = jr.param[j, 3], jr.param[j, 4]
-        kp = stiff + damp / h
-        fx = kp * cx_ - damp / h * jr.err0[j, 0]
-        fy = kp * cy_ - damp / h * jr.err0[j, 1]
-    else:
-        kp = jr.pen[j, 0]
-        fx = kp * cx_ + jr.lam[j, 0]
-        fy = kp * cy_ + jr.lam[j, 1]
+    fx, fy, kp = point_force(jr.kind, jr.param, jr.lam, jr.pen, jr.err0, j, cx_, cy_)
     fa = ka_ = 0.0
-    if kind == WELD:
+    if jr.kind[j] == WELD:
         ka_ = jr.pen[j, 2]
         fa = ka_ * (jr.err0[j, 2] + pha - phb) + jr.lam[j, 2]
     fm = km = 0.0
     clamped = False
     if jr.motor[j]:
         km = jr.pen[j, 3]
-        fm = km * (pha - phb - h * jr.param[j, 1]) + jr.lam[j, 3]
+        fm = km * (pha - phb - jr.param[j, 5] * jr.param[j, 1]) + jr.lam[j, 3]
         bound = jr.param[j, 2]
         if abs(fm) > bound:
             fm = bound if fm > 0.0 else -bound
@@ -191,12 +314,12 @@ def _rows(jr, blocks, j, k, cx, cy, phi, h):
 
 
 @njit(cache=True)
-def joint_block(jr, blocks, k, cx, cy, phi, h, acc):
-    """Add block ``k``'s joints at the pose ``(cx, cy, phi)`` to its gradient and Hessian
-    ``acc`` (g0, g1, g2, a00, a01, a02, a11, a12, a22; see the module docstring)."""
+def joint_block(jr, blocks, x, k, cx, cy, phi, acc):
+    """Add rigid block ``k``'s joints at the pose ``(cx, cy, phi)`` to its gradient and
+    Hessian ``acc`` (g0, g1, g2, a00, a01, a02, a11, a12, a22; see the module docstring)."""
     for p in range(jr.j_start[k], jr.j_start[k + 1]):
         j, side = jr.j_entry[p] // 2, jr.j_entry[p] % 2
-        _, _, fx, fy, kp, fa, ka_, fm, km, clamped, rax, ray, rbx, rby = _rows(jr, blocks, j, k, cx, cy, phi, h)
+        _, _, fx, fy, kp, fa, ka_, fm, km, clamped, rax, ray, rbx, rby = _rows(jr, blocks, x, j, k, cx, cy, phi)
         sg = 1.0 if side == 0 else -1.0
         rx, ry = (rax, ray) if side == 0 else (rbx, rby)
         acc[0] += sg * fx
@@ -210,31 +333,39 @@ def joint_block(jr, blocks, k, cx, cy, phi, h, acc):
         acc[8] += kp * (rx * rx + ry * ry) + abs(fx * rx) + abs(fy * ry) + ka_ + (0.0 if clamped else km)
 
 
+@njit(cache=True)
+def carry_joint_points(jr, blocks, k):
+    """Rigid block ``k`` took a new pose: its sides' points where it holds them now
+    (``jr.point``, what the soft vertices' blocks read)."""
+    p = blocks.pose
+    co, si = np.cos(p[k, 2]), np.sin(p[k, 2])
+    for q in range(jr.j_start[k], jr.j_start[k + 1]):
+        j, side = jr.j_entry[q] // 2, jr.j_entry[q] % 2
+        rx0, ry0 = jr.arm[j, 2 * side], jr.arm[j, 2 * side + 1]
+        jr.point[j, 2 * side] = p[k, 0] + co * rx0 - si * ry0
+        jr.point[j, 2 * side + 1] = p[k, 1] + si * rx0 + co * ry0
+
+
 @njit(cache=True, inline="always")
 def _energy(f, k):
     return 0.5 * f * f / k if k > 0.0 else 0.0
 
 
 @njit(cache=True)
-def joint_energy(jr, blocks, k, cx, cy, phi, h):
-    """Block ``k``'s joints' energy (J) with it at the pose ``(cx, cy, phi)``, up to a
+def joint_energy(jr, blocks, x, k, cx, cy, phi):
+    """Rigid block ``k``'s joints' energy (J) with it at the pose ``(cx, cy, phi)``, up to a
     constant: ``f^2 / 2k`` per row (``lambda C + k C^2 / 2`` and ``lambda^2 / 2k``), a
     clamped motor's continued linearly; a spring's own."""
     e = 0.0
     for p in range(jr.j_start[k], jr.j_start[k + 1]):
         j = jr.j_entry[p] // 2
-        cx_, cy_, fx, fy, kp, fa, ka_, fm, km, clamped, _, _, _, _ = _rows(jr, blocks, j, k, cx, cy, phi, h)
-        if jr.kind[j] == SPRING:
-            damp = jr.param[j, 4] / h
-            e += 0.5 * jr.param[j, 3] * (cx_ * cx_ + cy_ * cy_) + 0.5 * damp * (
-                (cx_ - jr.err0[j, 0]) ** 2 + (cy_ - jr.err0[j, 1]) ** 2)
-        else:
-            e += _energy(fx, kp) + _energy(fy, kp)
+        cx_, cy_, fx, fy, kp, fa, ka_, fm, km, clamped, _, _, _, _ = _rows(jr, blocks, x, j, k, cx, cy, phi)
+        e += joint_point_energy(jr.kind, jr.param, jr.lam, jr.pen, jr.err0, j, cx_, cy_)
         e += _energy(fa, ka_)
         if jr.motor[j]:
             if clamped:
                 # the unclamped force, continued linearly past the bound
-                u = km * (_rows_turn(jr, blocks, j, k, phi) - h * jr.param[j, 1]) + jr.lam[j, 3]
+                u = km * (_rows_turn(jr, blocks, j, k, phi) - jr.param[j, 5] * jr.param[j, 1]) + jr.lam[j, 3]
                 bound = jr.param[j, 2]
                 e += 0.5 * bound * bound / km + bound * (abs(u) - bound) / km
             else:
@@ -256,38 +387,36 @@ def _rows_turn(jr, blocks, j, k, phi):
 
 
 @njit(cache=True)
-def update_joint_rows(jr, blocks, beta, k_max, h):
-    """The joints' dual step at the blocks' poses (see the module docstring)."""
+def update_joint_rows(jr, blocks, x, beta, k_max, which):
+    """The dual step of the joints ``which`` (:data:`RIGID_JOINTS` or :data:`SOFT_JOINTS`)
+    at the blocks' poses and the vertices' positions (see the module docstring)."""
     for j in range(jr.kind.shape[0]):
-        ka = jr.block[j, 0]
-        p = blocks.pose
-        cx_, cy_, fx, fy, kp, fa, ka_, fm, km, clamped, _, _, _, _ = _rows(jr, blocks, j, ka, p[ka, 0], p[ka, 1],
-                                                                          p[ka, 2], h)
+        if jr.soft[j] != (which == SOFT_JOINTS):
+            continue
+        cx_, cy_, fx, fy, kp, fa, ka_, fm, km, clamped, _, _, _, _ = _rows(jr, blocks, x, j, -1, 0.0, 0.0, 0.0)
         kind = jr.kind[j]
         if kind != SPRING:
             jr.lam[j, 0], jr.lam[j, 1] = fx, fy
             jr.pen[j, 0] = min(k_max, kp + beta * np.sqrt(cx_ * cx_ + cy_ * cy_))
-        turn = _rows_turn(jr, blocks, j, ka, p[ka, 2])
+        turn = _rows_turn(jr, blocks, j, -1, 0.0)
         if kind == WELD:
             jr.lam[j, 2] = fa
             jr.pen[j, 2] = min(k_max, ka_ + beta * abs(jr.err0[j, 2] + turn))
         if jr.motor[j]:
-            turn -= h * jr.param[j, 1]
+            turn -= jr.param[j, 5] * jr.param[j, 1]
             jr.lam[j, 3] = fm
             if not clamped:
                 jr.pen[j, 3] = min(k_max, km + beta * abs(turn))
 
 
 @njit(cache=True)
-def joint_totals(jr, blocks, h):
+def joint_totals(jr, blocks, x, h):
     """Add each joint's force and torque on ``a`` over the substep of ``h`` s to ``jr.total``
     (N s, N m s): after the last dual step, a row's force is its multiplier (a spring's is
     its energy's gradient at the blocks' poses)."""
     for j in range(jr.kind.shape[0]):
         if jr.kind[j] == SPRING:
-            ka = jr.block[j, 0]
-            p = blocks.pose
-            _, _, fx, fy, _, _, _, _, _, _, _, _, _, _ = _rows(jr, blocks, j, ka, p[ka, 0], p[ka, 1], p[ka, 2], h)
+            _, _, fx, fy, _, _, _, _, _, _, _, _, _, _ = _rows(jr, blocks, x, j, -1, 0.0, 0.0, 0.0)
         else:
             fx, fy = jr.lam[j, 0], jr.lam[j, 1]
         jr.total[j, 0] -= h * fx
@@ -296,15 +425,14 @@ def joint_totals(jr, blocks, h):
 
 
 @njit(cache=True)
-def joint_gap(jr, blocks, h):
+def joint_gap(jr, blocks, x):
     """The widest a pin's or weld's points are apart at the blocks' poses (m), over the
-    islands without contacts (``jr.island_touch``)."""
+    joints of rigid bodies alone in islands without contacts (``jr.island_touch``)."""
     most = 0.0
     for j in range(jr.kind.shape[0]):
         ka = jr.block[j, 0]
-        if jr.kind[j] == SPRING or jr.island_touch[jr.island[ka]]:
+        if jr.kind[j] == SPRING or jr.soft[j] or ka < 0 or jr.island_touch[jr.island[ka]]:
             continue
-        p = blocks.pose
-        cx_, cy_, _, _, _, _, _, _, _, _, _, _, _, _ = _rows(jr, blocks, j, ka, p[ka, 0], p[ka, 1], p[ka, 2], h)
+        cx_, cy_, _, _, _, _, _, _, _, _, _, _, _, _ = _rows(jr, blocks, x, j, -1, 0.0, 0.0, 0.0)
         most = max(most, np.sqrt(cx_ * cx_ + cy_ * cy_))
     return most

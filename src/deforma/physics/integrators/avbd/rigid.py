@@ -41,7 +41,16 @@ from numba import njit
 from ...colliders.response import CORNER_NX, CORNER_NY, CORNER_S
 from .blocks import outer_block
 from ...rigid.joints import SPRING, WELD
-from .joints import joint_block, joint_energy, update_joint_rows
+from .joints import (
+    RIGID_JOINTS,
+    carry_joint_points,
+    held_point,
+    joint_block,
+    joint_energy,
+    joint_point_energy,
+    point_force,
+    update_joint_rows,
+)
 from .rows import (
     BOUND,
     K_N,
@@ -91,16 +100,21 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
     J_i^T H_i J_i`` (``J_i = [I | perp(r_i)]``) cost one pass over the vertices, and one
     Newton step solves the rigid modes as well as the iterate allows. Without outside
     forces it makes ``sum m (x - y) = 0``: the step keeps the body's momentum. A body with a
-    pinned vertex does not move as a whole."""
+    pinned vertex does not move as a whole. Its joints take part as rows on a point of the
+    body (their triangles move with it; their other sides stay): without them, a soft link
+    hinged to another hung from its three joint vertices while the sweeps carried its weight
+    to them ring by ring, and the multipliers, driven by what that left, flailed the links."""
     verts = np.arange(x.shape[0])
     for body in range(body_start.shape[0] - 1):
         lo, hi = body_start[body], body_start[body + 1]
         sm = cx = cy = 0.0
         pinned = False
+        joined = False
         for i in range(lo, hi):
             if inv_mass[i] == 0.0:
                 pinned = True
                 break
+            joined = joined or rs.jv_start[i + 1] > rs.jv_start[i]
             m = mass_h2[i]
             sm += m
             cx += m * x[i, 0]
@@ -134,6 +148,28 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
             a02 += -hxx * ry + hxy * rx
             a12 += -hxy * ry + hyy * rx
             a22 += hxx * ry * ry - 2.0 * hxy * rx * ry + hyy * rx * rx
+        if joined:
+            # its joints' point rows, each as a point of the body: J = [I | perp(p - c)]
+            for i in range(lo, hi):
+                for p in range(rs.jv_start[i], rs.jv_start[i + 1]):
+                    code = rs.jv_entry[p]
+                    if code % 3:
+                        continue
+                    j, side = code // 6, (code // 3) % 2
+                    pax, pay = held_point(x, rs.jblock, rs.jfv, rs.jfw, rs.jpoint, j, 0)
+                    pbx, pby = held_point(x, rs.jblock, rs.jfv, rs.jfw, rs.jpoint, j, 1)
+                    fx, fy, kp = point_force(rs.jkind, rs.jparam, rs.jlam, rs.jpen, rs.jerr0, j, pax - pbx,
+                                             pay - pby)
+                    sg = 1.0 if side == 0 else -1.0
+                    rx, ry = (pax - cx, pay - cy) if side == 0 else (pbx - cx, pby - cy)
+                    g0 += sg * fx
+                    g1 += sg * fy
+                    g2 += sg * (rx * fy - ry * fx)
+                    a00 += kp
+                    a11 += kp
+                    a02 += -kp * ry
+                    a12 += kp * rx
+                    a22 += kp * (rx * rx + ry * ry) + abs(fx * rx) + abs(fy * ry)
         # solve the 3 x 3 system A d = -g (symmetric positive definite: A includes sum m / h^2)
         ok, dx, dy, th = newton_step3(a00, a01, a02, a11, a12, a22, g0, g1, g2)
         if not ok:
@@ -226,6 +262,21 @@ def rigid_energy(x, x_n, y, mass_h2, verts, p0, p1, lo, hi, grab_slot, grab_pull
             fn, ft, _, _, _ = corner_row_forces_at(pax, pay, pbx, pby, x_n[ia, 0], x_n[ia, 1], x_n[ib, 0], x_n[ib, 1],
                                                    rs.cf, st, c)
             e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
+        # a soft body's joints, each side once (at its triangle's first vertex)
+        for p in range(rs.jv_start[i], rs.jv_start[i + 1]):
+            code = rs.jv_entry[p]
+            if code % 3:
+                continue
+            j, side = code // 6, (code // 3) % 2
+            px_, py_ = 0.0, 0.0
+            for slot in range(3):
+                vx, vy = _moved(x, rs.jfv[j, 3 * side + slot], lo, hi, cx, cy, dx, dy, co, si)
+                px_ += rs.jfw[j, 3 * side + slot] * vx
+                py_ += rs.jfw[j, 3 * side + slot] * vy
+            ox, oy = held_point(x, rs.jblock, rs.jfv, rs.jfw, rs.jpoint, j, 1 - side)
+            sg = 1.0 if side == 0 else -1.0
+            e += joint_point_energy(rs.jkind, rs.jparam, rs.jlam, rs.jpen, rs.jerr0, j, sg * (px_ - ox),
+                                    sg * (py_ - oy))
     return e
 
 
@@ -490,7 +541,7 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_o
         block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc)
         joined = jr.j_start[k + 1] > jr.j_start[k]
         if joined:
-            joint_block(jr, blocks, k, cx, cy, phi, h, acc)
+            joint_block(jr, blocks, x, k, cx, cy, phi, acc)
         g0 += acc[0]
         g1 += acc[1]
         g2 += acc[2]
@@ -506,13 +557,13 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_o
             e0 = _inertia_energy(blocks, k, cx, cy, phi, inv_h2) + rigid_energy(
                 x, x_n, x_n, zeros, act, p0, p1, a, b, grab_slot, grab_pull, rs, cx, cy, 0.0, 0.0, 0.0)
             if joined:
-                e0 += joint_energy(jr, blocks, k, cx, cy, phi, h)
+                e0 += joint_energy(jr, blocks, x, k, cx, cy, phi)
             while step > 1e-3:
                 e1 = _inertia_energy(blocks, k, cx + step * dx, cy + step * dy, phi + step * th, inv_h2) + rigid_energy(
                     x, x_n, x_n, zeros, act, p0, p1, a, b, grab_slot, grab_pull, rs, cx, cy, step * dx, step * dy,
                     step * th)
                 if joined:
-                    e1 += joint_energy(jr, blocks, k, cx + step * dx, cy + step * dy, phi + step * th, h)
+                    e1 += joint_energy(jr, blocks, x, k, cx + step * dx, cy + step * dy, phi + step * th)
                 if e1 <= e0 + 1e-4 * step * slope + 1e-12 * abs(e0):  # (a step too small to measure is taken)
                     break
                 step *= 0.5
@@ -520,6 +571,8 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_o
                 continue
         p[k, 0], p[k, 1], p[k, 2] = cx + step * dx, cy + step * dy, phi + step * th
         _place_listed(x, x_n, act, p0, p1, blocks.c_n[k, 0], blocks.c_n[k, 1], p[k, 0], p[k, 1], p[k, 2])
+        if joined:
+            carry_joint_points(jr, blocks, k)
         # the furthest a vertex moved: the centre's move plus the turn at the farthest vertex
         move = np.sqrt((step * dx) ** 2 + (step * dy) ** 2) + abs(step * th) * blocks.radius[k]
         most = max(most, move * move)
@@ -540,7 +593,7 @@ def rigid_pass(x, x_n, zeros, rigid, blocks, grab_slot, grab_pull, rs, jr, touch
     most = rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_only)
     if not last:
         update_rigid_rows(x, x_n, rigid, touch, planes, state, count, rs, n_body, n_corner, beta, k_max)
-        update_joint_rows(jr, blocks, beta, k_max, h)
+        update_joint_rows(jr, blocks, x, beta, k_max, RIGID_JOINTS)
     return most
 
 
@@ -574,6 +627,10 @@ def rigid_second_order(blocks, jr, keep, h):
         if blocks.held[k]:
             continue  # held as the world is: no part of its island's choice
         touched = blocks.act_start[k + 1] > blocks.act_start[k]
+        for p in range(jr.j_start[k], jr.j_start[k + 1]):
+            # a soft body's joint: its vertices are swept with the contact rows' (and no
+            # pass over the jointed blocks alone moves it)
+            touched = touched or jr.soft[jr.j_entry[p] // 2]
         if touched:
             jr.island_touch[jr.island[k]] = True
         ok = blocks.hist[k] == h and not touched
@@ -588,7 +645,7 @@ def rigid_second_order(blocks, jr, keep, h):
                 slack = abs(jr.err0[j, 0]) + abs(jr.err0[j, 1])
                 if jr.kind[j] == WELD:
                     slack += abs(jr.err0[j, 2]) * blocks.radius[k]
-                if jr.motor[j] or (jr.kind[j] != SPRING and slack > JOINT_SLACK):
+                if jr.motor[j] or jr.soft[j] or (jr.kind[j] != SPRING and slack > JOINT_SLACK):
                     ok = False
         if not ok:
             island_ok[jr.island[k]] = False

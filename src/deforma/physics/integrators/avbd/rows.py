@@ -50,6 +50,7 @@ from ...colliders.response import (
     CORNER_TARGET,
 )
 from ...contact.pairs import ContactImpulses
+from .joints import joint_vertex_block
 
 #: A step's contact rows as the sweeps read them: the collider rows (``vertex_row`` (N,),
 #: ``planes`` (N, 7), ``rows`` (N, ROW_COLUMNS)) and the body rows (their vertices ``bidx``
@@ -58,15 +59,21 @@ from ...contact.pairs import ContactImpulses
 #: vertex takes part in, ``b_start`` (N + 1,) and ``b_entry``) and the corner rows
 #: (:func:`~deforma.physics.colliders.response.corner_contacts`' ``cpairs`` and ``cf``, their
 #: state ``cstate`` and incidence ``c_start``, ``c_entry``), and which vertices hold a gas
-#: (``gas_start``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`'s ``start``), and
-#: whether each vertex takes part in any row or holds a gas (``rowed`` (N,) bool, :func:`mark_rowed`).
+#: (``gas_start``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`'s ``start``), the
+#: joints on soft bodies (``jv_start``, ``jv_entry`` and the ``j``-prefixed fields: the
+#: :class:`~deforma.physics.integrators.avbd.joints.JointRows`' ``v_start``, ``v_entry``,
+#: ``block``, ``fv``, ``fw``, ``kind``, ``param``, ``lam``, ``pen``, ``err0`` and ``point``),
+#: and whether each vertex takes part in any row, holds a gas or a joint (``rowed`` (N,)
+#: bool, :func:`mark_rowed`).
 #: Every field is an array, and kernels hand the set to a helper only for vertices with
 #: rows: Numba counts a reference to each of its arrays at every hand-over, 60 ns for these
 #: fields (170 ns when it nested the contact stage's topology and buffer), which made a
 #: vertex sweep of the README bunny's springs three times slower and its affine patches
 #: five times.
 RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "bidx", "bgeo", "bstate", "b_start", "b_entry",
-                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas_start", "rowed"])
+                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas_start", "jv_start", "jv_entry",
+                               "jblock", "jfv", "jfw", "jkind", "jparam", "jlam", "jpen", "jerr0", "jpoint",
+                               "rowed"])
 
 #: Columns of a step's body-row geometry ``bgeo`` (C, BODY_COLUMNS): where on the edge, the
 #: normal, the distance held, and the pair's dynamic and static friction.
@@ -565,16 +572,25 @@ def row_blocks(x, x_n, i, rs, whole):
         hxx += cxx
         hxy += cxy
         hyy += cyy
+    if not whole and rs.jv_start[i + 1] > rs.jv_start[i]:  # (the whole-body step takes the joints whole)
+        cgx, cgy, cxx, cxy, cyy = joint_vertex_block(x, i, rs.jv_start, rs.jv_entry, rs.jblock, rs.jfv, rs.jfw,
+                                                     rs.jkind, rs.jparam, rs.jlam, rs.jpen, rs.jerr0, rs.jpoint)
+        gx += cgx
+        gy += cgy
+        hxx += cxx
+        hxy += cxy
+        hyy += cyy
     return gx, gy, hxx, hxy, hyy
 
 
-def mark_rowed(vertex_row, b_start, c_start, gas_start, rowed):
+def mark_rowed(vertex_row, b_start, c_start, gas_start, jv_start, rowed):
     """Into ``rowed`` (N,) bool: whether each vertex takes part in any contact row this step,
-    or holds a gas."""
+    holds a gas or holds a soft body's joint."""
     np.greater_equal(vertex_row, 0, out=rowed)
     rowed |= b_start[1:] > b_start[:-1]
     rowed |= c_start[1:] > c_start[:-1]
     rowed |= gas_start[1:] > gas_start[:-1]
+    rowed |= jv_start[1:] > jv_start[:-1]
 
 
 @njit(cache=True)

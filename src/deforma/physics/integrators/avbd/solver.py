@@ -40,6 +40,8 @@ collider, and a vertex against an outline edge of another body or its own. Each 
 inside the sweep with Coulomb friction (:mod:`~deforma.physics.integrators.avbd.rows`),
 warm-started by its pair; the shared contact stage after the sweep stays as the fail-safe.
 Pins stay put (infinite mass); a grab is a zero-length spring of its strength to its target.
+Joints are rows too (:mod:`~deforma.physics.integrators.avbd.joints`): on a rigid body's
+block, or on a soft body's triangle, whose vertices take them with their contact rows.
 Each colour's vertices without contact rows are swept in parallel and those with rows after
 them one by one (:func:`_sweep`; option ``mode`` picks the build, measured by default): every
 build gives the same result bit for bit.
@@ -82,7 +84,15 @@ from .blocks import incidence, outer_block
 from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .gas import gas_areas, gas_block, gas_moved, gas_set
-from .joints import joint_gap, joint_totals, make_joint_rows, start_joint_rows, update_joint_rows
+from .joints import (
+    RIGID_JOINTS,
+    SOFT_JOINTS,
+    joint_gap,
+    joint_totals,
+    no_joint_rows,
+    start_joint_rows,
+    update_joint_rows,
+)
 from .rigid import (
     rigid_active,
     rigid_blocks,
@@ -519,6 +529,8 @@ class AVBD(Integrator):
     #: apart than JOINT_TOLERANCE (m), at most JOINT_PASSES
     JOINT_TOLERANCE = 1e-5
     JOINT_PASSES = 200
+    #: The fewest sweeps of a step with a joint on a soft body (see :meth:`_solve`).
+    SOFT_JOINT_SWEEPS = 20
 
     def __init__(self, **options):
         super().__init__(**options)
@@ -693,6 +705,7 @@ class AVBD(Integrator):
                 predict(x, v, self._x_n, self._y, self._v_last, self._has_last, inv_mass, gx, gy, keep,
                         control.force, control.has_force, hs)
                 blocks, body_mass = self._rigid_blocks(model)
+                jr = self._joint_rows(model, blocks)
                 if blocks is not None:
                     rigid_targets(x, v, self._x_n, self._y, model.vertex_mass, blocks, gx, gy, keep, control.force,
                                   control.has_force, hs)
@@ -724,6 +737,7 @@ class AVBD(Integrator):
                 if second and parts == 1 and self._history == hs:
                     np.copyto(self._held_before, self._held)
                     rows_held(self._held, self._touch, count, ctopo, found, n_body, self._cpairs, self._n_corner)
+                    self._held |= jr.v_start[1:] > jr.v_start[:-1]  # a joint's vertices: as a contact's
                     anchor = self._anchor
                     free = second_order_targets(x_n, self._y, self._v_n, self._x_prev, self._v_prev, self._x_end,
                                                 self._v_end, anchor, mass_h2, model.vertex_mass, inv_mass, self._held,
@@ -732,21 +746,22 @@ class AVBD(Integrator):
                     if free:
                         hd = 2.0 * hs / 3.0  # the damping's velocity, (x - anchor) / h'
                 if blocks is not None:
-                    start_joint_rows(x_n, blocks, self._joint_rows(model, blocks), opts["penalty_start"] / (hs * hs))
+                    start_joint_rows(x_n, blocks, jr, opts["penalty_start"] / (hs * hs), model.vertex_mass, inv_mass,
+                                     self.CARRY, self.SOFTEN, hs)
                 k_start = opts["penalty_start"] * (mass_h2 + self._stiffness(model, hd))
                 start_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows, k_start,
                            self.CARRY, self.SOFTEN, opts["penalty_max"], self._planes, v, hs)
-                rs = self._body_rows(model, ctopo, found, n_body, k_start, v)
+                rs = self._body_rows(model, ctopo, found, n_body, k_start, v, jr)
                 if blocks is not None:
                     rigid_active(blocks, rs.rowed, control.grab_slot)
-                    rigid_second_order(blocks, self._joint_rows(model, blocks), keep, hs)
+                    rigid_second_order(blocks, jr, keep, hs)
                     start_rigid_rows(model.rigid, opts["penalty_start"] * body_mass / (hs * hs), v, self._touch,
                                      self._planes, self._rows, count, rs, n_body, self._n_corner, hs)
                 self._solve(model, topo, control, x, anchor, mass_h2, inv_mass, count, n_body, rs, hd,
                             opts["tolerance"] * hs, hs)
                 if blocks is not None:
                     rigid_rates(blocks, hs)
-                    joint_totals(self._joint_rows(model, blocks), blocks, hs)
+                    joint_totals(jr, blocks, x, hs)
                 close_rows(self._touch, self._plane_rows, count, self._memory, self._vertex_row, self._rows)
                 close_body_rows(found, n_body, self._body_memory[0], rs.bstate)
                 close_corner_rows(self._cpairs, self._n_corner, self._corner_memory[0], self._cstate)
@@ -794,10 +809,11 @@ class AVBD(Integrator):
         (:func:`~deforma.physics.integrators.avbd.rigid.rigid_blocks`) and per vertex its rigid
         body's mass (kg), or ``(None, None)`` without rigid bodies; once per Model and version
         (a pin holds a rigid body whole)."""
-        key = (model, model.version)
+        key = (model, (model.version, model.joints is not None))
         if self._rigid is None or self._rigid[0] is not model or self._rigid[1] != key[1]:
             blocks = body_mass = None
-            if model.n_vertices and model.rigid.any():
+            # joints on soft bodies alone take blocks too (none): their rows read the blocks
+            if model.n_vertices and (model.rigid.any() or model.joints is not None):
                 blocks = rigid_blocks(model, rigid_set(model))
                 body_mass = np.zeros(model.n_vertices)
                 for a, b, m in zip(blocks.lo, blocks.hi, blocks.mass):
@@ -807,14 +823,14 @@ class AVBD(Integrator):
         return self._rigid[2], self._rigid[3]
 
     def _joint_rows(self, model, blocks):
-        """The Model's joints (``model.joints``), or an empty set of rows for ``blocks``."""
+        """The Model's joints (``model.joints``), or an empty set of rows for ``blocks`` (None:
+        no rigid body) and the model's vertices."""
         jr = model.joints
         if jr is None:
-            if self._no_joints is None or len(self._no_joints.j_start) != len(blocks.lo) + 1:
-                z = np.zeros((0, 4))
-                self._no_joints = make_joint_rows(np.zeros((0, 2), np.int64), np.zeros((0, 4), np.int64), z,
-                                                  np.zeros(0, np.int64), np.zeros((0, 5)), np.zeros(0, np.bool_), z,
-                                                  z, len(blocks.lo))
+            k = 0 if blocks is None else len(blocks.lo)
+            if (self._no_joints is None or len(self._no_joints.j_start) != k + 1
+                    or len(self._no_joints.v_start) != model.n_vertices + 1):
+                self._no_joints = no_joint_rows(k, model.n_vertices)
             return self._no_joints
         return jr
 
@@ -895,9 +911,10 @@ class AVBD(Integrator):
         self._n_corner = n_corner
         return count, n_body, found
 
-    def _body_rows(self, model, ctopo, buf, n_body, k_start, v):
+    def _body_rows(self, model, ctopo, buf, n_body, k_start, v, jr):
         """The step's body rows, warm-started (:func:`~deforma.physics.integrators.avbd.rows.start_body_rows`),
-        with the collider rows as one :class:`~deforma.physics.integrators.avbd.rows.RowSet`."""
+        with the collider rows and the joints on soft bodies (``jr``) as one
+        :class:`~deforma.physics.integrators.avbd.rows.RowSet`."""
         n_cv = len(ctopo.cv_vertex)
         if self._body_memory is None or self._body_memory[1] is not model:
             self._body_memory = (np.full((n_cv, MEMORY_COLUMNS), -1.0), model)
@@ -924,19 +941,21 @@ class AVBD(Integrator):
             self._gas = (model, gas_set(model))
         gas = self._gas[1]
         np.multiply(model.body_pressure, model.body_pressure_area, out=gas.load)  # settable live
-        mark_rowed(self._vertex_row, self._b_start, self._c_start, gas.start, self._rowed)
+        mark_rowed(self._vertex_row, self._b_start, self._c_start, gas.start, jr.v_start, self._rowed)
         return RowSet(self._vertex_row, self._planes, self._rows, self._bidx, self._bgeo, self._bstate, self._b_start,
                       self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas.start,
-                      self._rowed)
+                      jr.v_start, jr.v_entry, jr.block, jr.fv, jr.fw, jr.kind, jr.param, jr.lam, jr.pen, jr.err0,
+                      jr.point, self._rowed)
 
     def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol, h_rigid):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights
         (``h`` the soft vertices' damping step, ``2/3`` of the substep's ``h_rigid`` for BDF2)."""
         opts = self._options
         blocks = self._rigid[2]
-        jr = self._joint_rows(model, blocks) if blocks is not None else None
+        jr = self._joint_rows(model, blocks)
         coupled = None
-        if blocks is not None and model.fused and not model.has_pressure:
+        soft_joints = bool(jr.soft.any())
+        if blocks is not None and len(blocks.lo) and model.fused and not model.has_pressure:
             # the soft vertices with contact rows: swept again after each pass over the rigid
             # blocks (one serial colour: they are all rowed). Swept only with the others, a
             # jelly resting on a 24 kg crate buzzed at 5-80 mm/s (the crate, squeezed between
@@ -957,6 +976,12 @@ class AVBD(Integrator):
         patches = self._clusters(model, x_n)
         most = 0.0
         sweeps = opts["iterations"]
+        if soft_joints:
+            # a joint between soft bodies couples its two triangles' vertices stiffly, which a
+            # vertex sweep relaxes slowly: at 10 sweeps a chain of six soft links hanging
+            # still began to swing by itself (0.5 mm/s at 2 s, 13 cm/s at 4.5 s), at 20 it
+            # hangs at 0.1 mm/s
+            sweeps = max(sweeps, self.SOFT_JOINT_SWEEPS)
         it = 0
         gas = self._gas[1] if model.has_pressure else None
         for it in range(sweeps):
@@ -1002,6 +1027,11 @@ class AVBD(Integrator):
                                  tris.elem, tris.b, tris.area, tris.mu, tris.lam, tris.beta, tris.kind, s_start,
                                  s_item, s_corner, springs.i, springs.j, springs.rest, springs.ks, springs.kd,
                                  control.grab_slot, control.grab_pull, rs, inv_h, self._moves)
+            if soft_joints:
+                # the joints with a soft side: their dual step after each sweep (their
+                # vertices move in the sweeps and the whole-body steps, not in the passes over
+                # the rigid blocks)
+                update_joint_rows(jr, blocks, x, opts["penalty_ramp"], opts["penalty_max"], SOFT_JOINTS)
             if rho > 0.0:
                 omega = chebyshev_omega(it, rho, omega)
                 chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)
@@ -1014,7 +1044,7 @@ class AVBD(Integrator):
             # an island has contacts: there the stiff joints won over the contact rows, and
             # the `chain` scene's crate went into the post it swings against
             for _ in range(self.JOINT_PASSES):
-                if joint_gap(jr, blocks, h_rigid) <= self.JOINT_TOLERANCE:
+                if joint_gap(jr, blocks, x) <= self.JOINT_TOLERANCE:
                     break
                 rigid_pass(x, x_n, self._zeros, model.rigid, blocks, control.grab_slot, control.grab_pull, rs, jr,
                            self._touch, self._planes, self._rows, count, n_body, self._n_corner, h_rigid,
@@ -1027,7 +1057,7 @@ class AVBD(Integrator):
         update_corner_rows(x, x_n, rs.cpairs, rs.cf, rs.cstate, self._n_corner, opts["penalty_ramp"],
                            opts["penalty_max"])
         if blocks is not None:
-            update_joint_rows(jr, blocks, opts["penalty_ramp"], opts["penalty_max"], h_rigid)
+            update_joint_rows(jr, blocks, x, opts["penalty_ramp"], opts["penalty_max"], RIGID_JOINTS)
         self.iterations_run += it + 1
         self.residual = math.sqrt(most) * inv_h
         if tol > 0.0 and most > tol * tol:
