@@ -113,3 +113,163 @@ def test_small_random_pictures_mesh_into_a_manifold_or_a_clear_error(h, w, cell,
                           np.bincount(b[:, 1], minlength=len(m.vertices)))
     assert np.bincount(b[:, 0], minlength=len(m.vertices)).max() <= 1
     assert math.isfinite(m.area) and m.area > 0
+
+
+# -- issue 51: hardening, round three -------------------------------------------------------------
+# Each case was tried as a user would; these are the ones that still failed, one test each.
+import io  # noqa: E402
+import os  # noqa: E402
+import re  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import pytest  # noqa: E402
+
+#: Peak memory of a run refused up front (MB): start-up only, far below any video's buffers.
+REFUSED_PEAK_MB = 400
+
+
+def _lying_png_bytes(width: int, height: int) -> bytes:
+    """A PNG whose header says width x height and whose data holds one white row, ending cleanly."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(b"\x00" + b"\xff" * 3 * width)) + chunk(b"IEND", b""))
+
+
+def _peak_of(args, cwd, timeout=60):
+    """Run ``args`` in a child; (returncode, stderr, the largest peak RSS of it or any of its children in MB)."""
+    code = ("import resource, subprocess, sys\n"
+            "r = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+            "sys.stderr.write(r.stderr)\n"
+            "print(r.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024)")
+    r = subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True, text=True,
+                       timeout=timeout, cwd=cwd)
+    rc, peak = r.stdout.split()
+    return int(rc), r.stderr, float(peak)
+
+
+def test_a_lying_png_opened_from_memory_is_refused_before_a_pixel_is_decoded():
+    # Image.open(BytesIO(...)) has no file name: it was decoded as 6000 x 6000 and meshed (1.97 GB, 12 s)
+    from PIL import Image
+
+    picture = Image.open(io.BytesIO(_lying_png_bytes(6000, 6000)))
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"image file is truncated: its header says 6000x6000 pixels") as e:
+        deforma.mesh.from_image(picture)
+    one_line(e.value)
+    assert time.perf_counter() - t0 < 2
+    code = ("import io, resource, sys, deforma\nfrom PIL import Image\n"
+            "im = Image.open(io.BytesIO(sys.stdin.buffer.read()))\n"
+            "before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+            "try:\n    deforma.mesh.from_image(im)\nexcept ValueError:\n    pass\n"
+            "print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024)")
+    r = subprocess.run([sys.executable, "-c", code], input=_lying_png_bytes(6000, 6000), capture_output=True,
+                       timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert float(r.stdout) < 50, f"peak memory grew by {r.stdout.decode().strip()} MB"
+
+
+def test_a_box_of_high_detail_is_meshed_in_about_linear_time():
+    # the symmetric re-split of its cells scanned every triangle per cell: 18 s at detail 300,
+    # 63 s at 400, about half an hour at the largest detail (1000), before a run could start
+    corners = ((-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5))
+    deforma.mesh.box(corners, detail=4)  # compiled kernels loaded before the clock starts
+    t0 = time.perf_counter()
+    m = deforma.mesh.box(corners, detail=300)
+    assert time.perf_counter() - t0 < 8  # 2.3 s here; 18 s before
+    assert len(m.vertices) == 302**2 and len(m.triangles) == 2 * 301**2
+
+
+def test_export_onto_a_full_disk_names_the_folder_and_leaves_nothing(tmp_path, capsys, monkeypatch):
+    import errno
+
+    import deforma.mesh.export
+    from deforma.cli import EXIT_ERROR, main
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(deforma.mesh.export, "write_meshes", full)
+    target = tmp_path / "frames"
+    code = main(["run", "sample", "--seconds", "0.1", "--export", str(target)])
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith("deforma: compiling")]
+    assert code == EXIT_ERROR and len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0] == (f"deforma: error: --export {target}: could not be written: no space left on the device; "
+                        f"nothing was written")
+    assert os.listdir(tmp_path) == []  # neither the folder nor its hidden temporary one
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--size", "7680x4320", "--overlay", "-o", "o.mp4"], ["a 7680x4320 MP4", "ffmpeg's H.264 encoder"]),
+    (["--size", "7680x4320", "--fps", "240", "-o", "o.gif"], ["GIF of 960 frames", "kept until the end"]),
+    (["--seconds", "30", "--size", "1920x1080", "-o", "o.gif"], ["GIF of 900 frames", ".mp4", "at most"]),
+])
+def test_a_render_too_big_for_memory_is_refused_up_front_with_what_fits(tmp_path, args, names):
+    # they ran for minutes at up to 3.45 GB (an 8k MP4 peaked at 3.16 GB in ffmpeg, 1.39 GB here)
+    from deforma.render.video import MAX_RUN_MEMORY, run_memory
+
+    t0 = time.perf_counter()
+    rc, err, peak = _peak_of(["deforma", "run", "sample", *args], tmp_path)
+    assert time.perf_counter() - t0 < 10
+    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith("deforma: compiling")]
+    assert rc == 1 and len(lines) == 1 and "Traceback" not in err, err
+    assert "needs about" in lines[0] and "deforma run stays within 2.0 GB" in lines[0]
+    assert all(n in lines[0] for n in names), lines[0]
+    # the size it offers fits, and is the largest of that shape that does
+    w, h = map(int, re.search(r"--size (\d+)x(\d+) or smaller", lines[0]).groups())
+    kind, fps = args[-1].rsplit(".", 1)[1], float(args[args.index("--fps") + 1]) if "--fps" in args else 30.0
+    frames = 960 if "--fps" in args else (900 if "--seconds" in args else 120)
+    fits = lambda w, h: sum(run_memory((w, h), samples=4, kind=kind, frames=frames, fps=fps).values())  # noqa: E731
+    assert fits(w, h) <= MAX_RUN_MEMORY < fits(w + 2, h + 2)
+    assert os.listdir(tmp_path) == []
+    assert peak < REFUSED_PEAK_MB, f"{peak:.0f} MB before refusing"
+
+
+def test_a_run_within_the_memory_bound_peaks_under_its_estimate(tmp_path):
+    from deforma.render.video import run_memory
+
+    args = ["--seconds", "0.2", "--size", "640x360", "--overlay", "-o", "v.mp4"]
+    rc, err, peak = _peak_of(["deforma", "run", "sample", *args], tmp_path, timeout=300)
+    assert rc == 0, err
+    estimate = sum(run_memory((640, 360), samples=4, kind="mp4", frames=6, fps=30).values()) / 2**20
+    assert peak < estimate, f"measured {peak:.0f} MB, estimated {estimate:.0f} MB"
+    assert os.listdir(tmp_path) == ["v.mp4"]
+
+
+@pytest.mark.parametrize("strength", [1e6, 1e12])
+def test_a_runaway_under_a_strong_grab_names_the_grab(strength):
+    # the hint said only "lower the stiffness or damping, raise the mass": the grab is what to lower
+    import warnings
+
+    w = deforma.World(integrator="symplectic-euler", substeps=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=3))
+    grab = w.grab((0.5, 0.5), strength=strength)
+    grab.target = (50, 50)  # dragged far off
+    with pytest.raises(deforma.SimulationUnstable) as e:
+        for _ in range(20):
+            w.step()
+    one_line(e.value)
+    assert f"set by the grabs, up to {strength:.3g} N/m on a vertex" in e.value.hint
+    assert "lower the grab strength" in e.value.hint
+
+
+def test_a_sweep_video_too_big_for_memory_is_refused_before_anything_runs(tmp_path):
+    # each run's MP4 is deforma run -o's renderer and ffmpeg: 7680x4320 would need 5 GB a worker
+    from deforma.sweeps import SweepError, sweep
+
+    spec = tmp_path / "s.toml"
+    spec.write_text('scene = "sample"\nseconds = 0.1\n[parameters]\n"physics.friction" = [0.1, 0.5]\n')
+    with pytest.raises(SweepError, match=r"^video_size: a 7680x4320 MP4 needs about .* each run of a sweep stays "
+                                         r"within 2.0 GB: give --video-size \d+x\d+ or smaller$") as e:
+        sweep(spec, tmp_path / "out", video="mp4", video_size=(7680, 4320))
+    one_line(e.value)
+    assert sorted(os.listdir(tmp_path)) == ["s.toml"]

@@ -268,7 +268,11 @@ class _MeshExport:
         self.target = Path(path)
         self.fmt = fmt
         self.colors = [getattr(b, "color", None) for b in scene.body]
-        self.tmp = temp_folder_in(self.target.resolve().parent)
+        self.tmp = None
+        try:
+            self.tmp = temp_folder_in(self.target.resolve().parent)
+        except OSError as e:
+            raise self._failed(e) from None
         self.materials = None
         self._first = True
 
@@ -278,17 +282,30 @@ class _MeshExport:
         bodies = [b for b in world.bodies if len(b.triangles)]
         meshes = [b.to_mesh() for b in bodies]
         names = [f"body{b.index}" for b in bodies]
-        if self._first and self.fmt == "obj":  # the pictures do not change: once
-            self.materials = write_materials(meshes, self.tmp, names=names)
-        self._first = False
         colors = [self.colors[b.index] if b.index < len(self.colors) else None for b in bodies]
-        write_meshes(meshes, self.tmp / f"frame_{frame:05d}.{self.fmt}", names=names, colors=colors,
-                     materials=self.materials, frame=frame, time=world.time)
+        try:
+            if self._first and self.fmt == "obj":  # the pictures do not change: once
+                self.materials = write_materials(meshes, self.tmp, names=names)
+            self._first = False
+            write_meshes(meshes, self.tmp / f"frame_{frame:05d}.{self.fmt}", names=names, colors=colors,
+                         materials=self.materials, frame=frame, time=world.time)
+        except OSError as e:
+            # a full disk said only "[Errno 28] No space left on device": name the folder the
+            # user gave (the frames go to a hidden temporary one beside it, removed by abort())
+            raise self._failed(e) from None
+
+    def _failed(self, error: OSError) -> OSError:
+        from .files import failed_write
+
+        return failed_write(f"--export {self.target}", error)
 
     def publish(self) -> None:
-        if self.target.is_dir():  # an empty folder (checked before the run): replaced
-            self.target.rmdir()
-        os.replace(self.tmp, self.target)
+        try:
+            if self.target.is_dir():  # an empty folder (checked before the run): replaced
+                self.target.rmdir()
+            os.replace(self.tmp, self.target)
+        except OSError as e:
+            raise self._failed(e) from None
         self.tmp = None
 
     def abort(self) -> None:
@@ -360,8 +377,14 @@ def _run_scene(a, watch, shown: dict) -> int:
         raise CliError("--format says how --export writes the meshes: give --export DIR too")
     if a.export:
         _check_export_path(a.export)
-    world = scene.build()
     n_frames = frame_count(seconds, fps)
+    if a.output:
+        from .render.video import check_run_memory
+
+        # from the size, writer and frame count alone, before the scene is built: an 8k MP4
+        # peaked at 4.5 GB (ffmpeg's encoder 3.2 of it), a 30 s 1080p GIF kept 900 frames
+        check_run_memory(a.output, a.size, samples=a.samples, frames=n_frames, fps=fps)
+    world = scene.build()
     from .physics.diagnostics import xpbd_advice
 
     advice = xpbd_advice(world)

@@ -792,5 +792,15 @@ def _check_video(video, size):
     if not ok or not (16 <= size[0] <= 7680 and 16 <= size[1] <= 4320):
         raise SweepError(f"video_size: expected (width, height) in pixels, width in [16, 7680] and height in "
                          f"[16, 4320], got {size!r}")
+    if video == "mp4":
+        # each run is `deforma run -o`'s renderer and ffmpeg on a worker: the same bound, per
+        # run (a GIF's frame count comes from each run's scene: its worker's row says it)
+        from .render.video import check_run_memory
+
+        try:
+            check_run_memory("video.mp4", tuple(size), samples=4, frames=1, fps=30.0, size_option="--video-size",
+                             who="each run of a sweep")
+        except ValueError as e:
+            raise SweepError(f"video_size: {str(e).split(': ', 1)[1]}") from None
     return video
 

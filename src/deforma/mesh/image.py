@@ -618,6 +618,9 @@ def _from_pil(im, label):
     try:
         if im.format == "PNG" and getattr(im, "filename", ""):
             _check_png_data(im.filename, label)  # before a pixel is decoded: the full image is never made
+        elif im.format == "PNG" and im.tile and getattr(im, "fp", None) is not None:
+            # a PNG opened from memory (Image.open(BytesIO)) and not decoded yet lies the same way
+            _check_png_stream(im.fp, label)
         if im.mode in _WIDE_GREY_MODES:
             return _from_array(_wide_grey_to_8bit(np.asarray(im), im.mode, label))
         rgba = np.asarray(im.convert("RGBA"), dtype=np.uint8)
@@ -657,39 +660,57 @@ def _check_png_data(path, label) -> None:
     A file that does not start as a PNG does is left to Pillow.
     """
     with open(path, "rb") as f:
-        head = f.read(33)
-        if len(head) < 33 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
-            return
-        width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", head[16:29])
-        need = _png_data_size(width, height, depth, colour, interlace == 1)
-        inflate, got = zlib.decompressobj(), 0
-        try:
-            f.seek(8)
-            while got < need and not inflate.eof:
-                top = f.read(8)
-                if len(top) < 8:
+        _check_png_file(f, label)
+
+
+def _check_png_stream(fp, label) -> None:
+    """:func:`_check_png_data` on the open file object of a PNG not decoded yet, put back where it was."""
+    try:
+        where = fp.tell()
+    except (OSError, ValueError, AttributeError):  # not seekable, or closed: left to Pillow
+        return
+    try:
+        fp.seek(0)
+        _check_png_file(fp, label)
+    finally:
+        fp.seek(where)
+
+
+def _check_png_file(f, label) -> None:
+    """The check of :func:`_check_png_data`, on an open binary file (seekable)."""
+    head = f.read(33)
+    if len(head) < 33 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        return
+    width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", head[16:29])
+    need = _png_data_size(width, height, depth, colour, interlace == 1)
+    inflate, got = zlib.decompressobj(), 0
+    try:
+        f.seek(8)
+        while got < need and not inflate.eof:
+            top = f.read(8)
+            if len(top) < 8:
+                break
+            length, kind = struct.unpack(">I4s", top)
+            if kind == b"IEND":
+                break
+            if kind != b"IDAT":
+                f.seek(length + 4, os.SEEK_CUR)  # another chunk, and its CRC
+                continue
+            left = length
+            while left and got < need and not inflate.eof:
+                data = f.read(min(left, _PNG_PIECE))
+                if not data:
                     break
-                length, kind = struct.unpack(">I4s", top)
-                if kind == b"IEND":
-                    break
-                if kind != b"IDAT":
-                    f.seek(length + 4, os.SEEK_CUR)  # another chunk, and its CRC
-                    continue
-                left = length
-                while left and got < need and not inflate.eof:
-                    data = f.read(min(left, _PNG_PIECE))
-                    if not data:
-                        break
-                    left -= len(data)
-                    while data and got < need and not inflate.eof:
-                        got += len(inflate.decompress(data, _PNG_PIECE))
-                        data = inflate.unconsumed_tail
-                f.seek(left + 4, os.SEEK_CUR)  # what was not needed, and the CRC
-            if got < need and not inflate.eof:
-                got += len(inflate.flush())  # what the last piece still held
-        except zlib.error as exc:
-            raise ValueError(f"cannot read image {label!r} (corrupt compressed data: {exc}); a whole PNG or JPEG "
-                             f"file is needed") from None
+                left -= len(data)
+                while data and got < need and not inflate.eof:
+                    got += len(inflate.decompress(data, _PNG_PIECE))
+                    data = inflate.unconsumed_tail
+            f.seek(left + 4, os.SEEK_CUR)  # what was not needed, and the CRC
+        if got < need and not inflate.eof:
+            got += len(inflate.flush())  # what the last piece still held
+    except zlib.error as exc:
+        raise ValueError(f"cannot read image {label!r} (corrupt compressed data: {exc}); a whole PNG or JPEG "
+                         f"file is needed") from None
     if got < need:
         raise ValueError(f"cannot read image {label!r} (image file is truncated: its header says {width}x{height} "
                          f"pixels, its data ends {100 * got / need:.2g} % of the way through them); a whole PNG or "

@@ -11,6 +11,7 @@ Units are SI (m, kg, s, N).
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -123,6 +124,23 @@ def damping_note(model, control, stable: float) -> str:
     return f" (set by the damping: {undamped:.3g} s without it; lower material_damping or damping)"
 
 
+def grab_note(model, control, stable: float) -> str:
+    """`` (set by the grabs: ...)`` when the grabs, not the bodies, make the explicit step
+    ``stable`` (s) less than half as long: a runaway under a strong grab was told to "lower the
+    stiffness or damping, raise the mass", which changes nothing a grab of 1e12 N/m does."""
+    held = control.grab_slot >= 0
+    if not held.any():
+        return ""
+    free = copy.copy(control)
+    free.grab_slot = np.full_like(control.grab_slot, -1)
+    ungrabbed = stable_dt(model, free)
+    if not stable < 0.5 * ungrabbed:
+        return ""
+    strongest = float(np.max(control.grab_pull[control.grab_slot[held], 0]))
+    return (f" (set by the grabs, up to {strongest:.3g} N/m on a vertex: {ungrabbed:.3g} s without them; "
+            f"lower the grab strength)")
+
+
 def support_reach(x, pinned, down) -> float:
     """How far (m) the support of a body at rest positions ``x`` (N, 2) must travel through
     it: from its pinned vertices to the farthest vertex, in any direction (a cantilever held
@@ -213,10 +231,12 @@ def runaway(world, model, state, start, control, step: int, *, unconditionally_s
     elif h > stable and world.dt / stable <= MAX_SUBSTEPS:
         need = math.ceil(world.dt / stable)
         hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s"
-                f"{damping_note(model, control, stable)}: lower dt or raise substeps to at least {need}")
+                f"{damping_note(model, control, stable)}{grab_note(model, control, stable)}: lower dt or raise "
+                f"substeps to at least {need}")
     elif h > stable:
         hint = (f"dt/substeps {h:.3g} s exceeds the stable estimate {stable:.3g} s"
-                f"{damping_note(model, control, stable)} by more than {MAX_SUBSTEPS} substeps can make up: lower "
+                f"{damping_note(model, control, stable)}{grab_note(model, control, stable)} by more than "
+                f"{MAX_SUBSTEPS} substeps can make up: lower "
                 f"the stiffness or damping, raise the mass, or use an unconditionally stable integrator "
                 f"(implicit-euler, xpbd)")
     else:

@@ -455,3 +455,111 @@ def open_writer(path, *, fps: float) -> FrameWriter:
     """
     kind = check_output(path)
     return {"mp4": Mp4Writer, "gif": GifWriter, "png": PngFolderWriter}[kind](path, fps=fps)
+
+
+# -- memory of a headless run ----------------------------------------------------------------------
+#: The most memory ``deforma run -o`` plans for (bytes): the run is refused up front when
+#: :func:`run_memory` says more, naming a size (or a frame count) that fits. Measured peaks
+#: under it stay under it (``tests/test_cli_limits.py``); ``docs/cli.md`` states it.
+MAX_RUN_MEMORY = 2_000_000_000
+# Measured (issue 51, the sample scene, software OpenGL): the process before any frame
+# (Python, NumPy, the compiled kernels, the scene) ...
+_BASE_BYTES = 550 * 2**20
+# ... the renderer per pixel of --size: framebuffers (x4 with multisampling), the read-back
+# frame and the overlay's copy (7680x4320: 0.74 GB without multisampling, 1.39 GB with it) ...
+_RENDER_BYTES_PER_PIXEL = {0: 7, 4: 27}
+# ... and ffmpeg's H.264 encoder, a process of its own that queues and looks ahead over whole
+# frames (7680x4320: 3.16 GB; 3840x2160: 0.89 GB).
+_MP4_BYTES_PER_PIXEL = 115
+_MP4_BASE_BYTES = 40 * 2**20
+
+
+def run_memory(size, *, samples: int, kind: str, frames: int, fps: float) -> dict[str, int]:
+    """Estimate the peak memory of a headless run writing ``frames`` frames of ``size``.
+
+    Parameters
+    ----------
+    size : (int, int)
+        Width and height of the pictures in pixels.
+    samples : {0, 4}
+        Multisampling of the renderer.
+    kind : {"mp4", "gif", "png"}
+        The writer (see :func:`output_kind`).
+    frames : int
+        Frames the run writes.
+    fps : float
+        Frames per second (a GIF keeps its first second of frames whole to choose its palette).
+
+    Returns
+    -------
+    dict of str to int
+        Bytes by part: ``"process"``, ``"renderer"`` and ``"writer"`` (ffmpeg's encoder for an
+        MP4, every frame for a GIF, which is written only when the last one is known; nothing
+        for a PNG folder, whose frames go to disk one by one).
+
+    Examples
+    --------
+    >>> parts = run_memory((1280, 720), samples=4, kind="mp4", frames=90, fps=30)
+    >>> sum(parts.values()) < MAX_RUN_MEMORY
+    True
+    """
+    pixels = int(size[0]) * int(size[1])
+    parts = {"process": _BASE_BYTES, "renderer": pixels * _RENDER_BYTES_PER_PIXEL.get(samples, 27), "writer": 0}
+    if kind == "mp4":
+        parts["writer"] = _MP4_BASE_BYTES + pixels * _MP4_BYTES_PER_PIXEL
+    elif kind == "gif":
+        # one byte a pixel per kept frame, twice (Pillow's list and its frames' deltas when
+        # saving), and the first second as RGB (the copy kept and the palette's mosaic)
+        parts["writer"] = 2 * frames * pixels + 2 * min(frames, max(1, int(round(fps)))) * 3 * pixels
+    return parts
+
+
+def check_run_memory(path, size, *, samples: int, frames: int, fps: float, size_option: str = "--size",
+                     who: str = "deforma run") -> None:
+    """Refuse, before anything runs, a run whose :func:`run_memory` is over :data:`MAX_RUN_MEMORY`.
+
+    ``size_option`` and ``who`` are how the message names the size option and the command (a
+    sweep's videos: ``--video-size``, "a sweep's run").
+
+    Raises
+    ------
+    ValueError
+        One line: the estimate by part and what fits instead (a smaller ``--size`` with the same
+        shape, and for a GIF an MP4 or fewer frames).
+    """
+    kind = output_kind(path)
+    parts = run_memory(size, samples=samples, kind=kind, frames=frames, fps=fps)
+    total = sum(parts.values())
+    if total <= MAX_RUN_MEMORY:
+        return
+    gb = lambda b: f"{b / 1e9:.1f} GB"  # noqa: E731
+    w, h = size
+    what = {"mp4": f"a {w}x{h} MP4", "gif": f"a {w}x{h} GIF of {frames} frames", "png": f"{w}x{h} PNG frames"}[kind]
+    writer = {"mp4": " + ffmpeg's H.264 encoder ", "gif": " + the GIF's frames, kept until the end ",
+              "png": ""}[kind]
+    detail = f"renderer {gb(parts['renderer'])}" + (f"{writer}{gb(parts['writer'])}" if writer else "")
+    fits = []
+    if kind == "gif":
+        if sum(run_memory(size, samples=samples, kind="mp4", frames=frames, fps=fps).values()) <= MAX_RUN_MEMORY:
+            fits.append("-o with .mp4 (its frames are streamed)")
+        per_frame = 2 * w * h
+        room = MAX_RUN_MEMORY - parts["process"] - parts["renderer"] - (parts["writer"] - 2 * frames * w * h)
+        if room >= per_frame:
+            most = room // per_frame
+            fits.append(f"at most {most} frames (--seconds {most / fps:.3g} at {fps:g} fps)")
+    # the largest size of the same shape that fits: a bisection over the width
+    lo, hi = 0, w
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        mh = max(16, h * mid // w)
+        if mid >= 16 and sum(run_memory((mid, mh), samples=samples, kind=kind, frames=frames, fps=fps).values()) \
+                <= MAX_RUN_MEMORY:
+            lo = mid
+        else:
+            hi = mid - 1
+    if lo >= 16:
+        fits.append(f"{size_option} {lo}x{max(16, h * lo // w)} or smaller")
+    if samples and sum(run_memory(size, samples=0, kind=kind, frames=frames, fps=fps).values()) <= MAX_RUN_MEMORY:
+        fits.append("--samples 0")
+    raise ValueError(f"{path}: {what} needs about {gb(total)} of memory ({detail}); {who} stays within "
+                     f"{gb(MAX_RUN_MEMORY)}: give " + (" or ".join(fits) if fits else f"a smaller {size_option}"))
