@@ -1,4 +1,4 @@
-"""examples/notebook.ipynb runs from top to bottom in a real kernel and shows real pictures (issue 18).
+"""The bundled notebook (src/deforma/examples/notebook.ipynb) runs from top to bottom in a real kernel and shows real pictures (issue 18).
 
 nbclient executes it the way Jupyter would (ipykernel, display formatters and all), in a
 temporary folder, so a cell that breaks, a picture that stops being a PNG or an animation
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-NOTEBOOK = Path(__file__).resolve().parents[1] / "examples" / "notebook.ipynb"
+NOTEBOOK = Path(__file__).resolve().parents[1] / "src" / "deforma" / "examples" / "notebook.ipynb"
 #: The whole notebook, kernel start and Numba's cache loading included: a few seconds of
 #: simulation at small sizes. A cold Numba cache compiles for about a minute on top.
 TIMEOUT_SECONDS = 300
@@ -64,7 +64,7 @@ def executed(tmp_path_factory):
     start = time.perf_counter()
     client.execute()  # raises CellExecutionError, with the cell and its traceback, if a cell fails
     elapsed = time.perf_counter() - start
-    print(f"examples/notebook.ipynb executed in {elapsed:.1f} s")
+    print(f"src/deforma/examples/notebook.ipynb executed in {elapsed:.1f} s")
     return nb, workdir
 
 

@@ -1,4 +1,5 @@
-"""examples/compare_integrators.py runs headless and writes its video and plot."""
+"""The integrators example (src/deforma/examples/integrators.py; examples/compare_integrators.py points
+at it) runs headless and writes its video and plot."""
 
 import importlib.util
 from pathlib import Path
@@ -6,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "compare_integrators.py"
+EXAMPLE = Path(__file__).resolve().parents[2] / "src" / "deforma" / "examples" / "integrators.py"
 
 
 #: two_mass_period_error(integrator, h) -> its value or the exception it raised, shared by the

@@ -310,3 +310,31 @@ def test_rope_of_soft_links_swings_its_weight_without_gaining_energy():
     assert max(gap(j) for j in w.joints) < 2e-3
     for b in links:
         assert (signed_areas(b.positions, b.triangles) > 0).all()
+
+
+def test_car_drives_its_level_on_squashing_tyres():
+    # two soft tyres, each pinned on a rigid hub that a motor pin turns against the chassis:
+    # it drives over the humps, up the ramp and across the plateau in 6 s, its tyres squashed
+    # where they touch, no triangle turned inside out, every pin holding
+    from deforma.physics.elements.triangles import signed_areas
+
+    w = scenes.load_scene("car")
+    chassis, tyres = w.bodies[0], (w.bodies[2], w.bodies[4])
+    assert [b.material.is_rigid for b in w.bodies] == [True, True, False, True, False]
+    start = chassis.center_of_mass.copy()
+    lowest = np.inf
+    for _ in range(360):
+        w.step()
+        lowest = min(lowest, min(np.ptp(t.positions[:, 1]) for t in tyres))
+        for t in tyres:
+            assert (signed_areas(t.positions, t.triangles) > 0).all()
+    assert chassis.center_of_mass[0] - start[0] > 5.0  # 1 m/s or more, over humps and a ramp
+    assert abs(chassis.angle) < 30.0  # on its wheels
+    assert lowest < 0.49  # a 0.5 m tyre squashed by more than a centimetre
+    for j in w.joints:
+        if j.motor_speed is None:  # a tyre's pin: its triangle's point on the hub's
+            tyre, hub = j.a, j.b
+            p = j._frame[2][0] @ tyre.positions[j._frame[1][0]]
+            i0, i1, alpha, beta = j._frame[0][1]
+            x0, d = hub.positions[i0], hub.positions[i1] - hub.positions[i0]
+            assert np.hypot(*(p - x0 - alpha * d - beta * np.array([-d[1], d[0]]))) < 3e-3
