@@ -494,3 +494,22 @@ def test_the_join_key_is_listed():
     from deforma.viewer.controls import KEYS
 
     assert any(action == "join" for _names, action, _text in KEYS)
+
+
+def test_the_arrow_keys_drive_every_motor_and_wake_a_sleeping_car():
+    s = Session("car")
+    w = s.world
+    motors = [j for j in w.joints if j.motor_speed is not None]
+    assert len(motors) == 2 and all(j.motor_speed == -300.0 for j in motors)
+    assert s.drive(-1) == "driving back: 2 motors at 300 degrees/s"
+    assert [j.motor_speed for j in motors] == [300.0, 300.0]
+    assert s.drive(0) == "braking: 2 motors at no spin" and [j.motor_speed for j in motors] == [0.0, 0.0]
+    assert s.drive(1) == "driving forward: 2 motors at 300 degrees/s"  # the speed it was first driven at
+    assert [j.motor_speed for j in motors] == [-300.0, -300.0]
+    w.sleep = True
+    w.step()  # (its islands: the car's bodies, held together by their joints)
+    for b in w.bodies:
+        b.sleeping = True
+    s.drive(-1)
+    assert not any(b.sleeping for b in w.bodies)  # a motor's change wakes what it turns
+    assert Session("jelly").drive(1).startswith("no motor to drive")

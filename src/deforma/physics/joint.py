@@ -112,6 +112,7 @@ class Joint:
     @motor_speed.setter
     def motor_speed(self, value) -> None:
         self._motor_speed = motor(self.kind, value, self._max_torque)[0]
+        self._world._disturb(self.a)  # a sleeping car wakes when driven
 
     @property
     def max_torque(self) -> float | None:
@@ -121,6 +122,7 @@ class Joint:
     @max_torque.setter
     def max_torque(self, value) -> None:
         self._max_torque = motor(self.kind, self._motor_speed, value)[1]
+        self._world._disturb(self.a)
 
     def _pack(self) -> tuple[int, np.ndarray, bool]:
         """``(kind code, param row, motor on)`` for the rigid solver."""

@@ -400,6 +400,8 @@ class Viewer:
             self.unpin_all()
         elif action == "join":
             self.start_join()
+        elif action.startswith("drive:"):
+            self.inspector.say(self.session.drive(int(action.split(":", 1)[1])))
         elif action.startswith("object:"):
             self.select_object(action.split(":", 1)[1])
         elif action == "panel":

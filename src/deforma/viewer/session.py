@@ -165,6 +165,10 @@ def _check_int(value, name: str) -> int:
     return v
 
 
+#: Degrees/s the arrow keys drive a motor at whose own speed is zero (:meth:`Session.drive`).
+DRIVE_SPEED = 300.0
+
+
 class Session:
     """The live world, the scene it came from, and the inspector's selection.
 
@@ -190,6 +194,7 @@ class Session:
         if not isinstance(scene, Scene):
             scene = load(scene)
         self.world = build(scene)
+        self._drive_speeds: dict[int, float] = {}  # a motor's speed when first driven (drive)
         self.explosive_force = float(scene.interaction.explosive_force)
         self.camera_center = tuple(scene.camera.center)
         self.camera_size = tuple(scene.camera.size)
@@ -468,6 +473,32 @@ class Session:
             if i >= 0 and d[i] <= radius and (best is None or d[i] <= best[0]):
                 best = (float(d[i]), k, i)
         return None if best is None else (best[1], best[2])
+
+    def drive(self, direction: int) -> str:
+        """The arrow keys: every motor of the world forward (``direction`` 1: clockwise, which
+        rolls a wheel on the ground to the right), back (-1) or braked (0, held at no spin
+        relative to what it is joined to), at the speed it had when first driven (or
+        :data:`DRIVE_SPEED`). Returns what the status line says.
+
+        Examples
+        --------
+        >>> s = Session("car")
+        >>> s.drive(-1)
+        'driving back: 2 motors at 300 degrees/s'
+        >>> [j.motor_speed for j in s.world.joints if j.motor_speed is not None]
+        [300.0, 300.0]
+        """
+        motors = [j for j in self.world.joints if j.motor_speed is not None]
+        if not motors:
+            return "no motor to drive: join a wheel with motor_speed (docs/physics.md, Joints)"
+        speeds = set()
+        for j in motors:
+            base = self._drive_speeds.setdefault(id(j), abs(j.motor_speed) or DRIVE_SPEED)
+            j.motor_speed = -direction * base
+            speeds.add(base)
+        what = {1: "driving forward", -1: "driving back", 0: "braking"}[direction]
+        return f"{what}: {len(motors)} motor{'s' if len(motors) > 1 else ''} at " + (
+            "no spin" if direction == 0 else f"{'/'.join(f'{v:g}' for v in sorted(speeds))} degrees/s")
 
     def toggle_pin(self, point, *, radius: float = 0.0) -> tuple[int, int, bool] | None:
         """Pin the vertex nearest ``point`` (metres) on the body under it, or free it if pinned.
