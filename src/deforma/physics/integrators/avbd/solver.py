@@ -529,7 +529,7 @@ class AVBD(Integrator):
     #: apart than JOINT_TOLERANCE (m), at most JOINT_PASSES
     JOINT_TOLERANCE = 1e-5
     JOINT_PASSES = 200
-    #: The fewest sweeps of a step with a joint on a soft body (see :meth:`_solve`).
+    #: The fewest sweeps of a step with a joint between two soft bodies (see :meth:`_solve`).
     SOFT_JOINT_SWEEPS = 20
 
     def __init__(self, **options):
@@ -976,11 +976,12 @@ class AVBD(Integrator):
         patches = self._clusters(model, x_n)
         most = 0.0
         sweeps = opts["iterations"]
-        if soft_joints:
-            # a joint between soft bodies couples its two triangles' vertices stiffly, which a
-            # vertex sweep relaxes slowly: at 10 sweeps a chain of six soft links hanging
-            # still began to swing by itself (0.5 mm/s at 2 s, 13 cm/s at 4.5 s), at 20 it
-            # hangs at 0.1 mm/s
+        if soft_joints and ((jr.block < 0) & (jr.fv[:, ::3] >= 0)).all(axis=1).any():
+            # a joint between two soft bodies couples its two triangles' vertices stiffly,
+            # which a vertex sweep relaxes slowly: at 10 sweeps a chain of six soft links
+            # hanging still began to swing by itself (0.5 mm/s at 2 s, 13 cm/s at 4.5 s), at
+            # 20 it hangs at 0.1 mm/s. (A soft body joined to a rigid one or to the world
+            # keeps the budget: the car's tyres on their hubs, a jelly hung from a point.)
             sweeps = max(sweeps, self.SOFT_JOINT_SWEEPS)
         it = 0
         gas = self._gas[1] if model.has_pressure else None
