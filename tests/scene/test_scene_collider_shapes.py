@@ -146,7 +146,7 @@ def test_image_collider_from_a_builtin_texture_keeps_its_hole():
     ({"shape": "polygon", "points": [[0, 0], [1, 0], [0, 1]], "holes": [[[0, 0], [1, 1]]]},
      "collider[1].holes[0]: expected at least three points"),
     ({"shape": "image", "source": "nowhere"}, "collider[1].source: unknown picture 'nowhere'; allowed: a built-in "
-                                              "picture (ramp, armadillo, bunny, donut) or an image file"),
+                                              "picture (bumps, ramp, armadillo, bunny, donut) or an image file"),
     ({"shape": "rect", "colour": "#ffffff"}, "collider[1].colour: unknown key; did you mean 'color'?"),
     ({"shape": "segment", "a": [0, 0], "b": [1, 0], "angular_velocity": 1e7},
      "collider[1].angular_velocity: must be in [-1e+06, 1e+06] degrees/s"),
