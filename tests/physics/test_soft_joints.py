@@ -25,19 +25,9 @@ def energy(w):
                + G * (b.vertex_masses * b.positions[:, 1]).sum() for b in w.bodies)
 
 
-def soft_point(j, side):
-    """Where the soft ``side`` (0: a, 1: b) of joint ``j`` holds it now."""
-    body = j.a if side == 0 else j.b
-    tri, weights = j._frame[1][side], j._frame[2][side]
-    return weights @ body.positions[tri]
-
-
-def rigid_point(j, side):
-    """Where the rigid ``side`` of joint ``j`` holds it now (its frame of two vertices)."""
-    body = j.a if side == 0 else j.b
-    i0, i1, alpha, beta = j._frame[0][side]
-    x0, d = body.positions[i0], body.positions[i1] - body.positions[i0]
-    return x0 + alpha * d + beta * np.array([-d[1], d[0]])
+def gap(j):
+    """How far apart the joint's two sides hold it now (m)."""
+    return float(np.hypot(*(j._side_point(0) - j._side_point(1))))
 
 
 def test_a_jelly_hung_by_a_pin_hangs_there_and_the_pin_carries_its_weight():
@@ -64,7 +54,7 @@ def test_two_soft_links_swing_as_a_double_pendulum_without_gaining_energy():
     for _ in range(300):
         w.step()
         assert energy(w) <= e0 + 1e-6
-        gaps.append(np.hypot(*(soft_point(hinge, 0) - soft_point(hinge, 1))))
+        gaps.append(gap(hinge))
     assert max(gaps) < 1e-3 and gaps[-1] < 1e-4
     assert energy(w) < e0 - 20.0  # it swung down (and its damping took some)
     assert np.hypot(*hinge.force) == pytest.approx(b.mass * G, rel=0.1)  # swinging slowly, hanging b
@@ -83,7 +73,7 @@ def test_a_soft_link_holds_a_rigid_weight_at_its_pin():
     for _ in range(600):
         w.step()
         assert energy(w) <= e0 + 0.1  # (the rigid-soft pair trades a little with the link's stretch)
-    assert np.hypot(*(soft_point(pin, 0) - rigid_point(pin, 1))) < 1e-3
+    assert gap(pin) < 1e-3
     assert pin.force[1] == pytest.approx(-crate.mass * G, rel=0.05)  # the crate hangs from a
     assert (signed_areas(a.positions, a.triangles) > 0).all()
 
@@ -146,3 +136,12 @@ def test_joined_bodies_may_overlap_where_they_are_pinned():
     w.join(a, b, at=(0.28, 0.0))
     b.collide = True
     assert b.collide
+
+
+def test_removing_a_joint_lets_its_soft_bodies_collide_again():
+    w = deforma.World(dt=1 / 60)
+    a, b = link(w, 0.0), link(w, 0.26)
+    j = w.join(a, b, at=(0.28, 0.0))
+    assert list(w.model.contact.joined) == [1, 0]
+    w.remove_joint(j)
+    assert len(w.model.contact.joined) == 0

@@ -262,7 +262,7 @@ class World:
                 links.append((index[id(p.a)], index[id(p.b)]))
             elif getattr(p.b, "moving", False):
                 kept[index[id(p.a)]] = True  # on a moving collider
-        links += [(j.a._index, j.b._index) for j in self._joints if j.b is not None]
+        links += self._joined_pairs()
         self._island = islands(len(bodies), np.array(links, np.int64).reshape(-1, 2))
         asleep = np.array([b._asleep for b in bodies], bool)
         speed = fastest_vertex(self._state.v, self._model.body_vertex_offsets)
@@ -530,13 +530,20 @@ class World:
         (:mod:`deforma.physics.rigid`)."""
         return self._integrator.solves_rigid
 
+    def _joined_pairs(self) -> list[tuple[int, int]]:
+        """The pairs of body indices the joints hold together (not the world's joints)."""
+        return [(j.a._index, j.b._index) for j in self._joints if j.b is not None]
+
     def _rigid_solve_changed(self) -> None:
-        """Who moves the rigid bodies may have changed (the integrator, or the joints): their
-        contact switches follow, and their outlines are packed again or no more."""
+        """Who moves the rigid bodies may have changed (the integrator, or the joints): the
+        joined pairs' contact switch (soft bodies' too), the rigid bodies' contact switches,
+        and their outlines packed again or no more."""
         model = getattr(self, "_model", None)
-        if model is None or not model.n_vertices or not model.rigid.any():
+        if model is None or not model.n_vertices:
             return
-        model.set_joined([(j.a._index, j.b._index) for j in self._joints if j.b is not None])
+        model.set_joined(self._joined_pairs())
+        if not model.rigid.any():
+            return
         for body in self._bodies:
             if body.material.is_rigid:
                 model.set_contact_parameters(body._index, **self._contact_parameters(body))
@@ -774,7 +781,7 @@ class World:
             src = body._tear_source
             self._model.take_rest_shape(body._index, shape, None if isinstance(src, slice) else src)
         if self._joints:
-            self._model.set_joined([(j.a._index, j.b._index) for j in self._joints if j.b is not None])
+            self._model.set_joined(self._joined_pairs())
         self._model_bodies = list(self._bodies)
         self._state = State(x, v)
         packed = self._control.colliders
@@ -1161,7 +1168,6 @@ class World:
         j = Joint(self, a, b, kind, point, np.concatenate(local), turn, stiffness, damping, motor_speed, max_torque,
                   frame=(frames, tris, weights, ref), break_force=break_force)
         self._joints.append(j)
-        self._model.set_joined([(j.a._index, j.b._index) for j in self._joints if j.b is not None])
         self._rigid_solve_changed()
         return j
 
