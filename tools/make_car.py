@@ -75,6 +75,21 @@ def fmt(a) -> str:
     return "[" + ", ".join("[" + ", ".join(f"{v:.6g}" for v in row) + "]" for row in np.asarray(a).tolist()) + "]"
 
 
+#: The tyres' rubber.
+TYRE = """material = "corotated"
+youngs_modulus = 150000.0
+poisson_ratio = 0.4
+density = 400.0
+material_damping = 0.01"""
+
+
+def mesh_body(mesh: Mesh, at, material: str, color: str) -> str:
+    """A ``[[body]]`` table of ``mesh`` (``shape = "mesh"``) placed at ``at``, of ``material``
+    (its keys' lines)."""
+    return (f'[[body]]\nshape = "mesh"\nvertices = {fmt(mesh.vertices)}\ntriangles = {fmt(mesh.triangles)}\n'
+            f'position = [{at[0]:.4f}, {at[1]:.4f}]\n{material}\ncolor = "{color}"\n')
+
+
 def scene(top_px: float) -> str:
     tyre, hub = ring(R_TYRE, R_RIM, 4), ring(R_HUB, 0.0, 3)
     x0 = -LENGTH * SCALE / 2 + 1.0           # the car starts 1 m from the level's left end
@@ -108,28 +123,9 @@ density = 200.0
 color = "#2e86de"
 ''')
     for k, dx in enumerate((-0.45, 0.45)):
-        out.append(f'''# wheel {k}: its hub (rigid) and its tyre (soft rubber)
-[[body]]
-shape = "mesh"
-vertices = {fmt(hub.vertices)}
-triangles = {fmt(hub.triangles)}
-position = [{x0 + dx:.4f}, {y:.4f}]
-material = "rigid"
-density = 400.0
-color = "#dfe4ea"
-
-[[body]]
-shape = "mesh"
-vertices = {fmt(tyre.vertices)}
-triangles = {fmt(tyre.triangles)}
-position = [{x0 + dx:.4f}, {y:.4f}]
-material = "corotated"
-youngs_modulus = 150000.0
-poisson_ratio = 0.4
-density = 400.0
-material_damping = 0.01
-color = "#2f3542"
-''')
+        out.append(f"# wheel {k}: its hub (rigid) and its tyre (soft rubber)\n"
+                   + mesh_body(hub, (x0 + dx, y), 'material = "rigid"\ndensity = 400.0', "#dfe4ea") + "\n"
+                   + mesh_body(tyre, (x0 + dx, y), TYRE, "#2f3542"))
     height_m = (top_px + 10) * SCALE
     out.append(f'''# the level: white ground on black, its flat top at y = 0
 [[collider]]

@@ -292,22 +292,12 @@ def test_rope_of_soft_links_swings_its_weight_without_gaining_energy():
         return sum(0.5 * (b.vertex_masses * (b.velocities ** 2).sum(1)).sum()
                    + 9.81 * (b.vertex_masses * b.positions[:, 1]).sum() for b in w.bodies)
 
-    def gap(j):  # the soft side a's point from the other side's (the world's, a link's or the weight's)
-        p = j._frame[2][0] @ j.a.positions[j._frame[1][0]]
-        if j.b is None:
-            return np.hypot(*(p - j.anchor))
-        if j.b.material.is_rigid:
-            i0, i1, alpha, beta = j._frame[0][1]
-            x0, d = j.b.positions[i0], j.b.positions[i1] - j.b.positions[i0]
-            return np.hypot(*(p - x0 - alpha * d - beta * np.array([-d[1], d[0]])))
-        return np.hypot(*(p - j._frame[2][1] @ j.b.positions[j._frame[1][1]]))
-
     e0, start = energy(), weight.center_of_mass.copy()
     for _ in range(180):
         w.step()
         assert energy() <= e0 + 1e-6
     assert weight.center_of_mass[1] < start[1] - 0.5  # it swung down
-    assert max(gap(j) for j in w.joints) < 2e-3
+    assert max(np.hypot(*(j._side_point(0) - j._side_point(1))) for j in w.joints) < 2e-3
     for b in links:
         assert (signed_areas(b.positions, b.triangles) > 0).all()
 
@@ -333,8 +323,4 @@ def test_car_drives_its_level_on_squashing_tyres():
     assert lowest < 0.49  # a 0.5 m tyre squashed by more than a centimetre
     for j in w.joints:
         if j.motor_speed is None:  # a tyre's pin: its triangle's point on the hub's
-            tyre, hub = j.a, j.b
-            p = j._frame[2][0] @ tyre.positions[j._frame[1][0]]
-            i0, i1, alpha, beta = j._frame[0][1]
-            x0, d = hub.positions[i0], hub.positions[i1] - hub.positions[i0]
-            assert np.hypot(*(p - x0 - alpha * d - beta * np.array([-d[1], d[0]]))) < 3e-3
+            assert np.hypot(*(j._side_point(0) - j._side_point(1))) < 3e-3

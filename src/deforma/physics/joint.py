@@ -77,14 +77,28 @@ class Joint:
         point of the triangle it was made on."""
         a = self.a
         if not a.material.is_rigid:
-            tri, weights = self._frame[1][0], self._frame[2][0]
-            return weights @ a.positions[tri]
+            return self._side_point(0)
         x, m = a.positions, a.vertex_masses
         center = rigid_motion.center_of_mass(x, m)
         angle = rigid_motion.fit_angle(a.topology.rest_positions, x, m)
         c, s = math.cos(angle), math.sin(angle)
         lx, ly = self._local[0], self._local[1]
         return np.array([center[0] + c * lx - s * ly, center[1] + s * lx + c * ly])
+
+    def _side_point(self, side: int) -> np.ndarray:
+        """Where side ``side`` (0: ``a``, 1: ``b``) holds the joint now (m), as avbd's rows
+        read it: a rigid body's point on its frame of two vertices, a soft body's on the
+        triangle it was made on, the world's at the anchor. The two sides' points differ by
+        what the solver left of the joint's error."""
+        body = self.a if side == 0 else self.b
+        if body is None:
+            return np.array(self.anchor, np.float64)
+        x = body.positions
+        if not body.material.is_rigid:
+            return self._frame[2][side] @ x[self._frame[1][side]]
+        i0, i1, alpha, beta = self._frame[0][side]
+        d = x[i1] - x[i0]
+        return x[i0] + alpha * d + beta * np.array([-d[1], d[0]])
 
     @property
     def force(self) -> np.ndarray:

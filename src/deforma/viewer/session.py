@@ -729,6 +729,7 @@ class Session:
             # the message starts with the scene file's name, which says nothing in a panel
             raise ValueError(str(e).split(": ", 1)[-1]) from None
         self.world = world
+        self._drive_speeds.clear()  # keyed by the old world's joints
         self.generation += 1
 
     def reset(self) -> None:

@@ -231,13 +231,14 @@ def start_joint_rows(x_n, blocks, jr, k_floor, vertex_mass, inv_mass, carry, sof
     for j in range(jr.kind.shape[0]):
         jr.param[j, 5] = h
         floor = np.inf
-        ph = np.zeros(2)
-        pts = np.zeros(4)
+        ex = ey = turn = 0.0  # side a's point and frame angle less side b's
         for side in range(2):
             kb = jr.block[j, side]
             b = 3 * side
+            sg = 1.0 if side == 0 else -1.0
             if kb >= 0:
-                px, py, ph[side] = frame_point(x_n, jr.fv[j, b], jr.fv[j, b + 1], jr.fw[j, b], jr.fw[j, b + 1])
+                px, py, theta = frame_point(x_n, jr.fv[j, b], jr.fv[j, b + 1], jr.fw[j, b], jr.fw[j, b + 1])
+                turn += sg * theta
                 rx, ry = px - blocks.c_n[kb, 0], py - blocks.c_n[kb, 1]
                 jr.arm[j, 2 * side], jr.arm[j, 2 * side + 1] = rx, ry
                 if not blocks.held[kb]:
@@ -256,9 +257,10 @@ def start_joint_rows(x_n, blocks, jr, k_floor, vertex_mass, inv_mass, carry, sof
                             k_side += vertex_mass[i]
                     if k_side > 0.0:
                         floor = min(floor, k_side)
-            pts[2 * side], pts[2 * side + 1] = px, py
-        jr.err0[j, 0], jr.err0[j, 1] = pts[0] - pts[2], pts[1] - pts[3]
-        turn = ph[0] - ph[1] - jr.param[j, 0]
+            ex += sg * px
+            ey += sg * py
+        jr.err0[j, 0], jr.err0[j, 1] = ex, ey
+        turn -= jr.param[j, 0]
         jr.err0[j, 2] = np.arctan2(np.sin(turn), np.cos(turn))  # wrapped to (-pi, pi]
         k0 = k_floor * floor if floor < np.inf else 0.0
         for r in range(4):
