@@ -227,10 +227,12 @@ def pack_rows(joints, model, bodies: np.ndarray):
 def read_rows(joints, rows, dt: float) -> None:
     """After a step of ``dt`` s: each joint's force and torque (the rows' totals over the
     step, per second) and its rows' warm start for the next."""
+    from .integrators.avbd.joints import LAM, PEN, TOTAL
+
     for i, j in enumerate(joints):
-        j._force[...] = rows.total[i] / dt
-        j._lam[...] = rows.lam[i]
-        j._pen[...] = rows.pen[i]
+        j._force[...] = rows.jf[i, TOTAL:TOTAL + 3] / dt
+        j._lam[...] = rows.jf[i, LAM:LAM + 4]
+        j._pen[...] = rows.jf[i, PEN:PEN + 4]
 
 
 def frame(x: np.ndarray, point) -> tuple[int, int, float, float, float]:

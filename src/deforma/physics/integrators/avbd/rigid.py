@@ -42,7 +42,13 @@ from ...colliders.response import CORNER_NX, CORNER_NY, CORNER_S
 from .blocks import outer_block
 from ...rigid.joints import SPRING, WELD
 from .joints import (
+    ERR0,
+    FV,
+    FW,
+    KIND,
+    MOTOR,
     RIGID_JOINTS,
+    SOFT,
     carry_joint_points,
     held_point,
     joint_block,
@@ -114,7 +120,7 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
             if inv_mass[i] == 0.0:
                 pinned = True
                 break
-            joined = joined or rs.jv_start[i + 1] > rs.jv_start[i]
+            joined = joined or rs.jv[i + 1] > rs.jv[i]
             m = mass_h2[i]
             sm += m
             cx += m * x[i, 0]
@@ -151,15 +157,14 @@ def rigid_correction(x, x_n, y, mass_h2, inv_mass, body_start, grab_slot, grab_p
         if joined:
             # its joints' point rows, each as a point of the body: J = [I | perp(p - c)]
             for i in range(lo, hi):
-                for p in range(rs.jv_start[i], rs.jv_start[i + 1]):
-                    code = rs.jv_entry[p]
+                for p in range(rs.jv[i], rs.jv[i + 1]):
+                    code = rs.jv[p]
                     if code % 3:
                         continue
                     j, side = code // 6, (code // 3) % 2
-                    pax, pay = held_point(x, rs.jblock, rs.jfv, rs.jfw, rs.jpoint, j, 0)
-                    pbx, pby = held_point(x, rs.jblock, rs.jfv, rs.jfw, rs.jpoint, j, 1)
-                    fx, fy, kp = point_force(rs.jkind, rs.jparam, rs.jlam, rs.jpen, rs.jerr0, j, pax - pbx,
-                                             pay - pby)
+                    pax, pay = held_point(x, rs.ji, rs.jf, j, 0)
+                    pbx, pby = held_point(x, rs.ji, rs.jf, j, 1)
+                    fx, fy, kp = point_force(rs.ji, rs.jf, j, pax - pbx, pay - pby)
                     sg = 1.0 if side == 0 else -1.0
                     rx, ry = (pax - cx, pay - cy) if side == 0 else (pbx - cx, pby - cy)
                     g0 += sg * fx
@@ -263,19 +268,19 @@ def rigid_energy(x, x_n, y, mass_h2, verts, p0, p1, lo, hi, grab_slot, grab_pull
                                                    rs.cf, st, c)
             e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
         # a soft body's joints, each side once (at its triangle's first vertex)
-        for p in range(rs.jv_start[i], rs.jv_start[i + 1]):
-            code = rs.jv_entry[p]
+        for p in range(rs.jv[i], rs.jv[i + 1]):
+            code = rs.jv[p]
             if code % 3:
                 continue
             j, side = code // 6, (code // 3) % 2
             px_, py_ = 0.0, 0.0
             for slot in range(3):
-                vx, vy = _moved(x, rs.jfv[j, 3 * side + slot], lo, hi, cx, cy, dx, dy, co, si)
-                px_ += rs.jfw[j, 3 * side + slot] * vx
-                py_ += rs.jfw[j, 3 * side + slot] * vy
-            ox, oy = held_point(x, rs.jblock, rs.jfv, rs.jfw, rs.jpoint, j, 1 - side)
+                vx, vy = _moved(x, rs.ji[j, FV + 3 * side + slot], lo, hi, cx, cy, dx, dy, co, si)
+                px_ += rs.jf[j, FW + 3 * side + slot] * vx
+                py_ += rs.jf[j, FW + 3 * side + slot] * vy
+            ox, oy = held_point(x, rs.ji, rs.jf, j, 1 - side)
             sg = 1.0 if side == 0 else -1.0
-            e += joint_point_energy(rs.jkind, rs.jparam, rs.jlam, rs.jpen, rs.jerr0, j, sg * (px_ - ox),
+            e += joint_point_energy(rs.ji, rs.jf, j, sg * (px_ - ox),
                                     sg * (py_ - oy))
     return e
 
@@ -630,7 +635,7 @@ def rigid_second_order(blocks, jr, keep, h):
         for p in range(jr.j_start[k], jr.j_start[k + 1]):
             # a soft body's joint: its vertices are swept with the contact rows' (and no
             # pass over the jointed blocks alone moves it)
-            touched = touched or jr.soft[jr.j_entry[p] // 2]
+            touched = touched or jr.ji[jr.j_entry[p] // 2, SOFT] != 0
         if touched:
             jr.island_touch[jr.island[k]] = True
         ok = blocks.hist[k] == h and not touched
@@ -642,10 +647,10 @@ def rigid_second_order(blocks, jr, keep, h):
         if ok:
             for p in range(jr.j_start[k], jr.j_start[k + 1]):
                 j = jr.j_entry[p] // 2
-                slack = abs(jr.err0[j, 0]) + abs(jr.err0[j, 1])
-                if jr.kind[j] == WELD:
-                    slack += abs(jr.err0[j, 2]) * blocks.radius[k]
-                if jr.motor[j] or jr.soft[j] or (jr.kind[j] != SPRING and slack > JOINT_SLACK):
+                slack = abs(jr.jf[j, ERR0]) + abs(jr.jf[j, ERR0 + 1])
+                if jr.ji[j, KIND] == WELD:
+                    slack += abs(jr.jf[j, ERR0 + 2]) * blocks.radius[k]
+                if jr.ji[j, MOTOR] != 0 or jr.ji[j, SOFT] != 0 or (jr.ji[j, KIND] != SPRING and slack > JOINT_SLACK):
                     ok = False
         if not ok:
             island_ok[jr.island[k]] = False

@@ -60,9 +60,8 @@ from .joints import joint_vertex_block
 #: (:func:`~deforma.physics.colliders.response.corner_contacts`' ``cpairs`` and ``cf``, their
 #: state ``cstate`` and incidence ``c_start``, ``c_entry``), and which vertices hold a gas
 #: (``gas_start``, :class:`~deforma.physics.integrators.avbd.gas.GasSet`'s ``start``), the
-#: joints on soft bodies (``jv_start``, ``jv_entry`` and the ``j``-prefixed fields: the
-#: :class:`~deforma.physics.integrators.avbd.joints.JointRows`' ``v_start``, ``v_entry``,
-#: ``block``, ``fv``, ``fw``, ``kind``, ``param``, ``lam``, ``pen``, ``err0`` and ``point``),
+#: joints on soft bodies (``jv``, ``ji``, ``jf``: the
+#: :class:`~deforma.physics.integrators.avbd.joints.JointRows`' ``v``, ``ji`` and ``jf``),
 #: and whether each vertex takes part in any row, holds a gas or a joint (``rowed`` (N,)
 #: bool, :func:`mark_rowed`).
 #: Every field is an array, and kernels hand the set to a helper only for vertices with
@@ -71,8 +70,7 @@ from .joints import joint_vertex_block
 #: vertex sweep of the README bunny's springs three times slower and its affine patches
 #: five times.
 RowSet = namedtuple("RowSet", ["vertex_row", "planes", "rows", "bidx", "bgeo", "bstate", "b_start", "b_entry",
-                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas_start", "jv_start", "jv_entry",
-                               "jblock", "jfv", "jfw", "jkind", "jparam", "jlam", "jpen", "jerr0", "jpoint",
+                               "cpairs", "cf", "cstate", "c_start", "c_entry", "gas_start", "jv", "ji", "jf",
                                "rowed"])
 
 #: Columns of a step's body-row geometry ``bgeo`` (C, BODY_COLUMNS): where on the edge, the
@@ -572,9 +570,8 @@ def row_blocks(x, x_n, i, rs, whole):
         hxx += cxx
         hxy += cxy
         hyy += cyy
-    if not whole and rs.jv_start[i + 1] > rs.jv_start[i]:  # (the whole-body step takes the joints whole)
-        cgx, cgy, cxx, cxy, cyy = joint_vertex_block(x, i, rs.jv_start, rs.jv_entry, rs.jblock, rs.jfv, rs.jfw,
-                                                     rs.jkind, rs.jparam, rs.jlam, rs.jpen, rs.jerr0, rs.jpoint)
+    if not whole and rs.jv[i + 1] > rs.jv[i]:  # (the whole-body step takes the joints whole)
+        cgx, cgy, cxx, cxy, cyy = joint_vertex_block(x, i, rs.jv, rs.ji, rs.jf)
         gx += cgx
         gy += cgy
         hxx += cxx
@@ -583,14 +580,15 @@ def row_blocks(x, x_n, i, rs, whole):
     return gx, gy, hxx, hxy, hyy
 
 
-def mark_rowed(vertex_row, b_start, c_start, gas_start, jv_start, rowed):
+def mark_rowed(vertex_row, b_start, c_start, gas_start, jv, rowed):
     """Into ``rowed`` (N,) bool: whether each vertex takes part in any contact row this step,
     holds a gas or holds a soft body's joint."""
     np.greater_equal(vertex_row, 0, out=rowed)
     rowed |= b_start[1:] > b_start[:-1]
     rowed |= c_start[1:] > c_start[:-1]
     rowed |= gas_start[1:] > gas_start[:-1]
-    rowed |= jv_start[1:] > jv_start[:-1]
+    n = len(rowed)
+    rowed |= jv[1:n + 1] > jv[:n]
 
 
 @njit(cache=True)

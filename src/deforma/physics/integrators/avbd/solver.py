@@ -85,7 +85,10 @@ from .clusters import cluster_members, cluster_sweep, make_clusters
 from .colouring import colour_vertices
 from .gas import gas_areas, gas_block, gas_moved, gas_set
 from .joints import (
+    BLOCK,
+    FV,
     RIGID_JOINTS,
+    SOFT,
     SOFT_JOINTS,
     joint_gap,
     joint_totals,
@@ -737,7 +740,8 @@ class AVBD(Integrator):
                 if second and parts == 1 and self._history == hs:
                     np.copyto(self._held_before, self._held)
                     rows_held(self._held, self._touch, count, ctopo, found, n_body, self._cpairs, self._n_corner)
-                    self._held |= jr.v_start[1:] > jr.v_start[:-1]  # a joint's vertices: as a contact's
+                    n_v = len(self._held)
+                    self._held |= jr.v[1:n_v + 1] > jr.v[:n_v]  # a joint's vertices: as a contact's
                     anchor = self._anchor
                     free = second_order_targets(x_n, self._y, self._v_n, self._x_prev, self._v_prev, self._x_end,
                                                 self._v_end, anchor, mass_h2, model.vertex_mass, inv_mass, self._held,
@@ -829,7 +833,7 @@ class AVBD(Integrator):
         if jr is None:
             k = 0 if blocks is None else len(blocks.lo)
             if (self._no_joints is None or len(self._no_joints.j_start) != k + 1
-                    or len(self._no_joints.v_start) != model.n_vertices + 1):
+                    or self._no_joints.v[0] != model.n_vertices + 1):
                 self._no_joints = no_joint_rows(k, model.n_vertices)
             return self._no_joints
         return jr
@@ -941,11 +945,10 @@ class AVBD(Integrator):
             self._gas = (model, gas_set(model))
         gas = self._gas[1]
         np.multiply(model.body_pressure, model.body_pressure_area, out=gas.load)  # settable live
-        mark_rowed(self._vertex_row, self._b_start, self._c_start, gas.start, jr.v_start, self._rowed)
+        mark_rowed(self._vertex_row, self._b_start, self._c_start, gas.start, jr.v, self._rowed)
         return RowSet(self._vertex_row, self._planes, self._rows, self._bidx, self._bgeo, self._bstate, self._b_start,
                       self._b_entry, self._cpairs, self._cf, self._cstate, self._c_start, self._c_entry, gas.start,
-                      jr.v_start, jr.v_entry, jr.block, jr.fv, jr.fw, jr.kind, jr.param, jr.lam, jr.pen, jr.err0,
-                      jr.point, self._rowed)
+                      jr.v, jr.ji, jr.jf, self._rowed)
 
     def _solve(self, model, topo, control, x, x_n, mass_h2, inv_mass, count, n_body, rs, h, tol, h_rigid):
         """The sweeps of one substep, with the rows' dual steps and Chebyshev's weights
@@ -954,7 +957,7 @@ class AVBD(Integrator):
         blocks = self._rigid[2]
         jr = self._joint_rows(model, blocks)
         coupled = None
-        soft_joints = bool(jr.soft.any())
+        soft_joints = bool(jr.ji[:, SOFT].any())
         if blocks is not None and len(blocks.lo) and model.fused and not model.has_pressure:
             # the soft vertices with contact rows: swept again after each pass over the rigid
             # blocks (one serial colour: they are all rowed). Swept only with the others, a
@@ -976,7 +979,7 @@ class AVBD(Integrator):
         patches = self._clusters(model, x_n)
         most = 0.0
         sweeps = opts["iterations"]
-        if soft_joints and ((jr.block < 0) & (jr.fv[:, ::3] >= 0)).all(axis=1).any():
+        if soft_joints and ((jr.ji[:, BLOCK:BLOCK + 2] < 0) & (jr.ji[:, FV:FV + 6:3] >= 0)).all(axis=1).any():
             # a joint between two soft bodies couples its two triangles' vertices stiffly,
             # which a vertex sweep relaxes slowly: at 10 sweeps a chain of six soft links
             # hanging still began to swing by itself (0.5 mm/s at 2 s, 13 cm/s at 4.5 s), at
@@ -1038,7 +1041,7 @@ class AVBD(Integrator):
                 chebyshev(x, self._x1, self._x2, inv_mass, self._vertex_row, omega)
             if tol > 0.0 and most <= tol * tol:
                 break
-        if blocks is not None and len(jr.kind):
+        if blocks is not None and len(jr.ji):
             # the joints to a tolerance: passes over the jointed bodies alone (cheap beside a
             # sweep). At the budget's passes a weight of 1000 links under a chain of 20 sagged
             # 4.7 % of its length before the rows carried it; with these, 0.5 %. Not where
