@@ -1,4 +1,4 @@
-"""Sleeping (World(sleep=True), deforma.physics.sleeping): islands at rest stop being stepped,
+"""Sleeping (World(sleep=True), the default; deforma.physics.sleeping): islands at rest stop being stepped,
 and wake when disturbed, moving exactly as they would have without sleep."""
 
 import copy
@@ -134,11 +134,38 @@ def test_a_body_on_a_moving_collider_stays_awake():
     assert not box.sleeping and box.center_of_mass[1] == pytest.approx(0.150 + 2e-3, abs=1e-5)
 
 
-def test_sleep_off_by_default_and_from_scene_files(tmp_path):
-    assert not deforma.World().sleep
+def test_sleep_on_by_default_and_from_scene_files(tmp_path):
+    assert deforma.World().sleep
     with pytest.raises(ValueError, match="sleep"):
         deforma.World(sleep="yes")
-    w = _stack(2)
     path = tmp_path / "s.toml"
-    deforma.save_scene(w, path)
-    assert deforma.load_scene(path).sleep
+    for sleep in (True, False):
+        deforma.save_scene(_stack(2, sleep=sleep), path)
+        assert deforma.load_scene(path).sleep is sleep
+    path.write_text('[[body]]\nshape = "box"\ncorners = [[0, 0], [1, 0], [1, 1], [0, 1]]\n')
+    assert deforma.load_scene(path).sleep  # a scene that does not say sleeps
+
+
+def test_a_default_world_puts_a_jelly_on_the_floor_to_sleep():
+    w = deforma.World()
+    w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0.0))
+    body = w.add_body(_box(0.4, 4), position=(0.0, 0.25), material=deforma.Material.preset("jelly"))
+    _run(w, 4.0)
+    assert body.sleeping
+    assert np.all(body.velocities == 0.0)
+
+
+def test_a_body_drifting_slowly_through_space_keeps_its_momentum():
+    # nothing holds it (no collider, pin or joint to the world): it never sleeps, where a
+    # slow island would stop under Box2D's rule
+    w = deforma.World(gravity=(0.0, 0.0))
+    body = w.add_body(_box(), position=(0.0, 0.0), material=WOOD)
+    body.velocities = np.tile([2e-3, -1e-3], (body.n_vertices, 1))  # 2.2 mm/s, below the sleep speed
+    _run(w, 2.0)
+    assert not body.sleeping
+    np.testing.assert_allclose(body.velocities.mean(axis=0), [2e-3, -1e-3], rtol=1e-9)
+    # pinned, a body at rest falls asleep even in space
+    still = w.add_body(_box(), position=(2.0, 0.0), material=WOOD)
+    still.pin([0])
+    _run(w, 1.0)
+    assert still.sleeping and not body.sleeping

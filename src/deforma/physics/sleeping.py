@@ -4,7 +4,9 @@ Bodies form *islands*: two bodies touching (a contact pair of the last step,
 :func:`~deforma.physics.contact.pairs.group_pairs`) or joined by a joint are in one island;
 colliders join nothing. After each step every body's fastest vertex is measured; a body
 slower than :data:`SLEEP_SPEED` for :data:`SLEEP_TIME` on end is *still*. An island whose
-bodies are all still falls asleep as a whole: its velocities become zero and its vertices
+bodies are all still, and which the world holds (one of its bodies pinned, joined to the
+world or touching a collider: not a body drifting slowly through space, whose momentum
+sleep would take), falls asleep as a whole: its velocities become zero and its vertices
 are held as pins are (infinite mass) until it wakes, so the bodies awake meet it as a fixed
 shape. When every body sleeps the step costs no integration at all.
 
@@ -61,7 +63,7 @@ def islands(n_bodies: int, links: np.ndarray) -> np.ndarray:
 
 
 def sleep_changes(asleep: np.ndarray, still: np.ndarray, speed: np.ndarray, label: np.ndarray,
-                  kept_awake: np.ndarray, dt: float):
+                  kept_awake: np.ndarray, dt: float, held: np.ndarray | None = None):
     """One step of the rule (module docstring) over B bodies: ``(fall_asleep, wake, still)``,
     masks of the bodies that fall asleep and that wake now, and the time each has been still
     (s).
@@ -80,15 +82,26 @@ def sleep_changes(asleep: np.ndarray, still: np.ndarray, speed: np.ndarray, labe
         Bodies something keeps awake this step (grabbed, pushed, on a moving collider).
     dt : float
         The step (s).
+    held : (B,) bool, optional
+        Bodies the world holds: pinned, joined to the world, or touching a collider. An
+        island falls asleep only with one of them in it (or a body asleep already); None:
+        every body counts as held.
 
     Examples
     --------
     Two bodies resting on each other for 0.6 s and a third one moving:
 
     >>> f, w, s = sleep_changes(np.zeros(3, bool), np.array([0.6, 0.6, 0.6]), np.array([0.0, 0.001, 1.0]),
-    ...                         np.array([0, 0, 1]), np.zeros(3, bool), 1 / 60)
+    ...                         np.array([0, 0, 1]), np.zeros(3, bool), 1 / 60, np.array([True, False, False]))
     >>> f.tolist(), w.tolist()
     ([True, True, False], [False, False, False])
+
+    The same two drifting slowly in space, touching nothing that holds them, stay awake:
+
+    >>> f, w, s = sleep_changes(np.zeros(3, bool), np.array([0.6, 0.6, 0.6]), np.array([0.0, 0.001, 1.0]),
+    ...                         np.array([0, 0, 1]), np.zeros(3, bool), 1 / 60, np.zeros(3, bool))
+    >>> f.tolist()
+    [False, False, False]
     """
     still = np.where((speed < SLEEP_SPEED) & ~kept_awake, still + dt, 0.0)
     still[asleep] = SLEEP_TIME  # an asleep body counts as still
@@ -99,5 +112,11 @@ def sleep_changes(asleep: np.ndarray, still: np.ndarray, speed: np.ndarray, labe
                            minlength=n) > 0
     wake = asleep & restless[label]
     fall_asleep = ~asleep & ~restless[label]
+    if held is not None:
+        # a body drifting slowly through space keeps its momentum: an island sleeps only
+        # where the world holds it (Box2D lets any slow island sleep, which stops a body
+        # drifting at 4 mm/s in zero gravity)
+        supported = np.bincount(label, weights=(held | asleep).astype(float), minlength=n) > 0
+        fall_asleep &= supported[label]
     still[wake] = 0.0
     return fall_asleep, wake, still

@@ -100,6 +100,10 @@ class World:
         shortest boundary edge). ``None`` (default): each body uses 5% of its median
         boundary edge (``body.contact_thickness``), which keeps bodies of any size visibly
         touching. Contacts are explained in ``docs/physics.md``.
+    sleep : bool, optional
+        Whether bodies at rest fall asleep (default True): an island of bodies touching or
+        joined, every vertex slower than 5 mm/s for 0.5 s, is no longer stepped until
+        something disturbs it (:attr:`sleep`, ``docs/physics.md``, Sleeping).
 
     Every parameter is also a settable attribute, validated the same way, and takes effect
     at the next step (bodies and colliders that do not override it follow the world).
@@ -125,7 +129,7 @@ class World:
     def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 60, substeps="auto", mass=1.0, stiffness=1000.0,
                  damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
                  integrator="avbd", contact_thickness=None, air_drag=0.0, material=None,
-                 integrator_options=None, sleep=False):
+                 integrator_options=None, sleep=True):
         self._bodies: list[Body] = []
         self._colliders: list[Collider] = []
         self._packed_colliders: tuple | None = None  # what was packed: (id, version) per collider
@@ -202,7 +206,7 @@ class World:
         """Whether bodies at rest fall asleep (:mod:`deforma.physics.sleeping`): an island of
         bodies touching or joined, all slower than ``SLEEP_SPEED`` (5 mm/s) for ``SLEEP_TIME``
         (0.5 s), stops being stepped, held as pinned, until something disturbs it (see
-        :attr:`Body.sleeping`). Off by default; setting it off wakes every body."""
+        :attr:`Body.sleeping`). On by default; setting it off wakes every body."""
         return self._sleep
 
     @sleep.setter
@@ -257,17 +261,24 @@ class World:
         index = {id(b): k for k, b in enumerate(bodies)}
         links = []
         kept = np.array([id(b) in kept_awake for b in bodies], bool)
+        # held by the world: pinned, joined to it, or touching a collider
+        held = np.array([bool(b._pinned.any()) for b in bodies], bool)
+        for j in self._joints:
+            if j.b is None and id(j.a) in index:
+                held[index[id(j.a)]] = True
         for p in self._pairs().values():
             if id(p.b) in index:
                 links.append((index[id(p.a)], index[id(p.b)]))
-            elif getattr(p.b, "moving", False):
-                kept[index[id(p.a)]] = True  # on a moving collider
+            else:
+                held[index[id(p.a)]] = True
+                if getattr(p.b, "moving", False):
+                    kept[index[id(p.a)]] = True  # on a moving collider
         links += self._joined_pairs()
         self._island = islands(len(bodies), np.array(links, np.int64).reshape(-1, 2))
         asleep = np.array([b._asleep for b in bodies], bool)
         speed = fastest_vertex(self._state.v, self._model.body_vertex_offsets)
         fall, wake, still = sleep_changes(asleep, np.array([b._still for b in bodies]), speed, self._island, kept,
-                                          self.dt)
+                                          self.dt, held)
         for b, t in zip(bodies, still):
             b._still = float(t)
         self._wake([b for b, w in zip(bodies, wake) if w])

@@ -179,7 +179,7 @@ class PhysicsSettings:
     air_drag: float = spec("float", 0.0, lo=0.0, unit="1/s",
                            doc="Every velocity decays as dv/dt = -air_drag v; a little lets stacks and heaps come "
                                "to rest.")
-    sleep: bool = spec("bool", False, doc="Bodies at rest fall asleep: an island of bodies touching or joined, "
+    sleep: bool = spec("bool", True, doc="Bodies at rest fall asleep: an island of bodies touching or joined, "
                                           "all slower than 5 mm/s for 0.5 s, stops being stepped until something "
                                           "disturbs it (docs/physics.md, Sleeping).")
     material: str = spec("str", "springs", choices=material_names,
