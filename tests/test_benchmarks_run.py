@@ -50,3 +50,14 @@ def test_unknown_topic_is_refused(capsys):
         run.main(["--only", "no-such-topic"])
     assert e.value.code == 2
     assert "unknown topic" in capsys.readouterr().err
+
+
+def test_bench_video_reads_the_runs_figures_and_refuses_an_unfinished_run():
+    load_run_module()  # benchmarks/ on sys.path
+    import bench_video
+
+    line = "demo: 300 frames, 9.97 s simulated in 5.10 s wall (0.5 s start-up; ...) -> demo.mp4\nBENCH_WALL 4.25\n"
+    assert bench_video.parse_run(line) == (9.97, 4.25)
+    with pytest.raises(RuntimeError, match="not a finished deforma run"):
+        bench_video.parse_run("deforma: error: something\nBENCH_WALL 0.2\n")
+    assert set(bench_video.GOALS) == {"mp4", "gif"} and "physics" in bench_video.CASES

@@ -391,9 +391,10 @@ def _run_scene(a, watch, shown: dict) -> int:
     if advice:
         print(f"note: {advice} (docs/integrators.md)", file=sys.stderr)
 
-    view = writer = None
+    view = writer = recorder = None
     if a.output:
         from .render import Renderer, WorldView, open_writer
+        from .render.recorder import FrameRecorder
 
         try:
             renderer = Renderer.headless(a.size, samples=a.samples)
@@ -415,11 +416,15 @@ def _run_scene(a, watch, shown: dict) -> int:
         if a.output:
             # inside the try: from here on an interrupt removes the temporary file
             writer = open_writer(a.output, fps=fps)
+            # frames drawn while the next ones are simulated, encoded in the writer's thread
+            recorder = FrameRecorder(view, writer)
         if a.export:
             export = _MeshExport(a.export, a.format or "obj", scene)
         # the scene's [[event]] explosions and [[pull]] grabs, frame by frame
-        playback = Playback(scene, world, fps=fps, view=view, writer=writer, record=bool(a.states))
+        playback = Playback(scene, world, fps=fps, record=bool(a.states))
         for k in playback.frames(n_frames):
+            if recorder is not None:
+                recorder.add()
             if export is not None:
                 export.write(world, k)
             if bar is not None:
@@ -427,6 +432,7 @@ def _run_scene(a, watch, shown: dict) -> int:
         # every output complete before any is put in place: a disk too full for the states
         # (or a video that could not be finished) keeps the earlier files as they were
         if writer is not None:
+            recorder.finish()
             writer.finish()
         if a.states:
             playback.recording.save(a.states)

@@ -331,6 +331,7 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
     camera = _camera(world, scene)
     picture = _picture_size(width, height, camera)
 
+    from .recorder import FrameRecorder
     from .renderer import Renderer
     from .video import open_writer
     from .world_view import WorldView
@@ -347,10 +348,13 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
         with tempfile.TemporaryDirectory(prefix="deforma-show-") as tmp:
             path = Path(tmp) / f"animation.{format}"
             with open_writer(path, fps=fps) as writer:
-                # the scene's explosions and pulls that are still ahead of the world's clock
-                playback = Playback(scene, world, fps=fps, view=view, writer=writer)
-                playback.play(n_frames)
+                # the scene's explosions and pulls that are still ahead of the world's clock; each
+                # frame drawn while the next is simulated (render/recorder.py)
+                recorder = FrameRecorder(view, writer)
+                for _ in Playback(scene, world, fps=fps).frames(n_frames):
+                    recorder.add()
+                recorder.finish()
             data = path.read_bytes()
     finally:
         renderer.release()
-    return Animation(data, format=format, fps=fps, size=picture, n_frames=n_frames, last_frame=playback.last_frame)
+    return Animation(data, format=format, fps=fps, size=picture, n_frames=n_frames, last_frame=recorder.last_frame)

@@ -361,6 +361,8 @@ class Renderer:
         self._target = target
         self._owns_fbo = target is None
         self._msaa = self._resolve = None
+        self._buffers = []        # off-screen (msaa or None, resolve) pairs; the current is _msaa/_resolve
+        self._buffer = 0
         self.size = (0, 0)
         self._samples = 0
         if self._owns_fbo:
@@ -396,18 +398,29 @@ class Renderer:
         self.size = (w, h)
         if not self._owns_fbo:
             return
-        for fb in (self._msaa, self._resolve):
-            if fb is not None:
-                for a in fb.color_attachments:
-                    a.release()
-                fb.release()
-        ctx = self.ctx
-        self._resolve = ctx.framebuffer(color_attachments=[ctx.renderbuffer((w, h), 4)])
-        if self._samples:
-            self._msaa = ctx.framebuffer(color_attachments=[ctx.renderbuffer((w, h), 4, samples=self._samples)])
-        else:
-            self._msaa = None
+        self._release_buffers()
+        self._buffers = [self._make_buffer()]
+        self._buffer = 0
+        self._msaa, self._resolve = self._buffers[0]
         self._readbuf = bytearray(w * h * 3)
+
+    def _make_buffer(self):
+        ctx, (w, h) = self.ctx, self.size
+        resolve = ctx.framebuffer(color_attachments=[ctx.renderbuffer((w, h), 4)])
+        msaa = None
+        if self._samples:
+            msaa = ctx.framebuffer(color_attachments=[ctx.renderbuffer((w, h), 4, samples=self._samples)])
+        return msaa, resolve
+
+    def _release_buffers(self):
+        for pair in self._buffers:
+            for fb in pair:
+                if fb is not None:
+                    for a in fb.color_attachments:
+                        a.release()
+                    fb.release()
+        self._buffers = []
+        self._msaa = self._resolve = None
 
     @property
     def framebuffer(self):
@@ -691,6 +704,9 @@ class Renderer:
         else:
             self.finish()
             fb = self._resolve
+        return self._read_framebuffer(fb, components)
+
+    def _read_framebuffer(self, fb, components: int = 3) -> np.ndarray:
         w, h = self.size
         if components == 3 and self._owns_fbo:
             fb.read_into(self._readbuf, components=3)
@@ -700,6 +716,61 @@ class Renderer:
         img = np.frombuffer(raw, dtype=np.uint8).reshape(h, w, components)
         # OpenGL rows run bottom-up; copy so the caller owns the array (the buffer is reused)
         return img[::-1].copy()
+
+    # -- frames in flight (headless: see render/recorder.py) -------------------------------
+    # The software rasteriser (Mesa's llvmpipe) draws in threads of its own once work is
+    # flushed, and waits only where the pixels are needed: drawing frame k into one buffer
+    # while frame k - 1 is still being drawn into another lets the simulation of the next
+    # frame run meanwhile (render/recorder.py).
+    @property
+    def buffer(self) -> int:
+        """The off-screen buffer drawn into and read by :meth:`read` (0 unless :meth:`use_buffer` chose another)."""
+        return self._buffer
+
+    def use_buffer(self, index: int) -> None:
+        """Draw into off-screen buffer ``index`` from now on; buffers beyond 0 are made, with
+        the same size and multisampling, on first use (each costs the memory of buffer 0).
+        :meth:`read` and :meth:`finish` work on this buffer.
+
+        Raises
+        ------
+        ValueError
+            If the renderer draws into a given ``target`` (a window) or ``index`` is not 0 to 7.
+        """
+        if not self._owns_fbo:
+            raise ValueError("a renderer drawing into a given target has no off-screen buffers")
+        if not (isinstance(index, int) and 0 <= index < 8):
+            raise ValueError(f"buffer index must be an integer in [0, 8), got {index!r}")
+        while len(self._buffers) <= index:
+            self._buffers.append(self._make_buffer())
+        self._buffer = index
+        self._msaa, self._resolve = self._buffers[index]
+
+    def resolve_buffer(self, index: int) -> None:
+        """Queue the multisampling resolve of buffer ``index`` (nothing without multisampling).
+
+        It waits for the buffer's drawing to be done, but not for the resolve itself: call
+        :meth:`flush` to start it, and :meth:`read_buffer` reads the result."""
+        msaa, resolve = self._buffers[index]
+        if msaa is not None:
+            self.ctx.copy_framebuffer(resolve, msaa)
+
+    def read_buffer(self, index: int) -> np.ndarray:
+        """The picture of buffer ``index`` after :meth:`resolve_buffer`: (H, W, 3) uint8, row 0 on top.
+
+        Read a buffer before queueing more work for the rasteriser where you can: a read waits
+        for all the work queued before it."""
+        return self._read_framebuffer(self._buffers[index][1])
+
+    def flush(self) -> None:
+        """Start the work queued so far (``glFlush``) without waiting for it.
+
+        Drivers that draw in threads of their own (llvmpipe) begin drawing only when work is
+        flushed or waited for; where ``glFlush`` cannot be found this does nothing (the work
+        then starts at the next wait, which is correct, only later)."""
+        fn = _gl_flush()
+        if fn is not None:
+            fn()
 
     def render(self, bodies: Iterable = (), colliders: Iterable = (), *, wireframe: bool = False,
                collider_colors: Sequence | None = None) -> None:
@@ -736,15 +807,34 @@ class Renderer:
             if obj is not None:
                 obj.release()
         if self._owns_fbo:
-            for fb in (self._msaa, self._resolve):
-                if fb is not None:
-                    for a in fb.color_attachments:
-                        a.release()
-                    fb.release()
-            self._msaa = self._resolve = None
+            self._release_buffers()
         if self._owns_ctx:
             self.ctx.release()
             self._owns_ctx = False
+
+
+_GL_FLUSH: list = []  # [glFlush or None], looked up once
+
+
+def _gl_flush():
+    """``glFlush`` of the process's OpenGL library (the one moderngl's context loads), or None.
+
+    moderngl has no flush of its own; the library's entry point goes to the context current in
+    this thread, as moderngl's own calls do."""
+    if not _GL_FLUSH:
+        fn = None
+        try:
+            import ctypes
+            import ctypes.util
+
+            name = ctypes.util.find_library("GL")
+            if name:
+                fn = ctypes.CDLL(name).glFlush
+                fn.restype, fn.argtypes = None, []
+        except (OSError, AttributeError):  # no such library or symbol: flushing is an optimisation
+            fn = None
+        _GL_FLUSH.append(fn)
+    return _GL_FLUSH[0]
 
 
 _HEADLESS_HELP = (

@@ -5,13 +5,21 @@ place only when the last frame is written (:mod:`deforma.files`), so an interrup
 (Ctrl-C, a crash, an unstable simulation) never leaves a broken video: either the old file or
 a complete one. A PNG folder's frames are gathered in a hidden folder inside it and moved
 into place at the end, so an interrupted run adds no frames either.
+
+Every writer encodes in a thread of its own (:attr:`FrameWriter.QUEUE_FRAMES` frames may wait
+for it): piping raw frames to ffmpeg, a GIF's dithering (Pillow) and PNG compression release
+Python's lock, so they go on while the caller simulates and draws the next frames. A failure in
+that thread is raised, as one line, by the next :meth:`~FrameWriter.write` or by
+:meth:`~FrameWriter.finish`, and the output is discarded as before.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+import queue
 import shutil
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -77,18 +85,28 @@ class FrameWriter:
 
     Use :func:`open_writer` to get the right writer for a path. Leaving the ``with`` block
     normally commits the output; leaving it through an exception (KeyboardInterrupt too)
-    discards it.
+    discards it. :meth:`write` keeps a copy of the frame and returns: the frame is encoded in
+    the writer's own thread.
     """
+
+    #: Frames that may wait for the writer's thread; :meth:`write` blocks while that many do,
+    #: so memory stays bounded (:func:`run_memory` counts them, with the one being encoded and
+    #: the one being handed over).
+    QUEUE_FRAMES = 2
 
     def __init__(self, path, *, fps: float):
         if not (isinstance(fps, (int, float)) and np.isfinite(fps) and 0 < fps <= 1000):
             raise ValueError(f"fps must be a number in (0, 1000], got {fps!r}")
         self.path = Path(str(path).rstrip("/" + os.sep) or ".")
         self.fps = float(fps)
-        self.frames_written = 0
+        self.frames_written = 0   # frames encoded so far (by the writer's thread)
         self.size: tuple[int, int] | None = None
         self._closed = False
         self._finished = False
+        self._queue: queue.Queue | None = None
+        self._thread: threading.Thread | None = None
+        self._failure: BaseException | None = None   # what the thread's last frame raised
+        self._dropping = False                       # the thread skips the frames left (abort)
 
     def _check(self, frame) -> np.ndarray:
         f = np.asarray(frame)
@@ -103,25 +121,99 @@ class FrameWriter:
         return f
 
     def write(self, frame) -> None:
-        """Append one frame."""
+        """Append one frame: a copy goes to the writer's thread (this waits while
+        :attr:`QUEUE_FRAMES` frames are waiting there).
+
+        Raises
+        ------
+        OSError
+            One line naming the file, when encoding an earlier frame failed (a full disk,
+            ffmpeg stopped); the output is then discarded.
+        ValueError
+            For a frame of another size or type than the first, or a closed writer.
+        """
+        self._raise_failure()
         if self._closed:
             raise ValueError(f"{self.path}: writer is closed")
-        try:
-            self._write(self._check(frame))
-        except OSError as e:  # a full disk while frames are written (PNG folders, MP4's pipe)
-            if not self._closed:
-                self._closed = True
-                self._discard()
-            if str(self.path) in str(e):
-                raise
+        f = np.array(self._check(frame), order="C")   # the caller may reuse its array at once
+        if self._thread is None:
+            self._start(f)
+            self._queue = queue.Queue(maxsize=self.QUEUE_FRAMES)
+            self._thread = threading.Thread(target=self._work, name=f"deforma writer {self.path.name}", daemon=True)
+            self._thread.start()
+        self._queue.put(f)
+
+    def _work(self) -> None:
+        """The writer's thread: encodes frames in order until it is given None; after a failure
+        (kept for the caller's thread to raise) or an abort it only empties the queue."""
+        while True:
+            f = self._queue.get()
+            if f is None:
+                return
+            if self._failure is not None or self._dropping:
+                continue
+            try:
+                self._write(f)
+                self.frames_written += 1
+            except BaseException as e:  # noqa: BLE001 - raised again in the caller's thread
+                self._failure = e
+
+    def _join(self, *, drop: bool = False) -> None:
+        """Wait until the thread has encoded every frame given (or, with ``drop``, skipped them)
+        and ended. An interrupt meanwhile (Ctrl-C, a signal) makes it skip the rest; it is raised
+        once the thread has ended, so the output is never discarded under the thread's feet."""
+        t = self._thread
+        if t is None:
+            return
+        if drop:
+            self._dropping = True
+            while True:  # only the caller's thread puts: after this there is room for None
+                try:
+                    self._queue.get_nowait()
+                except queue.Empty:
+                    break
+        interrupt = None
+        queued = False
+        while t.is_alive():
+            try:
+                if not queued:
+                    self._queue.put(None)  # waits for room while the thread works through the frames
+                    queued = True
+                t.join()
+            except BaseException as e:  # noqa: BLE001 - the thread's frame takes milliseconds
+                interrupt = interrupt or e
+                self._dropping = True
+        self._thread = None
+        if interrupt is not None:
+            raise interrupt
+
+    def _raise_failure(self) -> None:
+        """Raise what the thread's encoding raised, as :meth:`write` raised it before threads:
+        the output discarded, an OSError as one line naming the file."""
+        e = self._failure
+        if e is None:
+            return
+        self._join(drop=True)
+        self._failure = None
+        if not self._closed:
+            self._closed = True
+            self._discard()
+        if isinstance(e, OSError) and str(self.path) not in str(e):
             raise failed_write(self.path, e) from None
-        self.frames_written += 1
+        raise e
 
     def finish(self) -> None:
         """Complete the file in its temporary place, not yet moved onto the target: a caller
         with more outputs finishes them all before it puts any in place (``deforma run -o
-        out.mp4 --states s.npz`` on a disk too full for the states keeps the earlier video)."""
+        out.mp4 --states s.npz`` on a disk too full for the states keeps the earlier video).
+        Waits for the writer's thread to encode every frame given."""
         if not self._closed and not self._finished:
+            try:
+                self._join()
+            except BaseException:
+                self.abort()
+                raise
+            self._raise_failure()
             self._finished = True
             try:
                 self._finish()
@@ -135,9 +227,12 @@ class FrameWriter:
                 self._closed = True
                 self._discard()
                 raise
+        else:
+            self._raise_failure()
 
     def close(self) -> None:
         """Finish the file and move it into place."""
+        self._raise_failure()
         if not self._closed:
             self.finish()
             self._closed = True
@@ -152,9 +247,12 @@ class FrameWriter:
 
     def abort(self) -> None:
         """Throw away everything written so far; the target is left as it was."""
-        if not self._closed:
-            self._closed = True
-            self._discard()
+        try:
+            self._join(drop=True)
+        finally:
+            if not self._closed:
+                self._closed = True
+                self._discard()
 
     def __enter__(self):
         return self
@@ -165,6 +263,10 @@ class FrameWriter:
         else:
             self.abort()
         return False
+
+    def _start(self, frame) -> None:
+        """Before the first frame goes to the writer's thread, in the caller's: start what the
+        encoding needs (a process, for an MP4)."""
 
     def _write(self, frame):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -241,19 +343,27 @@ class Mp4Writer(FrameWriter):
         self._tmp = temp_beside(self.path)
         self._gen = None
 
-    def _write(self, frame):
+    def _start(self, frame):
+        # ffmpeg is started here, in the caller's thread: started from the writer's thread, the
+        # fork ran Python's after-fork hooks in a thread the child does not know ("SystemError:
+        # RLock returned a result with an exception set" on stderr, in a notebook's deforma.show)
         import imageio_ffmpeg
 
         h, w = frame.shape[:2]
-        if self._gen is None:
-            self._padded = (w + w % 2, h + h % 2)
-            self._gen = imageio_ffmpeg.write_frames(
-                str(self._tmp), self._padded, fps=self.fps, codec="libx264", pix_fmt_in="rgb24",
-                pix_fmt_out="yuv420p", quality=self.quality, macro_block_size=1, ffmpeg_log_level="quiet",
-                # veryfast: half the encoding time of the default preset, and no bigger here
-                output_params=["-preset", "veryfast", "-movflags", "+faststart"],
-            )
+        self._padded = (w + w % 2, h + h % 2)
+        self._gen = imageio_ffmpeg.write_frames(
+            str(self._tmp), self._padded, fps=self.fps, codec="libx264", pix_fmt_in="rgb24",
+            pix_fmt_out="yuv420p", quality=self.quality, macro_block_size=1, ffmpeg_log_level="quiet",
+            # veryfast: half the encoding time of the default preset, and no bigger here
+            output_params=["-preset", "veryfast", "-movflags", "+faststart"],
+        )
+        try:
             self._gen.send(None)
+        except OSError as e:
+            raise self._failed(e) from None
+
+    def _write(self, frame):
+        h, w = frame.shape[:2]
         if (w, h) != self._padded:
             frame = np.pad(frame, ((0, self._padded[1] - h), (0, self._padded[0] - w), (0, 0)), mode="edge")
         try:
@@ -336,7 +446,7 @@ class GifWriter(FrameWriter):
 
     def _write(self, frame):
         if self._palette is None:
-            self._pending.append(frame.copy())
+            self._pending.append(frame)  # a private copy already (FrameWriter.write)
             if len(self._pending) >= self._palette_after:
                 self._build_palette()
         else:
@@ -493,9 +603,11 @@ def run_memory(size, *, samples: int, kind: str, frames: int, fps: float) -> dic
     Returns
     -------
     dict of str to int
-        Bytes by part: ``"process"``, ``"renderer"`` and ``"writer"`` (ffmpeg's encoder for an
-        MP4, every frame for a GIF, which is written only when the last one is known; nothing
-        for a PNG folder, whose frames go to disk one by one).
+        Bytes by part: ``"process"``, ``"renderer"`` (with the second buffer of frames drawn in
+        flight, :func:`deforma.render.recorder.pipeline_bytes`) and ``"writer"`` (the frames
+        queued for the writer's thread, and ffmpeg's encoder for an MP4, every frame for a GIF,
+        which is written only when the last one is known; a PNG folder's frames go to disk one
+        by one).
 
     Examples
     --------
@@ -503,14 +615,20 @@ def run_memory(size, *, samples: int, kind: str, frames: int, fps: float) -> dic
     >>> sum(parts.values()) < MAX_RUN_MEMORY
     True
     """
+    from .recorder import pipeline_bytes
+
     pixels = int(size[0]) * int(size[1])
-    parts = {"process": _BASE_BYTES, "renderer": pixels * _RENDER_BYTES_PER_PIXEL.get(samples, 27), "writer": 0}
+    # the renderer's second off-screen buffer where frames are drawn two in flight (render/recorder.py)
+    renderer = pixels * _RENDER_BYTES_PER_PIXEL.get(samples, 27) + pipeline_bytes(size, samples=samples)
+    # RGB frames on their way to the writer's thread: those queued, the one it encodes, the
+    # copy being handed over (FrameWriter.write)
+    parts = {"process": _BASE_BYTES, "renderer": renderer, "writer": (FrameWriter.QUEUE_FRAMES + 2) * 3 * pixels}
     if kind == "mp4":
-        parts["writer"] = _MP4_BASE_BYTES + pixels * _MP4_BYTES_PER_PIXEL
+        parts["writer"] += _MP4_BASE_BYTES + pixels * _MP4_BYTES_PER_PIXEL
     elif kind == "gif":
         # one byte a pixel per kept frame, twice (Pillow's list and its frames' deltas when
         # saving), and the first second as RGB (the copy kept and the palette's mosaic)
-        parts["writer"] = 2 * frames * pixels + 2 * min(frames, max(1, int(round(fps)))) * 3 * pixels
+        parts["writer"] += 2 * frames * pixels + 2 * min(frames, max(1, int(round(fps)))) * 3 * pixels
     return parts
 
 
@@ -536,7 +654,7 @@ def check_run_memory(path, size, *, samples: int, frames: int, fps: float, size_
     w, h = size
     what = {"mp4": f"a {w}x{h} MP4", "gif": f"a {w}x{h} GIF of {frames} frames", "png": f"{w}x{h} PNG frames"}[kind]
     writer = {"mp4": " + ffmpeg's H.264 encoder ", "gif": " + the GIF's frames, kept until the end ",
-              "png": ""}[kind]
+              "png": " + the frames queued for writing "}[kind]
     detail = f"renderer {gb(parts['renderer'])}" + (f"{writer}{gb(parts['writer'])}" if writer else "")
     fits = []
     if kind == "gif":

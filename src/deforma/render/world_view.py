@@ -157,7 +157,14 @@ class WorldView:
             return None
         frame = r.read()
         if self.overlay:
-            from .overlay import draw_overlay
-
-            draw_overlay(frame, time=self.world.time, metres_per_pixel=r.camera.metres_per_pixel(r.size))
+            self.overlay_onto(frame, time=self.world.time)
         return frame
+
+    def overlay_onto(self, frame, *, time: float, metres_per_pixel: float | None = None) -> None:
+        """Write the time and scale overlay onto ``frame`` (a picture this view drew, read back
+        later: :class:`deforma.render.recorder.FrameRecorder`); the scale defaults to the camera's now."""
+        from .overlay import draw_overlay
+
+        r = self.renderer
+        mpp = r.camera.metres_per_pixel(r.size) if metres_per_pixel is None else metres_per_pixel
+        draw_overlay(frame, time=time, metres_per_pixel=mpp)
