@@ -41,8 +41,10 @@ def assert_apart(world, where=""):
 # -- resting on each other ---------------------------------------------------------------------
 @pytest.mark.parametrize("name", ALL)
 def test_a_box_dropped_on_another_comes_to_rest_on_top(name):
-    # air drag for the slow sway, which spring damping hardly touches (see the stack below)
-    w = deforma.World(dt=1 / 600, substeps=6, stiffness=6000.0, damping=5.0, air_drag=1.0, integrator=name)
+    # air drag for the slow sway, which spring damping hardly touches (see the stack below);
+    # sleep off: the solver's own rest is measured
+    w = deforma.World(dt=1 / 600, substeps=6, stiffness=6000.0, damping=5.0, air_drag=1.0, integrator=name,
+                      sleep=False)
     w.add_collider(deforma.Rect((0, -0.5), (6, 1.0), 0.0))
     # checkerboard diagonals: a one-diagonal lattice shears and walks sideways under load (a
     # property of the springs, not of the contact, and what the FEM materials remove)
@@ -64,8 +66,9 @@ def test_a_box_dropped_on_another_comes_to_rest_on_top(name):
 def test_a_stack_of_five_boxes_rests():
     # Spring damping acts along springs and grows with frequency, so it barely touches the
     # stack's slow sway; air drag (1/s) damps it, as a real tower's material damping would.
+    # Sleep off: the solver's own rest is measured.
     w = deforma.World(integrator="symplectic-euler", dt=1 / 600, substeps=12, stiffness=6000.0, damping=5.0,
-                      air_drag=1.0)
+                      air_drag=1.0, sleep=False)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
     boxes = [w.add_body(grid_mesh(1.0, 1.0, 9, 9), position=(0.02 * (k % 2), 0.55 + 1.05 * k)) for k in range(5)]
     for k in range(int(5.0 / w.dt)):
@@ -106,11 +109,12 @@ def test_head_on_collision_keeps_momentum_and_never_gains_energy(name):
 # -- friction between bodies ---------------------------------------------------------------------
 def plank_and_block(angle, *, mu_s, mu_d, damping, integrator="symplectic-euler", dt=1 / 2000, substeps=3):
     """A 2 m plank held on a slope by a grippy collider, and a 20 x 10 cm block on the plank.
-    Both bodies use the coefficients given, so their contact does too (sqrt(mu mu) = mu)."""
+    Both bodies use the coefficients given, so their contact does too (sqrt(mu mu) = mu).
+    (Sleep off: a block that sticks is held by the solver itself, not put to sleep.)"""
     a = math.radians(angle)
     n, t = np.array([-math.sin(a), math.cos(a)]), np.array([math.cos(a), math.sin(a)])
     w = deforma.World(integrator=integrator, dt=dt, substeps=substeps, stiffness=2e4, damping=damping,
-                      friction=mu_d, static_friction=mu_s)
+                      friction=mu_d, static_friction=mu_s, sleep=False)
     w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle, friction=2.0, static_friction=3.0))
     plank = w.add_body(grid_mesh(2.0, 0.1, 41, 3, angle=angle, center=tuple(0.05 * n + 0.5 * t)), mass=4.0)
     gap = 1.01 * max(plank.contact_thickness, 0.0)
@@ -216,6 +220,7 @@ def test_pile_scene_never_crosses_and_no_vertex_enters_another_body():
     # as shipped: avbd at 1/60 s, one step a frame (implicit Euler at 2 substeps before; at
     # 1/600 s before that)
     w = deforma.load_scene("pile")
+    w.sleep = False  # (sleep off: the heap's own rest is measured)
     assert len(w.bodies) >= 12
     assert w.integrator == "avbd" and w.dt == pytest.approx(1 / 60) and w.substeps == 1
     steps = int(round(10.0 / w.dt))  # poured, landed and at rest: the scene's length

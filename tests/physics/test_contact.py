@@ -14,15 +14,16 @@ G = 9.81
 
 
 def slope_world(angle, *, mu_s=0.5, mu_d=0.3, dt=1 / 2000, damping=20.0, rect_coefficients=False):
-    """A 20 cm x 10 cm block resting on the upper face of a rectangle tilted by ``angle``."""
+    """A 20 cm x 10 cm block resting on the upper face of a rectangle tilted by ``angle``.
+    (Sleep off: a block that stays is held by the solver itself, not put to sleep.)"""
     a = math.radians(angle)
     n = np.array([-math.sin(a), math.cos(a)])
     t = np.array([math.cos(a), math.sin(a)])
     if rect_coefficients:  # the world's coefficients would let it slide; the collider's must win
-        w = deforma.World(dt=dt, friction=0.0, static_friction=0.0, stiffness=2e4, damping=damping)
+        w = deforma.World(dt=dt, friction=0.0, static_friction=0.0, stiffness=2e4, damping=damping, sleep=False)
         w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle, friction=mu_d, static_friction=mu_s))
     else:
-        w = deforma.World(dt=dt, friction=mu_d, static_friction=mu_s, stiffness=2e4, damping=damping)
+        w = deforma.World(dt=dt, friction=mu_d, static_friction=mu_s, stiffness=2e4, damping=damping, sleep=False)
         w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle))
     b = w.add_body(grid_mesh(0.2, 0.1, 6, 3, angle=angle, center=tuple(0.05 * n)))
     return w, b, n, t
@@ -77,8 +78,9 @@ def test_block_slides_with_acceleration_g_sin_minus_mu_cos(angle, mu_s, mu_d):
 
 
 def test_dropped_body_comes_to_rest_on_a_plane_without_sinking_or_jitter():
+    # (sleep off: the solver's own rest is measured)
     w = deforma.World(integrator="symplectic-euler", dt=1 / 1000, substeps=8, stiffness=2e4, damping=20.0,
-                      friction=0.3, static_friction=0.5)
+                      friction=0.3, static_friction=0.5, sleep=False)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
     b = w.add_body(grid_mesh(0.4, 0.2, 9, 5), position=(0.0, 0.5))
     b.velocities[:] = (0.3, 0.0)
@@ -177,8 +179,9 @@ def test_a_block_on_a_ledge_corner_tips_off_when_its_centre_overhangs(integrator
     # corner (x = 0.07): with 85% of it overhanging it tips off (its end beyond the corner
     # falls; the corner's push acts at the contact point, not on both ends alike), with 15%
     # it stays on the ledge
+    # (sleep off: that it stays on the ledge is the solver's own)
     w = deforma.World(integrator=integrator, dt=1 / 1000, substeps=10 if integrator == "symplectic-euler" else 1,
-                      stiffness=2e4, damping=20.0, friction=0.0, static_friction=0.0)
+                      stiffness=2e4, damping=20.0, friction=0.0, static_friction=0.0, sleep=False)
     w.add_collider(deforma.Rect((1.07, 0.0), (2.0, 0.2), 0.0))  # top face at y = 0.1
     block = deforma.mesh.Mesh([[0, 0], [0.2, 0], [0.2, 0.1], [0, 0.1]], [[0, 1, 2], [0, 2, 3]])
     b = w.add_body(block, position=(shift, 0.151))

@@ -107,11 +107,13 @@ def test_momentum_kept_without_gravity_or_colliders(name):
 
 
 def slope_world(name, angle, *, mu_s=0.5, mu_d=0.3, dt=1 / 2000, damping=20.0):
-    """A 20 cm x 10 cm block resting on the upper face of a rectangle tilted by ``angle``."""
+    """A 20 cm x 10 cm block resting on the upper face of a rectangle tilted by ``angle``.
+    (Sleep off: a block that stays is held by the solver itself, not put to sleep.)"""
     a = math.radians(angle)
     n = np.array([-math.sin(a), math.cos(a)])
     t = np.array([math.cos(a), math.sin(a)])
-    w = deforma.World(dt=dt, friction=mu_d, static_friction=mu_s, stiffness=2e4, damping=damping, integrator=name)
+    w = deforma.World(dt=dt, friction=mu_d, static_friction=mu_s, stiffness=2e4, damping=damping, integrator=name,
+                      sleep=False)
     w.add_collider(deforma.Rect(tuple(-0.5 * n), (20, 1.0), angle))
     b = w.add_body(grid_mesh(0.2, 0.1, 6, 3, angle=angle, center=tuple(0.05 * n)))
     return w, b, n, t
@@ -147,8 +149,9 @@ def test_dropped_body_comes_to_rest_on_a_plane(name, dt, substeps):
     # The stable integrators at a display frame rate, symplectic Euler at 8 x 1 kHz. Contacts
     # are resolved after each substep, outside the implicit solve, so a body landing or
     # resting on a collider still wants a few substeps (with one substep of 1/60 s both
-    # fold the bottom rows of this 2e4 N/m block: docs/integrators.md).
-    w = deforma.World(dt=dt, substeps=substeps, stiffness=2e4, damping=20.0, integrator=name)
+    # fold the bottom rows of this 2e4 N/m block: docs/integrators.md). Sleep off: the
+    # solver's own rest is measured.
+    w = deforma.World(dt=dt, substeps=substeps, stiffness=2e4, damping=20.0, integrator=name, sleep=False)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
     b = w.add_body(grid_mesh(0.4, 0.2, 9, 5), position=(0.0, 0.2))
     b.velocities[:] = (0.3, 0.0)
@@ -208,8 +211,10 @@ def _signed_areas(b):
 
 
 def _stiff_world(name, *, floor, substeps=1):
-    """dt = 1/60 s and a stiffness 100x what symplectic Euler can take at dt/substeps."""
-    w = deforma.World(dt=1 / 60, substeps=substeps, stiffness=1.0, damping=0.5, mass=1.0, integrator=name)
+    """dt = 1/60 s and a stiffness 100x what symplectic Euler can take at dt/substeps.
+    (Sleep off: on the floor, the solver's own rest is measured.)"""
+    w = deforma.World(dt=1 / 60, substeps=substeps, stiffness=1.0, damping=0.5, mass=1.0, integrator=name,
+                      sleep=False)
     if floor:
         w.add_collider(deforma.Rect((0, -0.5), (10, 1.0), 0.0))
     # Self contact off: at 10x the explicit step, one XPBD sweep per step reaches the rest
@@ -392,10 +397,11 @@ def test_air_drag_slows_a_fall_to_the_terminal_speed_g_over_drag(name):
 
 def test_implicit_euler_rests_where_forces_balance_whatever_the_air_drag():
     # (1 + h c) belongs on the mass, not only on gravity: with it only on gravity a hanging
-    # body settled short of its stretch by the factor 1 / (1 + h c) (25% here)
+    # body settled short of its stretch by the factor 1 / (1 + h c) (25% here). Sleep off:
+    # the slow settling is what is measured.
     ends = []
     for integrator, dt in (("symplectic-euler", 1 / 2000), ("implicit-euler", 1 / 60)):
-        w = deforma.World(integrator=integrator, dt=dt, air_drag=20.0, stiffness=200.0, damping=0.0)
+        w = deforma.World(integrator=integrator, dt=dt, air_drag=20.0, stiffness=200.0, damping=0.0, sleep=False)
         b = w.add_body(grid_mesh(0.2, 1.0, 3, 11), position=(0.0, 0.0))
         b.pin(np.flatnonzero(b.positions[:, 1] > 0.499))
         for _ in range(int(round(4.0 / dt))):
@@ -406,8 +412,10 @@ def test_implicit_euler_rests_where_forces_balance_whatever_the_air_drag():
 
 
 def _standing_grid(n, substeps):
-    """A 1 m square of n x n vertices (2000 N/m springs, 1 kg) standing on a floor under XPBD."""
-    w = deforma.World(dt=1 / 60, substeps=substeps, stiffness=2000.0, damping=0.5, mass=1.0, integrator="xpbd")
+    """A 1 m square of n x n vertices (2000 N/m springs, 1 kg) standing on a floor under XPBD.
+    (Sleep off: how far the solve lets it sink is measured, not put to sleep.)"""
+    w = deforma.World(dt=1 / 60, substeps=substeps, stiffness=2000.0, damping=0.5, mass=1.0, integrator="xpbd",
+                      sleep=False)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     body = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=n - 2), position=(0.0, 0.5 + 1e-6))
     return w, body
@@ -429,9 +437,10 @@ def test_xpbd_substeps_tells_holding_from_sinking():
 
 
 def _cantilever(substeps, integrator="xpbd"):
-    """A horizontal 1 m x 0.1 m corotated beam (E = 1e5 Pa) pinned at its left end, 1/60 s."""
+    """A horizontal 1 m x 0.1 m corotated beam (E = 1e5 Pa) pinned at its left end, 1/60 s.
+    (Sleep off: the solver's own settled sag is measured.)"""
     mat = deforma.Material("corotated", youngs_modulus=1e5, poisson_ratio=0.3, density=100.0)
-    w = deforma.World(dt=1 / 60, substeps=substeps, integrator=integrator, material=mat, air_drag=3.0)
+    w = deforma.World(dt=1 / 60, substeps=substeps, integrator=integrator, material=mat, air_drag=3.0, sleep=False)
     b = w.add_body(grid_mesh(1.0, 0.1, 41, 5), position=(0.5, 2.0))
     b.pin(np.flatnonzero(b.positions[:, 0] < b.positions[:, 0].min() + 1e-9))
     return w, b
@@ -473,8 +482,8 @@ def test_xpbd_substeps_scales_with_step_iterations_and_gravity():
 def test_air_drag_slows_motion_but_not_the_rest_state(name):
     # 1 kg hanging on a 100 N/m spring, 1/60 s, air_drag 5: it rests at m g / k whatever the
     # drag (XPBD rested 7.7% short, 1 / (1 + h air_drag), when its constraints weighed the
-    # plain mass against the damped prediction)
-    w = deforma.World(dt=1 / 60, integrator=name, mass=2.0, stiffness=100.0, damping=0.0, air_drag=5.0)
+    # plain mass against the damped prediction); sleep off: the solver's own rest is measured
+    w = deforma.World(dt=1 / 60, integrator=name, mass=2.0, stiffness=100.0, damping=0.0, air_drag=5.0, sleep=False)
     if name == "xpbd":
         w.integrator_options = {"iterations": 20}  # one spring: the sweeps converge
     b = w.add_body(Chain([[0, 0], [0, -1]], [[0, 1]]), position=None)

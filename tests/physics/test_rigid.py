@@ -55,7 +55,8 @@ def slope_run(angle_deg, mesh, *, friction=0.3, static_friction=0.5, seconds=1.0
     """Put ``mesh`` (rigid) on a slope at ``angle_deg``; return its fitted acceleration along
     the slope (m/s^2, downhill positive) and the body."""
     a = math.radians(angle_deg)
-    w = deforma.World(dt=1 / 60, friction=friction, static_friction=static_friction)
+    # (sleep off: a box that sticks is held by the solver itself, not put to sleep)
+    w = deforma.World(dt=1 / 60, friction=friction, static_friction=static_friction, sleep=False)
     w.add_collider(deforma.Rect((0, 0), (60, 1), angle_deg))
     n, t = np.array([-math.sin(a), math.cos(a)]), np.array([-math.cos(a), -math.sin(a)])
     half = np.ptp(mesh.vertices[:, 1]) / 2
@@ -101,7 +102,7 @@ def test_a_rigid_disc_rolls_down_a_slope_at_two_thirds_g_sin(angle):
 
 
 def test_a_stack_of_ten_rigid_boxes_stands_for_ten_seconds():
-    w = deforma.World(dt=1 / 60)
+    w = deforma.World(dt=1 / 60, sleep=False)  # (sleep off: the solver's own rest is measured)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
     boxes = [w.add_body(deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=2),
                         position=(0.01 * (i % 2), 0.1 + 0.201 * i), material=RIGID) for i in range(10)]
@@ -131,8 +132,9 @@ def drift_after(w, bodies, settle: int, watch: int) -> float:
 
 def test_avbd_holds_a_stack_of_ten_rigid_boxes_still():
     # the default integrator solves each rigid box as one block of its sweep: settled (3 s),
-    # every box stays within a millimetre for ten seconds and ends slower than 1 mm/s
-    w = deforma.World(dt=1 / 60)
+    # every box stays within a millimetre for ten seconds and ends slower than 1 mm/s (sleep
+    # off: the solver's own rest is measured)
+    w = deforma.World(dt=1 / 60, sleep=False)
     assert w.integrator == "avbd"
     w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
     boxes = [w.add_body(deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=2),
@@ -146,8 +148,8 @@ def test_avbd_holds_a_stack_of_ten_rigid_boxes_still():
 def test_avbd_holds_a_pyramid_of_rigid_boxes_still():
     # ten rows of 0.2 m boxes, 2 mm apart, rows 1 mm apart: settled (1 s), every box stays
     # within a millimetre for ten seconds (the 20-row one does too, 1.5 mm:
-    # benchmarks/bench_rigid.py, 17 s a run)
-    w = deforma.World(dt=1 / 60)
+    # benchmarks/bench_rigid.py, 17 s a run); sleep off: the solver's own rest is measured
+    w = deforma.World(dt=1 / 60, sleep=False)
     w.add_collider(deforma.Rect((0, -0.5), (40, 1), 0))
     boxes = [w.add_body(deforma.mesh.box(((0, 0), (0.2, 0), (0.2, 0.2), (0, 0.2)), detail=2),
                         position=((c - (10 - r - 1) / 2) * 0.202, 0.1 + r * 0.201), material=RIGID)
@@ -160,7 +162,7 @@ def test_avbd_holds_a_pyramid_of_rigid_boxes_still():
 def two_boxes_through(*integrators):
     """A rigid box resting on another, stepped half a second under each integrator in turn:
     the top box's heights (m) and its last angle (degrees)."""
-    w = deforma.World(dt=1 / 60)
+    w = deforma.World(dt=1 / 60, sleep=False)  # (sleep off: the solvers' own rest is measured)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
     box = lambda y: w.add_body(deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=2),  # noqa: E731
                                position=(0.0, y), material=RIGID)
@@ -191,7 +193,7 @@ def test_rigid_bodies_change_back_to_avbd():
 def test_a_rigid_box_dropped_on_another_lands_flat_on_it(offset):
     # landing at 2.5 m/s off-centre, it ended 0.03 mm into the lower box, its pairs were taken as
     # behind the edges from then on, and it sank in and tipped over: 28 degrees, a corner 4 cm in
-    w = deforma.World()
+    w = deforma.World(sleep=False)  # (sleep off: the solver's own rest is measured)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
     box = lambda size: deforma.mesh.box(((0, 0), (size, 0), (size, size), (0, size)), detail=3, edges=True)  # noqa: E731
     wood = deforma.Material("rigid", density=600.0)
@@ -205,7 +207,7 @@ def test_a_rigid_box_dropped_on_another_lands_flat_on_it(offset):
 
 def test_a_jelly_block_stays_on_a_level_rigid_crate():
     # it slid off at 0.8 m/s under implicit Euler when the crate was a rigid stage's outline
-    w = deforma.World(dt=1 / 60)
+    w = deforma.World(dt=1 / 60, sleep=False)  # (sleep off: the solver's own rest is measured)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
     crate = w.add_body(deforma.mesh.box(((0, 0), (0.6, 0), (0.6, 0.4), (0, 0.4)), detail=2), position=(0, 0.2),
                        material=RIGID)
@@ -220,7 +222,7 @@ def test_a_jelly_block_stays_on_a_level_rigid_crate():
 def test_a_jelly_block_on_a_rigid_crate_comes_to_rest_within_two_seconds():
     # its contact vertices buzzed at 5-80 mm/s until the soft vertices on the crate were swept
     # again after each pass over the rigid blocks
-    w = deforma.World(dt=1 / 60)
+    w = deforma.World(dt=1 / 60, sleep=False)  # (sleep off: the solver's own rest is measured)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
     w.add_body(deforma.mesh.box(((0, 0), (0.6, 0), (0.6, 0.4), (0, 0.4)), detail=2), position=(0, 0.2),
                material=RIGID)
@@ -237,7 +239,7 @@ def test_a_jelly_block_on_a_rigid_crate_comes_to_rest_within_two_seconds():
 
 @pytest.mark.parametrize("integrator", ["symplectic-euler", "implicit-euler", "implicit-bdf2", "xpbd"])
 def test_a_soft_body_rests_on_a_rigid_box_under_every_integrator(integrator):
-    w = deforma.World(dt=1 / 60, integrator=integrator)
+    w = deforma.World(dt=1 / 60, integrator=integrator, sleep=False)  # (sleep off: the solver's own rest is measured)
     w.add_collider(deforma.Rect((0, -0.5), (10, 1), 0))
     crate = w.add_body(deforma.mesh.box(((0, 0), (0.6, 0), (0.6, 0.3), (0, 0.3)), detail=2), position=(0, 0.16),
                        material=RIGID)
@@ -412,6 +414,7 @@ position = [0, 0.8]
 angle = 30
 """)
     w = deforma.load_scene(p)
+    w.sleep = False  # (sleep off: the solver's own rest is measured)
     crate = w.bodies[0]
     assert crate.material.is_rigid and crate.angle == pytest.approx(30)
     for _ in range(180):

@@ -37,8 +37,9 @@ def inverted_triangles(w):
 
 def stiff_drop(name, *, substeps=1, iterations=None):
     """A 1 m box (detail 8, side points) 100x stiffer than symplectic Euler takes at 1/60 s,
-    dropped 1 m onto a 10 degree floor; returns the world and the largest strain seen."""
-    w = deforma.World(dt=H, substeps=substeps, integrator=name, stiffness=1000.0, damping=0.5)
+    dropped 1 m onto a 10 degree floor; returns the world and the largest strain seen.
+    (Sleep off: where it rests, and how, is the solver's own.)"""
+    w = deforma.World(dt=H, substeps=substeps, integrator=name, stiffness=1000.0, damping=0.5, sleep=False)
     if iterations is not None:
         w.integrator_options = {"iterations": iterations}
     w.add_collider(deforma.Rect((0, -0.5), (20, 1.0), 10.0))
@@ -78,8 +79,9 @@ def test_the_resolved_drop_the_bound_comes_from():
 
 def test_a_large_stiff_body_stands_on_the_floor_at_a_display_step_under_implicit_euler():
     # 1e4 vertices, 1 m: with the floor outside the solve it sank to 0.877 m in 1/6 s and
-    # 0.26 m in 2 s, since its support reached it only through the bottom row
-    w = deforma.World(stiffness=2000.0, damping=0.5, mass=1.0, integrator="implicit-euler", dt=H)
+    # 0.26 m in 2 s, since its support reached it only through the bottom row (sleep off: the
+    # solve's own support is measured)
+    w = deforma.World(stiffness=2000.0, damping=0.5, mass=1.0, integrator="implicit-euler", dt=H, sleep=False)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     body = w.add_body(grid_mesh(1.0, 1.0, 100, 100), position=(0.0, 0.5 + 1e-6))
     for _ in range(120):
@@ -93,7 +95,7 @@ def test_a_large_stiff_body_stands_on_the_floor_at_a_display_step_under_implicit
 def test_a_block_on_a_slope_slides_or_sticks_at_a_display_step(name, iterations, angle, mu_s, mu_d):
     a = math.radians(angle)
     n, t = np.array([-math.sin(a), math.cos(a)]), np.array([math.cos(a), math.sin(a)])
-    w = deforma.World(dt=H, stiffness=2e4, damping=2.0, integrator=name)
+    w = deforma.World(dt=H, stiffness=2e4, damping=2.0, integrator=name, sleep=False)  # (sleep off: the solver's rest)
     if iterations:
         w.integrator_options = {"iterations": iterations}
     w.add_collider(deforma.Rect(tuple(-0.5 * n), (40, 1.0), angle, friction=mu_d, static_friction=mu_s))
@@ -187,6 +189,7 @@ def test_the_jelly_stack_rests_at_a_display_step_under_implicit_euler():
     from contact_checks import crossings
 
     w = deforma.load_scene("jelly")
+    w.sleep = False  # (sleep off: the solver's own rest is measured)
     w.integrator = "implicit-euler"
     w.dt, w.substeps = H, 2
     for k in range(360):
@@ -204,6 +207,7 @@ def test_the_jelly_stack_keeps_apart_and_its_shape_at_a_display_step_under_xpbd(
     from contact_checks import crossings, vertices_inside_other_bodies
 
     w = deforma.load_scene("jelly")
+    w.sleep = False  # (sleep off: how far the solve lets the stack sag is measured)
     w.integrator = "xpbd"
     w.integrator_options = {"iterations": 100}
     w.dt, w.substeps = H, 2
