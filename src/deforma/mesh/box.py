@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import operator
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..checks import MAX_COORDINATE, MAX_DETAIL
 from .delaunay import delaunay
 from .mesh import Mesh
 
 
-def box(corners, *, detail=8, edges=True) -> Mesh:
+def box(corners: ArrayLike, *, detail: int = 8, edges: bool = True) -> Mesh:
     """A quadrilateral ("box") mesh filled evenly with points, as in the original's Square.
 
     Parameters
@@ -63,12 +65,12 @@ def box(corners, *, detail=8, edges=True) -> Mesh:
     s = np.arange(1, n + 1, dtype=np.float64) / (n + 1)
     # interior: the bilinear map of the unit square, (s, t) -> a + s(b-a) + t(d-a) + st(a-b+c-d)
     ss, tt = np.meshgrid(s, s)
-    ss, tt = ss.ravel(), tt.ravel()
+    ss, tt = ss.ravel(), tt.ravel()  # type: ignore[assignment]  # 2-d grids to 1-d
     twist = a - b + cc - d
     interior = a + ss[:, None] * (b - a) + tt[:, None] * (d - a) + (ss * tt)[:, None] * twist
-    points = [c, interior]
-    uv = [np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), np.stack([ss, tt], axis=1)]
-    side_of = [np.full(4, -1), np.full(n * n, -1)]
+    points: Any = [c, interior]  # lists of pieces, then arrays
+    uv: Any = [np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), np.stack([ss, tt], axis=1)]
+    side_of: Any = [np.full(4, -1), np.full(n * n, -1)]
     if edges and n > 0:
         z, o = np.zeros(n), np.ones(n)
         for k, (p, q, uvs) in enumerate(

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from .ordering import brio_order
 from .predicates import SCRATCH_SIZE, incircle, orient2d
@@ -327,7 +328,7 @@ def _as_points(points) -> np.ndarray:
     return pts
 
 
-def delaunay(points) -> np.ndarray:
+def delaunay(points: ArrayLike) -> np.ndarray:
     """Delaunay triangulation of 2D points (incremental Bowyer-Watson, exact predicates).
 
     Parameters

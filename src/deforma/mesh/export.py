@@ -27,7 +27,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -85,7 +85,7 @@ def obj_text(meshes: Sequence[Mesh], names: Sequence[str], materials: str | None
     return "\n".join(out) + "\n"
 
 
-def json_data(meshes: Sequence[Mesh], names: Sequence[str], **extra) -> dict:
+def json_data(meshes: Sequence[Mesh], names: Sequence[str], **extra: Any) -> dict:
     """A JSON-ready dict: ``extra`` (frame, time, ...) and ``bodies``, each with ``name``,
     ``vertices`` (m), ``triangles`` (vertex indices, counter-clockwise) and ``uv``."""
     return {**extra, "bodies": [{"name": name, "vertices": m.vertices.tolist(), "triangles": m.triangles.tolist(),
@@ -121,8 +121,8 @@ def svg_text(meshes: Sequence[Mesh], names: Sequence[str], colors: Sequence[str]
     return "\n".join(out) + "\n"
 
 
-def write_meshes(meshes: Sequence[Mesh], path, *, names: Sequence[str] | None = None,
-                 colors: Sequence[str] = (), materials: str | None = None, **extra) -> None:
+def write_meshes(meshes: Sequence[Mesh], path: str | Path, *, names: Sequence[str] | None = None,
+                 colors: Sequence[str] = (), materials: str | None = None, **extra: Any) -> None:
     """Write ``meshes`` to ``path`` in the format its suffix names (``.obj``, ``.json``, ``.svg``).
 
     Parameters
@@ -162,7 +162,7 @@ def write_meshes(meshes: Sequence[Mesh], path, *, names: Sequence[str] | None = 
     path.write_text(text)
 
 
-def write_materials(meshes: Sequence[Mesh], folder, *, names: Sequence[str] | None = None,
+def write_materials(meshes: Sequence[Mesh], folder: str | Path, *, names: Sequence[str] | None = None,
                     name: str = "materials.mtl") -> str | None:
     """Write each textured mesh's picture as ``NAME.png`` into ``folder`` and a material
     library ``name`` naming them (OBJ's ``map_Kd``); returns ``name``, or ``None`` (nothing
@@ -184,7 +184,7 @@ def write_materials(meshes: Sequence[Mesh], folder, *, names: Sequence[str] | No
     return name
 
 
-def read_meshes(path) -> list[Mesh]:
+def read_meshes(path: str | Path) -> list[Mesh]:
     """The meshes of an OBJ or JSON file written by :func:`write_meshes` (or ``deforma run
     --export``), one per object, in order, exactly as written (a deformed shape's turned-over
     triangles stay as they are; no texture picture).
@@ -228,7 +228,10 @@ def _as_written(vertices, triangles, uv) -> Mesh:
 
 
 def _read_obj(text: str) -> list[Mesh]:
-    meshes, v, vt, f = [], [], [], []
+    meshes: list[Mesh] = []
+    v: list[Any] = []
+    vt: list[Any] = []
+    f: list[Any] = []
     base = 0
 
     def close():

@@ -57,15 +57,22 @@ import warnings
 import zlib
 from importlib import resources
 from pathlib import Path
+from typing import Any, Union
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 from PIL import Image, UnidentifiedImageError
 
 from ..checks import positive
 from . import quality
 from .delaunay import delaunay
 from .mesh import Mesh, split_pinches
+
+#: What a picture argument may be: a built-in texture's name, a path, a PIL image or an (H, W[, C]) array.
+ImageSource = Union[str, "os.PathLike[str]", Image.Image, ArrayLike]
+#: A ``background`` argument: ``"black"``, ``"white"``, ``"auto"``, ``"#rrggbb"`` or (r, g, b) ints 0-255.
+Background = Union[str, tuple[int, int, int], list[int]]
 
 #: File types a built-in texture may be stored as (what Pillow reads).
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
@@ -117,15 +124,15 @@ _AUTO_AGREEMENT = 0.5
 
 
 def from_image(
-    source,
+    source: ImageSource,
     *,
-    resolution=4,
-    detect_edges=True,
-    edge_step=2,
-    scale=0.01,
-    background="black",
-    threshold=None,
-    max_points=DEFAULT_MAX_POINTS,
+    resolution: int = 4,
+    detect_edges: bool = True,
+    edge_step: int = 2,
+    scale: float = 0.01,
+    background: Background = "black",
+    threshold: float | None = None,
+    max_points: int = DEFAULT_MAX_POINTS,
 ) -> Mesh:
     """A mesh of a picture's foreground that follows its outline, holes and concavities.
 
@@ -286,7 +293,8 @@ def from_image(
     return Mesh(vertices, tris, uv=uv, texture=_with_alpha(pic, None if by_alpha else mask))
 
 
-def foreground_mask(source, *, background="black", threshold=None) -> np.ndarray:
+def foreground_mask(source: ImageSource, *, background: Background = "black",
+                    threshold: float | None = None) -> np.ndarray:
     """The pixels :func:`from_image` treats as the shape.
 
     Parameters
@@ -315,7 +323,8 @@ def foreground_mask(source, *, background="black", threshold=None) -> np.ndarray
     return _clean(pic.field > pic.level)
 
 
-def load_rgba(source, *, background="black", threshold=None) -> np.ndarray:
+def load_rgba(source: ImageSource, *, background: Background = "black",
+              threshold: float | None = None) -> np.ndarray:
     """The picture as :func:`from_image` reads it and puts in ``Mesh.texture``.
 
     The one image loader of the package (scene textures use it too). A picture without
@@ -383,7 +392,7 @@ def _load(source, background, threshold):
     return _Picture(rgba, _colour_distance(rgba, rgb), level, False, background, rgb)
 
 
-def check_background(background):
+def check_background(background: Any) -> str | tuple[int, ...]:
     """What a ``background`` argument means: an (r, g, b) tuple of ints 0-255, or ``"auto"``.
 
     Accepted: ``"black"``, ``"white"``, ``"auto"`` (any case), a colour ``"#rrggbb"``, or a
@@ -425,7 +434,7 @@ def check_background(background):
     )
 
 
-def check_threshold(threshold):
+def check_threshold(threshold: Any) -> float | None:
     """What a ``threshold`` argument means: a float in [0, 1), or None for the default.
 
     Raises
@@ -545,7 +554,7 @@ def _with_alpha(pic, mask):
     return rgba
 
 
-def read_rgba(source) -> np.ndarray:
+def read_rgba(source: ImageSource) -> np.ndarray:
     """Read a picture as it is, without any foreground test: (H, W, 4) uint8 RGBA, row 0 on top.
 
     Parameters
@@ -585,7 +594,7 @@ def _from_path(source):
     return _open(name, name)
 
 
-def check_picture(path) -> None:
+def check_picture(path: str | os.PathLike[str]) -> None:
     """Read the picture at ``path`` as :func:`from_image` would, to refuse at once what it
     would refuse later (not a picture, truncated or corrupt data, a header that lies about its
     size, no pixels, more than ``MAX_PIXELS``): a scene file's texture is checked when the

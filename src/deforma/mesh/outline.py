@@ -37,10 +37,12 @@ How it works:
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..checks import non_negative, positive
-from .image import _check_foreground, _clean, _load
+from .image import Background, ImageSource, _check_foreground, _clean, _load
 
 # px: a loop still bad when halved to here goes to 0 (straight runs only), then unsimplified
 _MIN_TOLERANCE = 1.0 / 16.0
@@ -49,13 +51,13 @@ _PAIR_CHUNK = 2_000_000
 
 
 def outline(
-    source,
+    source: ImageSource,
     *,
-    scale=0.01,
-    tolerance=1.0,
-    background="black",
-    threshold=None,
-    min_area=4.0,
+    scale: float = 0.01,
+    tolerance: float = 1.0,
+    background: Background = "black",
+    threshold: float | None = None,
+    min_area: float = 4.0,
 ) -> list[tuple[np.ndarray, list[np.ndarray]]]:
     """The foreground of a picture as simple polygons with holes, in metres.
 
@@ -129,7 +131,7 @@ def outline(
     loops = _split(xy, sizes)
     size = np.abs(_loop_areas(xy, sizes))
     # a piece's outer loop encloses its holes, so it is its largest
-    regions = []  # (outer, holes) as traced loops in image units
+    regions: list[Any] = []  # (outer, holes) as traced loops in image units
     order = np.lexsort((-size, piece))
     first = np.r_[True, piece[order][1:] != piece[order][:-1]]
     for k, is_outer in zip(order, first):
@@ -227,7 +229,7 @@ def _to_metres(xy, cx, cy, scale, ccw):
 # ---- simplification ------------------------------------------------------------------------
 
 
-def simplify_loop(xy, tolerance):
+def simplify_loop(xy: np.ndarray, tolerance: float) -> np.ndarray:
     """Ramer-Douglas-Peucker on a closed loop: the corners kept, as a subset of ``xy``.
 
     Every point of ``xy`` lies within ``tolerance`` of the returned loop (of the segment

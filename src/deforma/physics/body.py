@@ -10,9 +10,10 @@ pulled toward a target while held.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..checks import MAX_LOAD
 from ..checks import number as _number
@@ -28,6 +29,7 @@ from .rigid.stage import rigid_set
 from .topology import BodyTopology, element_geometry
 
 if TYPE_CHECKING:  # the World imports this module
+    from ..mesh.mesh import Mesh
     from .world import World
 
 
@@ -86,8 +88,8 @@ class Body:
     ((3, 2), 1.0, 3)
     """
 
-    def __init__(self, world: "World", index: int, mesh, topology: BodyTopology, overrides: dict):
-        self._world = world
+    def __init__(self, world: World, index: int, mesh: Any, topology: BodyTopology, overrides: dict[str, Any]) -> None:
+        self._world: World | None = world
         self._index = index
         self.mesh = mesh
         self.topology = topology
@@ -95,10 +97,10 @@ class Body:
         self._pinned = np.zeros(topology.n_vertices, bool)
         self._asleep = False  # held still by the world's sleeping (physics.sleeping)
         self._still = 0.0  # s it has been slower than sleeping.SLEEP_SPEED
-        self._tear_topology = None  # (topology, tearing.TearTopology) cached for the tear check
+        self._tear_topology: tuple[BodyTopology, Any] | None = None  # (topology, tearing.TearTopology) cached for the tear check
         self._tear_source = slice(None)  # after a tear: which old vertex each new one copies
         self._tear_fresh = np.zeros(0, np.int64)  # and the vertices whose springs, elements or mass it changed
-        self._cracks = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
+        self._cracks: tuple[BodyTopology, Any] | None = None  # (topology, tips of the cracks that ran in its last step: Tear.tips)
         self._angle0 = 0.0  # rad: the angle it was placed at (its rest shape is turned so)
 
     def _tear_view(self):
@@ -174,7 +176,7 @@ class Body:
         return self._check()._state.x[self.vertex_slice]
 
     @positions.setter
-    def positions(self, value):
+    def positions(self, value: ArrayLike) -> None:
         x = self._checked_array(value, "positions", shapes=((self.n_vertices, 2),))
         world = self._check()
         if self._overrides["collide"]:
@@ -188,7 +190,7 @@ class Body:
         return self._check()._state.v[self.vertex_slice]
 
     @velocities.setter
-    def velocities(self, value):
+    def velocities(self, value: ArrayLike) -> None:
         # a single (vx, vy) sets every vertex: the usual way to launch a body
         v = self._checked_array(value, "velocities", shapes=((self.n_vertices, 2), (2,)))
         self._check()._disturb(self)
@@ -224,7 +226,7 @@ class Body:
         """(E, 2) int32 spring vertex pairs in body-local indices."""
         return self.topology.springs
 
-    def to_mesh(self):
+    def to_mesh(self) -> Mesh:
         """The body's current shape as a :class:`~deforma.mesh.Mesh`: its positions (m), its
         triangles (a torn body's as torn), its texture coordinates and picture.
 
@@ -291,7 +293,7 @@ class Body:
         return rigid_motion.center_of_mass(self.velocities, m)  # the momentum over the mass
 
     @velocity.setter
-    def velocity(self, value):
+    def velocity(self, value: ArrayLike) -> None:
         world = self._check()
         vel = _pair(value, "velocity", limit=world.max_speed)
         self.velocities[...] += np.asarray(vel) - self.velocity
@@ -317,7 +319,7 @@ class Body:
         return math.degrees(omega)
 
     @angular_velocity.setter
-    def angular_velocity(self, value):
+    def angular_velocity(self, value: float) -> None:
         world = self._check()
         spin = _spin(value, world.max_speed)
         m = world._model.vertex_mass[self.vertex_slice]
@@ -360,7 +362,7 @@ class Body:
         return SPRINGS if m is None else m
 
     @material.setter
-    def material(self, value):
+    def material(self, value: Material | None) -> None:
         world = self._check()
         value = _material(value)
         if value is not None and value.is_fem:
@@ -434,7 +436,7 @@ class Body:
         return self._asleep
 
     @sleeping.setter
-    def sleeping(self, value):
+    def sleeping(self, value: bool) -> None:
         world = self._check()
         if _switch(value, "sleeping"):
             world._fall_asleep(world._island_of(self))
@@ -487,7 +489,7 @@ class Body:
             a = a[None, :] * (m / m.sum())[:, None] if len(idx) else np.zeros((0, 2))
         return idx, a
 
-    def apply_force(self, force, indices=None) -> None:
+    def apply_force(self, force: ArrayLike, indices: ArrayLike | None = None) -> None:
         """Push the body with ``force`` (N) during the next step (every substep of it).
 
         Parameters
@@ -515,7 +517,7 @@ class Body:
         world._disturb(self)
         world._forces.append((self, idx, f))
 
-    def apply_impulse(self, impulse, indices=None) -> None:
+    def apply_impulse(self, impulse: ArrayLike, indices: ArrayLike | None = None) -> None:
         """Change the body's velocities now by ``impulse`` (N s): ``impulse / mass`` per vertex.
 
         Parameters
@@ -552,7 +554,7 @@ class Body:
         free = ~self._pinned[idx]
         np.add.at(world._state.v, rows[free], j[free] * world._model.vertex_inv_mass[rows[free], None])
 
-    def pin(self, indices) -> None:
+    def pin(self, indices: ArrayLike) -> None:
         """Hold vertices ``indices`` (body-local, or a bool mask) where they are: infinite mass,
         zero velocity, under every integrator, until :meth:`unpin`. A rigid body held at any
         vertex is held whole: it stops and stands as a collider would.
@@ -575,7 +577,7 @@ class Body:
         self.velocities[slice(None) if self.material.is_rigid and idx.size else idx] = 0.0
         world._hold([self])
 
-    def unpin(self, indices=None) -> None:
+    def unpin(self, indices: ArrayLike | None = None) -> None:
         """Free vertices ``indices`` (default: all of them)."""
         world = self._check()
         world._disturb(self)
@@ -602,7 +604,7 @@ class Body:
         return self._overrides["collide"]
 
     @collide.setter
-    def collide(self, value):
+    def collide(self, value: bool) -> None:
         self._set_switch("collide", value)
 
     @property
@@ -611,7 +613,7 @@ class Body:
         return self._overrides["self_collision"]
 
     @self_collision.setter
-    def self_collision(self, value):
+    def self_collision(self, value: bool) -> None:
         self._set_switch("self_collision", value)
 
     def _set_switch(self, name, value):
@@ -636,7 +638,7 @@ class Body:
         return self._overrides["pressure"]
 
     @pressure.setter
-    def pressure(self, value):
+    def pressure(self, value: float | None) -> None:
         world = self._check()
         self._overrides["pressure"] = _pressure(value, self.topology)
         world._rebuild(world._state.x, world._state.v)
@@ -677,7 +679,8 @@ class Grab:
     triangles under a wide grab, and inverted the grabbed triangle under a strong one).
     """
 
-    def __init__(self, world, body, vertices, target, strength, offsets=None):
+    def __init__(self, world: World, body: Body | None, vertices: ArrayLike, target: tuple[float, float], strength: float,
+                 offsets: ArrayLike | None = None) -> None:
         self._world = world
         self.body = body
         self.vertices = np.asarray(vertices, dtype=np.int64)

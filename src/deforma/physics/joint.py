@@ -13,9 +13,10 @@ impulses, and the force of the last step.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..checks import non_negative as _non_negative
 from ..checks import number as _number
@@ -26,6 +27,8 @@ from .rigid.joints import KINDS
 
 if TYPE_CHECKING:
     from .body import Body
+    from .model import Model
+    from .world import World
 
 #: Largest motor speed (degrees/s) a joint takes, as a collider's spin.
 MAX_MOTOR_SPEED = 1e6
@@ -48,8 +51,10 @@ class Joint:
         N: the force past which a step breaks it (None: never).
     """
 
-    def __init__(self, world, a: Body, b: Body | None, kind: str, anchor, local, reference: float,
-                 stiffness, damping, motor_speed, max_torque, frame=None, break_force=None):
+    def __init__(self, world: World, a: Body, b: Body | None, kind: str, anchor: tuple[float, float], local: ArrayLike,
+                 reference: float, stiffness: float | None, damping: float | None, motor_speed: float | None,
+                 max_torque: float | None, frame: tuple[Any, ...] | None = None,
+                 break_force: float | None = None) -> None:
         self._world = world
         self.a, self.b, self.kind = a, b, kind
         self.anchor = anchor
@@ -64,7 +69,7 @@ class Joint:
         # avbd's rows (integrators.avbd.joints): per side its point as a rigid body carries
         # it and as a soft body does (see frame_rows), the frames' reference angle, and the
         # rows' warm start
-        self._frame = frame
+        self._frame: Any = frame
         self.break_force = break_force
         self._broken = False
         self._lam = np.zeros(4)
@@ -124,7 +129,7 @@ class Joint:
         return self._motor_speed
 
     @motor_speed.setter
-    def motor_speed(self, value) -> None:
+    def motor_speed(self, value: float | None) -> None:
         self._motor_speed = motor(self.kind, value, self._max_torque)[0]
         self._world._disturb(self.a)  # a sleeping car wakes when driven
 
@@ -134,7 +139,7 @@ class Joint:
         return self._max_torque
 
     @max_torque.setter
-    def max_torque(self, value) -> None:
+    def max_torque(self, value: float | None) -> None:
         self._max_torque = motor(self.kind, self._motor_speed, value)[1]
         self._world._disturb(self.a)
 
@@ -158,7 +163,7 @@ class Joint:
         return f"Joint({self.kind} of body {self.a._index} and {b} at {self.anchor})"
 
 
-def motor(kind: str, speed, max_torque) -> tuple[float | None, float | None]:
+def motor(kind: str, speed: float | None, max_torque: float | None) -> tuple[float | None, float | None]:
     """A motor's ``(speed deg/s, max_torque N m)`` checked: a pin's only, the torque bound
     only with a speed."""
     if speed is None:
@@ -174,7 +179,7 @@ def motor(kind: str, speed, max_torque) -> tuple[float | None, float | None]:
     return s, None if max_torque is None else _positive(max_torque, "max_torque", "N m")
 
 
-def spring(kind: str, stiffness, damping) -> tuple[float | None, float | None]:
+def spring(kind: str, stiffness: float | None, damping: float | None) -> tuple[float | None, float | None]:
     """A joint's ``(stiffness N/m, damping N s/m)`` checked: a spring's, and only a spring's."""
     if kind != "spring":
         for name, value in (("stiffness", stiffness), ("damping", damping)):
@@ -187,7 +192,7 @@ def spring(kind: str, stiffness, damping) -> tuple[float | None, float | None]:
             0.0 if damping is None else _non_negative(damping, "damping", "N*s/m"))
 
 
-def pack_rows(joints, model, bodies: np.ndarray):
+def pack_rows(joints: list[Joint], model: Model, bodies: np.ndarray) -> Any:
     """The joints as avbd's rows (:class:`~deforma.physics.integrators.avbd.joints.JointRows`)
     of ``model``, whose rigid bodies are ``bodies`` (body indices, in block order), warm-started
     from each joint's last step; None without joints. A side on a rigid body is its frame
@@ -224,7 +229,7 @@ def pack_rows(joints, model, bodies: np.ndarray):
     return make_joint_rows(block, fv, fw, kind, param, motor_on, lam, pen, len(bodies), model.n_vertices)
 
 
-def read_rows(joints, rows, dt: float) -> None:
+def read_rows(joints: list[Joint], rows: Any, dt: float) -> None:
     """After a step of ``dt`` s: each joint's force and torque (the rows' totals over the
     step, per second) and its rows' warm start for the next."""
     from .integrators.avbd.joints import LAM, PEN, TOTAL
@@ -235,7 +240,7 @@ def read_rows(joints, rows, dt: float) -> None:
         j._pen[...] = rows.jf[i, PEN:PEN + 4]
 
 
-def frame(x: np.ndarray, point) -> tuple[int, int, float, float, float]:
+def frame(x: np.ndarray, point: ArrayLike) -> tuple[int, int, float, float, float]:
     """Two of a rigid body's vertices ``x`` (body-local indices) and the point's ``(alpha,
     beta)`` on them (``point = x_0 + alpha d + beta perp(d)``, ``d = x_1 - x_0``), and the
     angle of ``d`` (rad): the point carried exactly as the body moves. The two are the
@@ -248,7 +253,7 @@ def frame(x: np.ndarray, point) -> tuple[int, int, float, float, float]:
     return 0, i1, float(w @ d) / n2, float(-w[0] * d[1] + w[1] * d[0]) / n2, math.atan2(d[1], d[0])
 
 
-def triangle_weights(x: np.ndarray, triangles: np.ndarray, point) -> tuple[np.ndarray, np.ndarray]:
+def triangle_weights(x: np.ndarray, triangles: np.ndarray, point: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """The triangle of a soft body (vertices ``x``, ``triangles``) that holds ``point`` and
     the point's barycentric weights on it, ``(vertices (3,), weights (3,))``: of the
     triangles under the point (on a shared edge or vertex, several) the one whose least
@@ -266,6 +271,6 @@ def triangle_weights(x: np.ndarray, triangles: np.ndarray, point) -> tuple[np.nd
     return triangles[best].astype(np.int64), weights / weights.sum()
 
 
-def anchor(value) -> tuple[float, float]:
+def anchor(value: ArrayLike) -> tuple[float, float]:
     """The joint point ``at`` checked (m)."""
     return _pair(value, "at")

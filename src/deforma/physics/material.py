@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import KW_ONLY, dataclass
+from typing import Any
 
 from .elements.kind import BUILT_IN, registered_models
 
@@ -222,7 +223,7 @@ class Material:
         object.__setattr__(self, "damping", d)
 
     @classmethod
-    def preset(cls, name: str, **overrides) -> "Material":
+    def preset(cls, name: str, **overrides: Any) -> "Material":
         """A named material with real-world parameters (SI; see :data:`PRESETS`), any of them
         replaced by ``overrides`` (the keywords of :class:`Material`).
 
@@ -326,6 +327,7 @@ class Material:
         if not self.is_fem or self.is_rigid:
             raise ValueError(f"the {self.model!r} material has no Lamé parameters")
         e, nu = self.youngs_modulus, self.poisson_ratio
+        assert e is not None and nu is not None  # set for every FEM model (__post_init__)
         if self.plane == "strain":
             return e / (2.0 * (1.0 + nu)), e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
         return e / (2.0 * (1.0 + nu)), e * nu / (1.0 - nu * nu)
@@ -333,4 +335,4 @@ class Material:
     def wave_speed(self) -> float:
         """Speed of the fastest (dilatational) wave in the sheet, m/s: ``sqrt((lambda + 2 mu) / rho)``."""
         mu, lam = self.lame()
-        return math.sqrt((lam + 2.0 * mu) / self.density)
+        return math.sqrt((lam + 2.0 * mu) / self.density)  # type: ignore[operator]  # lame() checked the model

@@ -12,6 +12,7 @@ import re
 import sys
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,10 +22,16 @@ from .schema import Scene, parse_scene, scene_to_dict
 from .tables import (BEHAVIOUR_KEYS, MATERIAL_KEYS, CircleCollider, ColliderSpec, InteractionSettings, JointSpec,
                      MeshBody, PhysicsSettings, PolygonCollider, SceneError, SegmentCollider, material_settings)
 
+if TYPE_CHECKING:
+    import os
+
+    from ..physics import Collider, World
+    from .tables import BoxBody, ImageBody
+
 try:  # Python >= 3.11
     import tomllib
 except ImportError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+    import tomli as tomllib  # type: ignore[no-redef]
 
 __all__ = ["body_specs", "build", "collider_spec", "load", "load_scene", "save_scene", "scene_of"]
 
@@ -35,7 +42,7 @@ __all__ = ["body_specs", "build", "collider_spec", "load", "load_scene", "save_s
 SCENE_MAX_NESTING = 5
 
 
-def load(name_or_path) -> Scene:
+def load(name_or_path: str | os.PathLike[str]) -> Scene:
     """Read and validate a scene: a built-in name (``deforma scenes`` lists them) or a ``.toml`` path.
 
     Raises
@@ -81,7 +88,7 @@ def load(name_or_path) -> Scene:
     return replace(scene, path=str(path.resolve()))
 
 
-def load_scene(name_or_path):
+def load_scene(name_or_path: str | os.PathLike[str]) -> World:
     """A :class:`deforma.World` from a built-in scene name or a ``.toml`` file.
 
     Parameters
@@ -154,7 +161,7 @@ def _expected_material(physics: PhysicsSettings, spec):
     try:
         own = material_settings(physics, spec)
         settings = own if own is not None else material_settings(physics)
-        return Material(**settings)
+        return Material(**settings)  # type: ignore[arg-type]  # material_settings(physics) is a table
     except ValueError:
         return None
 
@@ -189,7 +196,7 @@ def _pin_keys(spec, body) -> dict:
     return dict(pin=None, pin_vertices=pinned or None)
 
 
-def scene_of(world) -> Scene:
+def scene_of(world: World) -> Scene:
     """The scene of ``world`` as it is now: its current parameters, bodies and colliders.
 
     Bodies made from a scene keep their recipe (box or image parameters, colour, texture);
@@ -240,7 +247,7 @@ def scene_of(world) -> Scene:
             spec = MeshBody(vertices=tuple(map(tuple, b.topology.rest_positions.tolist())),
                             triangles=tuple(map(tuple, np.asarray(b.triangles).tolist())),
                             uv=None if uv is None else tuple(map(tuple, np.asarray(uv).tolist())))
-        overrides = {}
+        overrides: dict[str, Any] = {}
         fem = b.is_fem
         for name in ("mass", "stiffness", "damping", "friction", "static_friction"):
             if fem and name in ("mass", "stiffness", "damping"):
@@ -284,7 +291,9 @@ def _loop(points) -> tuple:
     return tuple(_xy(p, 9) for p in np.asarray(points).tolist())
 
 
-def collider_spec(collider, spec=None, pose=None):
+def collider_spec(collider: Collider, spec: ColliderSpec | None = None,
+                  pose: tuple[Any, float] | None = None
+                  ) -> ColliderSpec | CircleCollider | SegmentCollider | PolygonCollider:
     """The ``[[collider]]`` spec of ``collider``: its motion and friction now, at its
     :attr:`~deforma.physics.colliders.shapes.Collider.origin` (where it was put, before its own motion
     moved it: a saved moving collider starts where it started, as bodies do).
@@ -305,9 +314,9 @@ shape='circle', center=(1.0, 2.0), radius=0.5)
     from ..physics import Circle, Polygon, Rect, Segment
 
     collider = collider.at_origin()
-    common = dict(velocity=_xy(collider.velocity), angular_velocity=float(collider.angular_velocity),
-                  friction=collider.friction, static_friction=collider.static_friction,
-                  color=None if spec is None else spec.color)
+    common: dict[str, Any] = dict(velocity=_xy(collider.velocity), angular_velocity=float(collider.angular_velocity),
+                                  friction=collider.friction, static_friction=collider.static_friction,
+                                  color=None if spec is None else spec.color)
     still = pose is not None and (collider.center, collider.angle) == pose
     if isinstance(collider, Rect):
         # a turning rect's angle grows without end; a file takes [-360, 360]
@@ -328,7 +337,7 @@ shape='circle', center=(1.0, 2.0), radius=0.5)
     raise TypeError(f"cannot write a collider of type {type(collider).__name__} to a scene")
 
 
-def body_specs(world) -> list:
+def body_specs(world: World) -> list[BoxBody | ImageBody | MeshBody]:
     """The scene spec of each of ``world.bodies`` (a MeshBody for bodies not made from a scene)."""
     return list(scene_of(world).body)
 
@@ -360,7 +369,7 @@ def _inline_short_arrays(text: str) -> str:
         text = new
 
 
-def save_scene(world, path) -> Path:
+def save_scene(world: World, path: str | os.PathLike[str]) -> Path:
     """Write ``world`` (or a :class:`Scene`) to a TOML scene file that :func:`load_scene` reads back.
 
     Every key is written, defaults included, except integrator options, of which only those

@@ -20,13 +20,18 @@ from __future__ import annotations
 
 import copy
 import math
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ...checks import coefficient as _coefficient
 from ...checks import number as _number
 from ...checks import pair as _pair
 from ...mesh.polygons import inside_loops, segments_meet, signed_area
+
+if TYPE_CHECKING:
+    from ...mesh.image import Background, ImageSource
 
 # Columns of the packed array. Collider rows:
 RECT_CX, RECT_CY, RECT_UX, RECT_UY = 0, 1, 2, 3   # centre; unit x axis of the shape's frame
@@ -110,7 +115,8 @@ class Collider:
 
     kind = -2  # set by each shape
 
-    def __init__(self, center, angle, friction, static_friction, velocity, angular_velocity):
+    def __init__(self, center: ArrayLike, angle: float, friction: float | None, static_friction: float | None,
+                 velocity: ArrayLike, angular_velocity: float) -> None:
         self._version = 0
         self.center = center
         self.angle = angle
@@ -128,7 +134,7 @@ class Collider:
         return self._center
 
     @center.setter
-    def center(self, value):
+    def center(self, value: ArrayLike) -> None:
         self._center = self._origin_center = _pair(value, "center")  # within +-1e9 m
         self._changed()
 
@@ -138,7 +144,7 @@ class Collider:
         return self._angle
 
     @angle.setter
-    def angle(self, value):
+    def angle(self, value: float) -> None:
         self._angle = self._origin_angle = _finite(value, "angle")
         self._changed()
 
@@ -165,7 +171,7 @@ class Collider:
         return self._velocity
 
     @velocity.setter
-    def velocity(self, value):
+    def velocity(self, value: ArrayLike) -> None:
         v = _pair(value, "velocity")
         if max(abs(v[0]), abs(v[1])) > MAX_SPEED:
             raise ValueError(f"velocity must be within +-{MAX_SPEED:g} m/s, got {value!r}")
@@ -178,7 +184,7 @@ class Collider:
         return self._angular_velocity
 
     @angular_velocity.setter
-    def angular_velocity(self, value):
+    def angular_velocity(self, value: float) -> None:
         self._angular_velocity = _finite(value, "angular_velocity", bound=MAX_ANGULAR_SPEED)
         self._changed()
 
@@ -188,7 +194,7 @@ class Collider:
         return self._friction
 
     @friction.setter
-    def friction(self, value):
+    def friction(self, value: float | None) -> None:
         self._friction = _coefficient(value, "friction")
         self._changed()
 
@@ -198,7 +204,7 @@ class Collider:
         return self._static_friction
 
     @static_friction.setter
-    def static_friction(self, value):
+    def static_friction(self, value: float | None) -> None:
         self._static_friction = _coefficient(value, "static_friction")
         self._changed()
 
@@ -207,7 +213,7 @@ class Collider:
         """Whether it has a velocity or an angular velocity."""
         return self._velocity != (0.0, 0.0) or self._angular_velocity != 0.0
 
-    def surface_velocity(self, points) -> np.ndarray:
+    def surface_velocity(self, points: ArrayLike) -> np.ndarray:
         """(N, 2) velocity (m/s) of the collider's material at each point: ``v + w x (p - c)``."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
         w = math.radians(self._angular_velocity)
@@ -220,7 +226,7 @@ class Collider:
             self._set_pose((self._center[0] + self._velocity[0] * dt, self._center[1] + self._velocity[1] * dt),
                            self._angle + self._angular_velocity * dt)
 
-    def contains(self, points) -> np.ndarray:
+    def contains(self, points: ArrayLike) -> np.ndarray:
         """Whether each point (N, 2) lies strictly inside, as (N,) bool."""
         raise NotImplementedError
 
@@ -277,8 +283,8 @@ class Rect(Collider):
 
     kind = RECT
 
-    def __init__(self, center, size, angle=0.0, *, friction=None, static_friction=None, velocity=(0.0, 0.0),
-                 angular_velocity=0.0):
+    def __init__(self, center: ArrayLike, size: ArrayLike, angle: float = 0.0, *, friction: float | None = None, static_friction: float | None = None,
+                 velocity: ArrayLike = (0.0, 0.0), angular_velocity: float = 0.0) -> None:
         self.size = size
         super().__init__(center, angle, friction, static_friction, velocity, angular_velocity)
 
@@ -288,7 +294,7 @@ class Rect(Collider):
         return self._size
 
     @size.setter
-    def size(self, value):
+    def size(self, value: ArrayLike) -> None:
         self._size = _pair(value, "size", positive=True)  # at most 1e9 m
         if hasattr(self, "_version"):
             self._changed()
@@ -306,7 +312,7 @@ class Rect(Collider):
         c = np.array(self._center)
         return np.array([c + hx * u - hy * w, c + hx * u + hy * w, c - hx * u + hy * w, c - hx * u - hy * w])
 
-    def contains(self, points) -> np.ndarray:
+    def contains(self, points: ArrayLike) -> np.ndarray:
         q = self._local(points)
         return (np.abs(q[:, 0]) < self._size[0] / 2) & (np.abs(q[:, 1]) < self._size[1] / 2)
 
@@ -338,8 +344,8 @@ class Circle(Collider):
 
     kind = CIRCLE
 
-    def __init__(self, center, radius, *, friction=None, static_friction=None, velocity=(0.0, 0.0),
-                 angular_velocity=0.0):
+    def __init__(self, center: ArrayLike, radius: float, *, friction: float | None = None, static_friction: float | None = None,
+                 velocity: ArrayLike = (0.0, 0.0), angular_velocity: float = 0.0) -> None:
         self.radius = radius
         super().__init__(center, 0.0, friction, static_friction, velocity, angular_velocity)
 
@@ -349,12 +355,12 @@ class Circle(Collider):
         return self._radius
 
     @radius.setter
-    def radius(self, value):
+    def radius(self, value: float) -> None:
         self._radius = _finite(value, "radius", bound=1e9, positive=True)
         if hasattr(self, "_version"):
             self._changed()
 
-    def contains(self, points) -> np.ndarray:
+    def contains(self, points: ArrayLike) -> np.ndarray:
         q = self._local(points)
         return np.einsum("ij,ij->i", q, q) < self._radius ** 2
 
@@ -394,8 +400,8 @@ class Segment(Collider):
 
     kind = SEGMENT
 
-    def __init__(self, a, b, *, radius=0.0, friction=None, static_friction=None, velocity=(0.0, 0.0),
-                 angular_velocity=0.0):
+    def __init__(self, a: ArrayLike, b: ArrayLike, *, radius: float = 0.0, friction: float | None = None, static_friction: float | None = None,
+                 velocity: ArrayLike = (0.0, 0.0), angular_velocity: float = 0.0) -> None:
         pa, pb = np.array(_pair(a, "a")), np.array(_pair(b, "b"))
         d = pb - pa
         length = float(np.hypot(*d))
@@ -414,7 +420,7 @@ class Segment(Collider):
         return self._radius
 
     @radius.setter
-    def radius(self, value):
+    def radius(self, value: float) -> None:
         self._radius = _finite(value, "radius", bound=1e9, non_negative=True)
         if hasattr(self, "_version"):
             self._changed()
@@ -436,7 +442,7 @@ class Segment(Collider):
         u = _rotation(self._angle)[:, 0]
         return (float(self._center[0] + self._half * u[0]), float(self._center[1] + self._half * u[1]))
 
-    def contains(self, points) -> np.ndarray:
+    def contains(self, points: ArrayLike) -> np.ndarray:
         q = self._local(points)
         dx = np.abs(q[:, 0]) - self._half
         dx = np.maximum(dx, 0.0)
@@ -485,8 +491,8 @@ class Polygon(Collider):
 
     kind = POLYGON
 
-    def __init__(self, points, *, holes=(), friction=None, static_friction=None, velocity=(0.0, 0.0),
-                 angular_velocity=0.0):
+    def __init__(self, points: ArrayLike, *, holes: Sequence[ArrayLike] = (), friction: float | None = None, static_friction: float | None = None,
+                 velocity: ArrayLike = (0.0, 0.0), angular_velocity: float = 0.0) -> None:
         outer = _points(points, "points", minimum=3)
         if abs(signed_area(outer)) <= 1e-12 * max(1.0, float(np.ptp(outer, axis=0).max()) ** 2):
             spread = np.linalg.svd(outer - outer.mean(axis=0), compute_uv=False)
@@ -545,7 +551,7 @@ class Polygon(Collider):
         """The outer boundary, then the holes."""
         return [self._world(p) for p in self._local_loops]
 
-    def contains(self, points) -> np.ndarray:
+    def contains(self, points: ArrayLike) -> np.ndarray:
         q = self._local(points)
         return inside_loops(q, self._local_loops)
 
@@ -560,7 +566,7 @@ class Polygon(Collider):
 SHAPES = (Rect, Circle, Polygon, Segment)
 
 
-def pack_colliders(colliders, *, friction: float, static_friction: float) -> np.ndarray:
+def pack_colliders(colliders: Sequence[Collider], *, friction: float, static_friction: float) -> np.ndarray:
     """Pack colliders into the (R + E, RECT_COLUMNS) float64 array the kernels read.
 
     ``friction`` / ``static_friction`` fill in coefficients a collider leaves as ``None``.
@@ -574,9 +580,10 @@ def pack_colliders(colliders, *, friction: float, static_friction: float) -> np.
     >>> a.shape, int(a[0, KIND]), int(a[0, RECT_HX]), int(a[0, RECT_HY])  # 3 edge rows from row 1
     ((4, 21), 2, 1, 3)
     """
-    rows = []
-    edges = []
+    rows: list[np.ndarray] = []
+    edges: list[np.ndarray] = []
     n = len(colliders)
+    c: Any  # each shape's own fields, by its kind
     for c in colliders:
         row = np.zeros(RECT_COLUMNS)
         row[KIND] = c.kind
@@ -656,8 +663,9 @@ def _polygon_reach(loops: list[np.ndarray]) -> float:
     return 0.5 * best if np.isfinite(best) else 0.0
 
 
-def colliders_from_image(source, *, scale=0.01, position=(0.0, 0.0), tolerance=1.0, background="black",
-                         threshold=None, min_area=4.0, friction=None, static_friction=None) -> list[Polygon]:
+def colliders_from_image(source: ImageSource, *, scale: float = 0.01, position: ArrayLike = (0.0, 0.0),
+                         tolerance: float = 1.0, background: Background = "black", threshold: float | None = None,
+                         min_area: float = 4.0, friction: float | None = None, static_friction: float | None = None) -> list[Polygon]:
     """A level drawn as a picture: its foreground as static :class:`Polygon` colliders.
 
     One polygon per connected piece of foreground, holes kept, its outline simplified to

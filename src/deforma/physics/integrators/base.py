@@ -36,7 +36,7 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, NamedTuple
+from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple, TypeVar
 
 import numpy as np
 from numba import njit
@@ -48,6 +48,13 @@ from ..contact.broad_phase import gather_start
 from ..contact.narrow_phase import detect_contacts
 from ..contact.response import hold_start_distance
 from ..contact.stage import contact_stage
+
+if TYPE_CHECKING:
+    from ..contact.contacts import Contacts
+    from ..contact.pairs import ContactImpulses
+    from ..control import Control
+    from ..model import Model
+    from ..state import State
 
 
 @njit(cache=True, inline="always")
@@ -201,7 +208,7 @@ class Option:
             return f"a number in {'[' if self.closed_low else '('}{self.low:g}, {self.high:g})"
         return "one of " + ", ".join(repr(c) for c in self.choices)
 
-    def check(self, value, integrator: str):
+    def check(self, value: Any, integrator: str) -> Any:
         """``value`` as the option keeps it; ``ValueError`` saying what is allowed if it is not."""
         bad = ValueError(f"{integrator} option {self.name} must be {self.allowed()}, got {value!r}")
         if self.kind == "int":
@@ -245,7 +252,7 @@ class Integrator:
     solves_pressure = False
     solves_rigid = False
 
-    def __init__(self, **options):
+    def __init__(self, **options: Any) -> None:
         self._options = {o.name: o.default for o in self.OPTIONS}
         self.configure(options)
 
@@ -254,7 +261,7 @@ class Integrator:
         """The integrator's settings by name (a copy: set them with :meth:`configure`)."""
         return dict(self._options)
 
-    def configure(self, options) -> None:
+    def configure(self, options: Mapping[str, Any]) -> None:
         """Set the options named in the mapping ``options``; the others go back to their
         defaults. Checks every value first: a bad one raises ``ValueError`` and changes nothing."""
         if not hasattr(options, "items"):
@@ -275,19 +282,20 @@ class Integrator:
         """Counters of the work done so far (per integrator; empty by default)."""
         return {}
 
-    def contact_impulses(self, model):
+    def contact_impulses(self, model: Model) -> ContactImpulses | None:
         """The last step's contact rows with their impulses
         (:class:`~deforma.physics.contact.pairs.ContactImpulses`), or None where the integrator
         keeps no contact force (the World then lists its contacts without impulses)."""
         return None
 
-    def step(self, model, state_in, state_out, control, contacts, h: float, *, substeps: int = 1,
+    def step(self, model: Model, state_in: State, state_out: State, control: Control, contacts: Contacts, h: float,
+             *, substeps: int = 1,
              max_speed: float = math.inf) -> StepReport:
         """Advance ``state_out`` by ``substeps`` substeps of ``h`` seconds (see the module docstring)."""
         raise NotImplementedError
 
 
-def unknown_option(key, integrator: str) -> str:
+def unknown_option(key: Any, integrator: str) -> str:
     """The message for an option ``key`` that ``integrator`` does not take: which integrator
     does take it, or the nearest of its own names."""
     others = [n for n, cls in _REGISTRY.items() if n != integrator and any(o.name == key for o in cls.OPTIONS)]
@@ -301,10 +309,12 @@ def unknown_option(key, integrator: str) -> str:
     return f"unknown {integrator} option {key!r}{hint}; {takes}"
 
 
-_REGISTRY: dict[str, Callable[[], Integrator]] = {}
+_REGISTRY: dict[str, type[Integrator]] = {}
+
+_I = TypeVar("_I", bound=type[Integrator])
 
 
-def register_integrator(name: str):
+def register_integrator(name: str) -> Callable[[_I], _I]:
     """Class decorator: make an :class:`Integrator` subclass available as ``World(integrator=name)``.
 
     Examples
@@ -318,7 +328,7 @@ def register_integrator(name: str):
     True
     >>> _ = _REGISTRY.pop("noop")
     """
-    def deco(cls):
+    def deco(cls: _I) -> _I:
         if name in _REGISTRY:
             raise ValueError(f"an integrator named {name!r} is already registered")
         if not (isinstance(cls, type) and issubclass(cls, Integrator)):
@@ -340,7 +350,7 @@ def available_integrators() -> list[str]:
     return list(_REGISTRY)
 
 
-def make_integrator(name: str, options=None) -> Integrator:
+def make_integrator(name: str, options: Mapping[str, Any] | None = None) -> Integrator:
     """A new integrator instance by name with ``options`` (a mapping; defaults for the rest);
     ``ValueError`` naming the choices if the name is unknown, or saying what is wrong with an option."""
     try:
