@@ -169,3 +169,41 @@ def test_a_body_drifting_slowly_through_space_keeps_its_momentum():
     still.pin([0])
     _run(w, 1.0)
     assert still.sleeping and not body.sleeping
+
+
+def test_a_sleeping_body_is_awake_for_the_step_a_thrown_body_reaches_it():
+    # woken only after the step of the impact (by its contact pairs), the sleeping box met
+    # the thrown one held, as a wall: the cards scene's wheel bounced off the house of cards
+    w = _stack(1)
+    _run(w, 1.0)
+    low = w.bodies[0]
+    top = w.add_body(_box(), position=(0.0, 1.0), material=WOOD)
+    w.step()  # (a body added wakes every island at the next step)
+    low.sleeping = True
+    top.velocities = np.tile([0.0, -8.0], (top.n_vertices, 1))  # 13 cm a step: past any contact margin
+    for _ in range(120):
+        w.step()
+        if w.contacts_between(low, top) is not None:
+            break
+    else:
+        pytest.fail("the thrown box never reached the one below")
+    # it moved in the step of the impact: held (asleep), its velocities would stay exactly 0
+    assert np.abs(low.velocities).max() > 0.0
+
+
+def test_a_sleeping_body_is_awake_for_the_step_a_moving_collider_reaches_it():
+    w = _stack(1)
+    box = w.bodies[0]
+    paddle = w.add_collider(deforma.Rect((-1.0, 0.15), (0.2, 0.1), 0.0))
+    _run(w, 1.0)
+    assert box.sleeping
+    paddle.velocity = (6.0, 0.0)  # 10 cm a step, towards the box 0.85 m away
+    w.step()  # (a collider's change of motion wakes every island at the next step)
+    box.sleeping = True
+    for _ in range(60):
+        w.step()
+        if w.contacts_between(box, paddle) is not None:
+            break
+    else:
+        pytest.fail("the paddle never reached the box")
+    assert np.abs(box.velocities).max() > 0.0  # held (asleep), they would stay exactly 0

@@ -10,7 +10,10 @@ sleep would take), falls asleep as a whole: its velocities become zero and its v
 are held as pins are (infinite mass) until it wakes, so the bodies awake meet it as a fixed
 shape. When every body sleeps the step costs no integration at all.
 
-An island wakes when one of its bodies is touched by an awake body, is pushed, pulled,
+An island wakes when an awake body may reach one of its bodies within the step (checked
+before the step, on bounding boxes grown by the awake body's reach, :func:`body_boxes`,
+:func:`touching_boxes`: woken after it, the island would meet the impact held, as a wall),
+when one of its bodies is touched by an awake body, is pushed, pulled,
 dragged, pinned or unpinned, gets a joint or loses one, touches a moving collider, or has
 a parameter set; a change to the world's own parameters, its colliders or its bodies wakes
 every island. Box2D does the same (islands over contacts and joints, a time below speed
@@ -46,6 +49,40 @@ def fastest_vertex(v: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     filled = np.diff(offsets) > 0
     out[filled] = np.maximum.reduceat(speed, offsets[:-1][filled]) if len(speed) else 0.0
     return out
+
+
+def body_boxes(x: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per body, the corners ``(lo, hi)`` (B, 2) of its bounding box (m): vertices ``x`` (N, 2)
+    m, bodies' vertices ``offsets[b]:offsets[b + 1]`` (an empty body's box is empty: lo = inf,
+    hi = -inf).
+
+    Examples
+    --------
+    >>> lo, hi = body_boxes(np.array([[0.0, 0.0], [1.0, 2.0], [5.0, 5.0]]), np.array([0, 2, 3]))
+    >>> lo.tolist(), hi.tolist()
+    ([[0.0, 0.0], [5.0, 5.0]], [[1.0, 2.0], [5.0, 5.0]])
+    """
+    b = len(offsets) - 1
+    lo, hi = np.full((b, 2), np.inf), np.full((b, 2), -np.inf)
+    filled = np.diff(offsets) > 0
+    if filled.any():
+        lo[filled] = np.minimum.reduceat(x, offsets[:-1][filled])
+        hi[filled] = np.maximum.reduceat(x, offsets[:-1][filled])
+    return lo, hi
+
+
+def touching_boxes(lo_a: np.ndarray, hi_a: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray) -> np.ndarray:
+    """Which of the boxes ``b`` (corners (M, 2)) overlap any of the boxes ``a`` ((K, 2)): (M,)
+    bool.
+
+    Examples
+    --------
+    >>> touching_boxes(np.array([[0.0, 0.0]]), np.array([[1.0, 1.0]]),
+    ...                np.array([[0.5, 0.5], [2.0, 0.0]]), np.array([[3.0, 3.0], [3.0, 1.0]])).tolist()
+    [True, False]
+    """
+    overlap = ((lo_a[:, None, :] <= hi_b[None, :, :]) & (lo_b[None, :, :] <= hi_a[:, None, :])).all(axis=2)
+    return overlap.any(axis=0)
 
 
 def islands(n_bodies: int, links: np.ndarray) -> np.ndarray:

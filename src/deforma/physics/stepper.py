@@ -107,6 +107,7 @@ def step(world) -> None:
         if key != w._sleep_key:  # a parameter, the bodies, the joints or a still collider changed
             w._wake(w._bodies)
             w._sleep_key = key
+        w._wake_approached()
     # no body, or every body asleep and no collider moving: nothing to integrate
     idle = not w._model.n_vertices or (w._sleep and not poses and all(b._asleep for b in w._bodies))
     if idle:  # moving colliders still move

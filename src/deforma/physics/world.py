@@ -36,7 +36,7 @@ from .contact.pairs import ContactPair, group_pairs, impulses_from_points
 from .control import Control
 from ..checks import IgnoredSettingWarning, StepBeyondStableWarning
 from .diagnostics import Energy, SimulationUnstable
-from .sleeping import SLEEP_TIME, fastest_vertex, islands, sleep_changes
+from .sleeping import SLEEP_TIME, body_boxes, fastest_vertex, islands, sleep_changes, touching_boxes
 from .events import ContactEvent, Events
 from . import joint as _joint
 from .joint import Joint
@@ -241,6 +241,38 @@ class World:
             b._asleep = False
             b._still = 0.0
         self._hold(woken)
+
+    def _wake_approached(self) -> None:
+        """Before a step: wake the islands an awake body or a moving collider may reach in it.
+        Woken after the step (by its contact pairs), a sleeping island met the step's impact
+        held, as a wall: the ``cards`` scene's wheel bounced off the sleeping house instead of
+        knocking it down."""
+        bodies = self._bodies
+        asleep = np.array([b._asleep for b in bodies], bool)
+        if not asleep.any():
+            return
+        offsets = self._model.body_vertex_offsets
+        lo, hi = body_boxes(self._state.x, offsets)
+        dt = self.dt
+        # how far each awake body may get this step: its fastest vertex, and gravity's pull
+        # from rest, plus both sides' contact thickness
+        thick = np.array([b.contact_thickness for b in bodies])
+        reach = fastest_vertex(self._state.v, offsets) * dt + math.hypot(*self._gravity) * dt * dt + thick
+        lo_a, hi_a = lo[~asleep] - reach[~asleep, None], hi[~asleep] + reach[~asleep, None]
+        moving = [c for c in self._colliders if c.moving]
+        if moving:  # and each moving collider: its speed, the turn's at its box's corners
+            box = np.array([c.bounds() for c in moving]).reshape(-1, 4)
+            half = 0.5 * np.hypot(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
+            speed = np.array([math.hypot(*c.velocity) for c in moving]) + half * np.abs(
+                np.radians([c.angular_velocity for c in moving]))
+            r = (speed * dt)[:, None]
+            lo_a, hi_a = np.vstack([lo_a, box[:, :2] - r]), np.vstack([hi_a, box[:, 2:] + r])
+        if not len(lo_a):
+            return
+        hit = touching_boxes(lo_a, hi_a, lo[asleep] - thick[asleep, None], hi[asleep] + thick[asleep, None])
+        for k in np.flatnonzero(asleep)[hit]:
+            if bodies[k]._asleep:
+                self._wake(self._island_of(bodies[k]))
 
     def _fall_asleep(self, bodies) -> None:
         for b in bodies:
