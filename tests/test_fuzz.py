@@ -273,3 +273,60 @@ def test_a_sweep_video_too_big_for_memory_is_refused_before_anything_runs(tmp_pa
         sweep(spec, tmp_path / "out", video="mp4", video_size=(7680, 4320))
     one_line(e.value)
     assert sorted(os.listdir(tmp_path)) == ["s.toml"]
+
+
+# "this world cannot step at this dt": one error type, SimulationUnstable (StepTooLong, also a
+# ValueError, where substeps = "auto" would need more than 1000 substeps)
+def _stiff_world():
+    import warnings
+
+    w = deforma.World(integrator="symplectic-euler", dt=0.1, substeps=1, stiffness=1e7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # add_body says it at once; here it is asked for
+        b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=4), position=(0, 2))
+    return w, b
+
+
+def test_auto_substeps_past_the_limit_is_simulation_unstable_naming_the_dt_that_fits():
+    from deforma.physics.diagnostics import StepTooLong
+
+    w, b = _stiff_world()
+    before = b.positions.copy()
+    with pytest.raises(deforma.SimulationUnstable) as e:  # it was a bare ValueError
+        w.substeps = "auto"
+    one_line(e.value)
+    assert isinstance(e.value, StepTooLong) and isinstance(e.value, ValueError)  # old `except ValueError` works
+    assert e.value.needed == 3802 and e.value.body is b and e.value.step == 0
+    assert re.fullmatch(r'substeps = "auto" would need 3802 substeps of dt = 0\.1 s \(stable step 2\.63e-05 s\), '
+                        r'more than 1000: lower dt to 0\.0263 s or less \(1000 substeps of it hold\), soften the bodies, or use '
+                        r'integrator="implicit-euler" \(stable at any step\)', str(e.value)), str(e.value)
+    assert e.value.hint in str(e.value)
+    assert w.substeps == 1 and not w.auto_substeps and np.array_equal(b.positions, before)  # nothing changed
+    # the dt it names fits: "auto" takes it, at most 1000 substeps, and the step runs
+    w.dt = e.value.largest_dt
+    w.substeps = "auto"
+    assert 990 < w.substeps <= 1000
+    # the same type when a step finds it (a dt raised after "auto" was set): the world as before
+    w.dt = 0.1
+    with pytest.raises(StepTooLong) as e2:
+        w.step()
+    one_line(e2.value)
+    assert w.step_count == 0 and np.array_equal(b.positions, before)
+
+
+def test_run_that_cannot_step_at_its_dt_says_so_in_one_line_and_writes_nothing(tmp_path, capsys):
+    from deforma.cli import EXIT_UNSTABLE, main
+
+    scene = tmp_path / "stiff.toml"
+    scene.write_text('[physics]\ndt = 0.1\nintegrator = "symplectic-euler"\nstiffness = 1e7\n'
+                     '[[body]]\nshape = "box"\ncorners = [[0, 0], [1, 0], [1, 1], [0, 1]]\ndetail = 4\n'
+                     'position = [0.0, 2.0]\n[[collider]]\ncenter = [0.0, -0.5]\nsize = [4.0, 1.0]\n')
+    code = main(["run", str(scene), "--seconds", "0.5", "--states", str(tmp_path / "s.npz"),
+                 "--export", str(tmp_path / "frames")])
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith("deforma: compiling")]
+    assert code == EXIT_UNSTABLE and len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith(f"deforma: error: {scene}: cannot step at t = 0.000 s: substeps = \"auto\" would "
+                               f"need 3802 substeps"), lines[0]
+    assert "lower dt to 0.0263 s or less" in lines[0] and lines[0].endswith("; nothing was written")
+    assert os.listdir(tmp_path) == ["stiff.toml"]

@@ -357,6 +357,7 @@ def _run_scene(a, watch, shown: dict) -> int:
 
     from . import scene as scenes
     from .physics import SimulationUnstable
+    from .physics.diagnostics import StepTooLong
     from .scene.playback import Playback, frame_count
 
     scene = scenes.load(a.scene)  # SceneError is a one-line ValueError
@@ -441,7 +442,10 @@ def _run_scene(a, watch, shown: dict) -> int:
         if writer is not None:
             writer.close()
     except SimulationUnstable as e:
-        raise CliError(f"{a.scene}: simulation became unstable at t = {world.time:.3f} s: {e}; "
+        # one error type for "this world cannot step at this dt": refused before the step
+        # (StepTooLong: "auto" substeps past the limit) or blown up in it; both exit 3
+        what = "cannot step" if isinstance(e, StepTooLong) else "simulation became unstable"
+        raise CliError(f"{a.scene}: {what} at t = {world.time:.3f} s: {e}; "
                        f"nothing was written", EXIT_UNSTABLE) from None
     finally:
         if bar is not None:

@@ -1,6 +1,8 @@
 """world.solve_static: static equilibrium against known answers, and one line for what it
 cannot solve."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -92,3 +94,107 @@ def test_what_it_cannot_solve_is_refused_and_changes_nothing():
         w.solve_static(max_iterations=1)
     assert np.array_equal(c.positions, before) and w.integrator == "symplectic-euler" and w.step_count == 0
     assert np.array_equal(b.positions, free.bodies[0].positions)
+
+
+# -- issue 51: statics that end: progress, a time bound, and what cannot settle named ----------
+import time  # noqa: E402
+
+
+def box_on_floor(floor=(10.0, 0.5), *, force=None, friction=0.0, sleep=True):
+    """A small corotated block on a floor (frictionless by default), pushed sideways by ``force`` N."""
+    w = deforma.World(friction=friction, static_friction=friction, sleep=sleep)
+    w.add_collider(deforma.Rect((0.0, -0.25), floor))
+    b = w.add_body(deforma.mesh.box(((0, 0), (0.4, 0), (0.4, 0.2), (0, 0.2)), detail=2), position=(0.0, 0.15),
+                   material=deforma.Material("corotated", youngs_modulus=1e5, poisson_ratio=0.3, density=100.0))
+    if force is not None:
+        b.apply_force(force)
+    return w, b
+
+
+def refused(w, b, match, **kwargs):
+    """solve_static raises one ValueError line matching ``match`` and leaves ``w`` as it was."""
+    before, forces = b.positions.copy(), list(w._forces)
+    seen = []
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=match) as e:
+        w.solve_static(progress=seen.append, **kwargs)
+    assert "\n" not in str(e.value)
+    assert np.array_equal(b.positions, before) and not b.velocities.any() and w.step_count == 0 and w.time == 0.0
+    assert w._forces == forces and w.integrator == "avbd" and w.sleep and not b.sleeping
+    return e.value, seen, time.perf_counter() - t0
+
+
+def test_a_tolerance_below_float64_is_refused_before_any_step():
+    w, b = hanging_spring()
+    e, seen, took = refused(w, b, r"^solve_static: tolerance 1e-300 m is below what float64 resolves at these "
+                                  r"coordinates .*: give tolerance >= 3\.6e-15 m$", tolerance=1e-300,
+                            max_iterations=100_000)
+    assert seen == [] and took < 1.0
+
+
+def test_a_body_that_slides_freely_is_named_not_relaxed_for_ever():
+    # a frictionless floor holds nothing sideways: with sleeping on, the block fell asleep after
+    # 5 steps and was "settled"; before that, it slid for max_iterations (minutes)
+    w, b = box_on_floor(force=(0.05, 0.0))
+    e, seen, took = refused(w, b, r"^solve_static stopped getting closer after 200 relaxation steps: body 0 keeps "
+                                  r"moving one way .* along \(1\.00, -?0\.00\) .*: it slides freely, as the colliders "
+                                  r"are frictionless and no wall stops it that way")
+    assert [p.iteration for p in seen] == list(range(1, 201)) and took < 60
+
+
+def test_a_body_that_slides_off_its_support_is_named_when_it_has_fallen_past_every_collider():
+    w, b = box_on_floor((1.0, 0.5), force=(20.0, 0.0))
+    e, seen, took = refused(w, b, r"^solve_static: body 0 fell past every collider at relaxation step \d+ \(now at "
+                                  r".*\): it slid or rolled off its support")
+    assert len(seen) < 60 and took < 30
+
+
+def test_the_time_budget_bounds_a_solve_and_progress_is_reported():
+    w, b = box_on_floor(force=(0.05, 0.0))
+    e, seen, took = refused(w, b, r"^solve_static did not settle within max_seconds = 0\.3 s \(\d+ relaxation steps",
+                            max_seconds=0.3)
+    assert took < 3 and seen and seen[-1].elapsed > 0.3 and seen[-1].max_seconds == 0.3
+    assert all(p.tolerance == 1e-6 and p.moved > 0 for p in seen)
+
+
+def test_an_exception_from_progress_stops_the_solve_and_puts_the_world_back():
+    w, b = box_on_floor(force=(0.05, 0.0))
+    before = b.positions.copy()
+
+    def stop(p):
+        if p.iteration == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        w.solve_static(progress=stop)
+    assert np.array_equal(b.positions, before) and w.step_count == 0 and w._forces
+
+
+def test_a_tolerance_below_the_solves_noise_is_named():
+    w, b = box_on_floor(friction=0.5)
+    e, seen, took = refused(w, b, r"^solve_static stopped getting closer after 200 relaxation steps: the moves stay "
+                                  r"about .* m a step .* give a tolerance above .* m if that is close enough",
+                            tolerance=1e-13)
+    assert float(re.search(r"above (\S+) m", str(e)).group(1)) < 1e-8
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"max_seconds": 0}, "max_seconds must be a number of seconds > 0 (inf: no limit), got 0"),
+    ({"max_seconds": float("nan")}, "max_seconds must be a number of seconds > 0 (inf: no limit), got nan"),
+    ({"max_seconds": "1 min"}, "max_seconds must be a number of seconds > 0 (inf: no limit), got '1 min'"),
+    ({"progress": "yes"}, "progress must be None (a bar on a terminal), False or a callable taking a "
+                          "StaticProgress, got 'yes'"),
+])
+def test_bad_budgets_and_progress_are_one_line(kwargs, message):
+    w, _ = hanging_spring()
+    with pytest.raises(ValueError) as e:
+        w.solve_static(**kwargs)
+    assert str(e.value) == message
+
+
+def test_a_settling_world_reports_progress_and_sleeps_again_after():
+    w, b = box_on_floor(friction=0.5)
+    seen = []
+    steps = w.solve_static(progress=seen.append, max_seconds=float("inf"), tolerance=1e-7)
+    assert [p.iteration for p in seen] == list(range(1, steps + 1)) and seen[-1].remaining <= 1e-7
+    assert w.sleep and not b.velocities.any()

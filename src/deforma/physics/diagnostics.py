@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import MAX_SUBSTEPS
+from ..checks import LIMITS, MAX_SUBSTEPS
 from .behaviours.strain import spring_strains
 from .elements.triangles import element_energy, signed_areas
 
@@ -29,7 +29,9 @@ SHAPE_CHECK_EVERY = 16
 
 
 class SimulationUnstable(RuntimeError):
-    """A step produced a non-finite or runaway state; the world was put back as before it.
+    """This world cannot step at this ``dt``: a step produced a non-finite or runaway state
+    (the world was put back as before it), or, before any step, the step it asks for is beyond
+    what the integrator can hold (:class:`StepTooLong`, also a ``ValueError``).
 
     Attributes
     ----------
@@ -46,6 +48,76 @@ class SimulationUnstable(RuntimeError):
         self.body = body
         self.step = step
         self.hint = hint
+
+
+class StepTooLong(SimulationUnstable, ValueError):
+    """``substeps = "auto"`` would need more than ``MAX_SUBSTEPS`` substeps of ``dt`` to stay
+    within the stable explicit step: raised where it is asked (setting ``substeps = "auto"``,
+    or at the next :meth:`World.step` after the bodies, grabs or ``dt`` changed), before anything
+    is changed. The one error for "this world cannot step at this dt" is
+    :class:`SimulationUnstable`, and this is one; it is also a ``ValueError``, as a setting the
+    world refuses is everywhere else (and as this was before), so ``except ValueError`` and
+    ``except SimulationUnstable`` both catch it.
+
+    Attributes (besides :class:`SimulationUnstable`'s; ``body`` is the one whose vertex sets the
+    stable step)
+    ----------
+    needed : int
+        The substeps ``"auto"`` would take.
+    stable : float
+        The stable explicit (sub)step, s.
+    largest_dt : float
+        The largest ``dt`` (s) that ``MAX_SUBSTEPS`` substeps hold, rounded down to 3 digits;
+        0 where that is below the shortest ``dt`` a World takes (1e-6 s).
+    """
+
+    def __init__(self, message: str, *, body, step: int, hint: str, needed: int, stable: float, largest_dt: float):
+        super().__init__(message, body=body, step=step, hint=hint)
+        self.needed = needed
+        self.stable = stable
+        self.largest_dt = largest_dt
+
+
+def _round_down(value: float, digits: int = 3) -> float:
+    """``value`` (> 0) rounded down to ``digits`` significant digits."""
+    unit = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.floor(value / unit * (1.0 + 1e-12)) * unit
+
+
+def step_too_long(world, model, control, need: int, stable: float) -> StepTooLong:
+    """The :class:`StepTooLong` for ``world`` whose ``substeps = "auto"`` would need ``need``
+    substeps of its ``dt`` at the stable step ``stable`` (s): names the body that sets it and
+    the options that fit (the largest ``dt``, softer bodies, a weaker grab, an unconditionally
+    stable integrator)."""
+    body = world.bodies[0] if world.bodies else None
+    if model.n_vertices:
+        n = model.n_vertices
+        ks, kd = np.zeros(n), np.zeros(n)
+        for kind in model.elements:
+            ks += kind.stiffness_rows(n)
+            kd += kind.damping_rows(n)
+        held = control.grab_slot >= 0
+        ks[held] += control.grab_pull[control.grab_slot[held], 0]
+        w2, gamma = 2 * ks * model.vertex_inv_mass, 2 * kd * model.vertex_inv_mass
+        first = int(np.argmax(np.hypot(gamma, 2.0 * np.sqrt(w2)) + gamma))  # the shortest 4 / (...)
+        b = int(np.searchsorted(model.body_vertex_offsets, first, side="right") - 1)
+        if 0 <= b < len(world.bodies):
+            body = world.bodies[b]
+    largest = _round_down(MAX_SUBSTEPS * stable) if math.isfinite(stable) and stable > 0 else 0.0
+    shortest = LIMITS["dt"][0]
+    why = f"{damping_note(model, control, stable)}{grab_note(model, control, stable)}"
+    if largest >= shortest:
+        fits = f"lower dt to {largest:.3g} s or less ({MAX_SUBSTEPS} substeps of it hold)"
+    else:  # no dt the World takes: only the bodies or the integrator can change
+        largest = 0.0
+        fits = f"no dt of at least {shortest:g} s fits in {MAX_SUBSTEPS} substeps"
+    fits += ", lower the grab strength" if grab_note(model, control, stable) else ", soften the bodies"
+    hint = f"{fits}, or use integrator=\"implicit-euler\" (stable at any step)"
+    count = f"{need}" if need < 10**6 else f"about {need:.3g}"  # no count of 80 digits
+    message = (f"substeps = \"auto\" would need {count} substeps of dt = {world.dt:g} s (stable step {stable:.3g} s"
+               f"{why}), more than {MAX_SUBSTEPS}: {hint}")
+    return StepTooLong(message, body=body, step=world.step_count, hint=hint, needed=need, stable=stable,
+                       largest_dt=largest)
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ from .behaviours import tearing
 from .colliders.response import clear_impulses
 from .joint import pack_rows, read_rows
 from .rigid.stage import begin_joint_forces, end_joint_forces, rigid_set, step_rigid_bodies
-from .diagnostics import SHAPE_CHECK_EVERY, SimulationUnstable, lost_shape, runaway, trapped
+from .diagnostics import SHAPE_CHECK_EVERY, lost_shape, runaway, trapped
 from .topology import BodyTopology
 
 REPACK_EVERY = 64  # steps: moving colliders are packed again from their objects this often
@@ -120,8 +120,7 @@ def step(world) -> None:
     if w._grabs_dirty:
         w._rebuild_grabs()
     if w._auto:  # substeps = "auto": chosen again when what the stable step depends on changed
-        w._substeps = w._auto_substeps(lambda message: SimulationUnstable(
-            message, body=w._bodies[0], step=w.step_count, hint=message))
+        w._substeps = w._auto_substeps()  # StepTooLong (a SimulationUnstable) past the limit
     control = w._control
     control.step = w.step_count
     if control.has_force:

@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..checks import MAX_COORDINATE, MAX_GRAVITY, MAX_SUBSTEPS, MIN_SUBSTEP
 from ..checks import non_negative as _non_negative
@@ -46,6 +47,9 @@ from .model import Model
 from .rigid.stage import RIGID_SUBSTEP, rigid_set
 from .state import State
 from .topology import BodyTopology, triangles_under
+
+if TYPE_CHECKING:
+    from ..mesh.mesh import Mesh
 
 __all__ = ["Body", "Energy", "Grab", "SimulationUnstable", "World"]
 
@@ -126,17 +130,19 @@ class World:
     True
     """
 
-    def __init__(self, *, gravity=(0.0, -9.81), dt=1 / 60, substeps="auto", mass=1.0, stiffness=1000.0,
-                 damping=0.5, friction=0.3, static_friction=0.5, grab_strength=50.0, max_speed=1e3,
-                 integrator="avbd", contact_thickness=None, air_drag=0.0, material=None,
-                 integrator_options=None, sleep=True):
+    def __init__(self, *, gravity: ArrayLike = (0.0, -9.81), dt: float = 1 / 60, substeps: int | str = "auto",
+                 mass: float = 1.0, stiffness: float = 1000.0, damping: float = 0.5, friction: float = 0.3,
+                 static_friction: float = 0.5, grab_strength: float = 50.0, max_speed: float = 1e3,
+                 integrator: str = "avbd", contact_thickness: float | None = None, air_drag: float = 0.0,
+                 material: Material | None = None, integrator_options: Mapping[str, Any] | None = None,
+                 sleep: bool = True) -> None:
         self._bodies: list[Body] = []
         self._colliders: list[Collider] = []
         self._packed_colliders: tuple | None = None  # what was packed: (id, version) per collider
         self._grabs: list[Grab] = []
         self._grabs_dirty = True
-        self._lost_shape = {}  # id(body) -> checks in a row at which it had lost its shape
-        self._forces = []  # (body, body-local vertices, forces): applied during the next step
+        self._lost_shape: dict[int, int] = {}  # id(body) -> checks in a row at which it had lost its shape
+        self._forces: list[tuple[Body, np.ndarray, np.ndarray]] = []  # (body, body-local vertices, forces): applied during the next step
         self._joints: list[Joint] = []
         self._events = Events()  # on_contact, on_joint_break
         self._contact_record = None  # (model, its bodies, ContactImpulses or None) of the last step
@@ -145,17 +151,17 @@ class World:
         self._sleep_key = None  # what a change of wakes every island (_world_key)
         self._gravity, self._air_drag = (0.0, -9.81), 0.0
         self._model = Model([], masses=[], stiffness=[], damping=[])
-        self._model_bodies = []
+        self._model_bodies: list[Body] = []
         self._state = State.empty()
         self._start = State.empty()  # the state the step started from: what a failed step keeps
         self._sub_start = State.empty()  # with rigid bodies: where each substep started
         self._control = Control(0)
         self._contacts = Contacts.for_topology(self._model.contact, n_vertices=0)
-        self._contact_thickness = None
-        self._material = None
+        self._contact_thickness: float | None = None
+        self._material: Material | None = None
         self.time = 0.0
         self.step_count = 0
-        self._said_ignored = set()  # the spring parameters already said to reach no FEM body
+        self._said_ignored: set[str] = set()  # the spring parameters already said to reach no FEM body
         self._auto = False  # substeps = "auto"
         self._auto_key = None  # what the automatic substeps were chosen for
         self.gravity = gravity
@@ -210,7 +216,7 @@ class World:
         return self._sleep
 
     @sleep.setter
-    def sleep(self, value):
+    def sleep(self, value: bool) -> None:
         self._sleep = _switch(value, "sleep")
         if not self._sleep:
             self._wake(self._bodies)
@@ -323,7 +329,7 @@ class World:
         return self._gravity
 
     @gravity.setter
-    def gravity(self, value):
+    def gravity(self, value: ArrayLike) -> None:
         self._gravity = self._model.gravity = _pair(value, "gravity", limit=MAX_GRAVITY)
 
     @property
@@ -332,7 +338,7 @@ class World:
         return self._dt
 
     @dt.setter
-    def dt(self, value):
+    def dt(self, value: float) -> None:
         dt = _positive(value, "dt", "s")
         self._check_substep(dt, getattr(self, "_substeps", 1))
         self._dt = dt
@@ -355,16 +361,16 @@ class World:
         """
         if self._auto:
             try:
-                self._substeps = self._auto_substeps(ValueError)
+                self._substeps = self._auto_substeps()
             except ValueError:  # more than allowed: the next step says so
                 pass
         return self._substeps
 
     @substeps.setter
-    def substeps(self, value):
+    def substeps(self, value: int | str) -> None:
         if isinstance(value, str) and value == "auto":
             self._auto_key = None
-            self._substeps = self._auto_substeps(ValueError)
+            self._substeps = self._auto_substeps()  # StepTooLong past MAX_SUBSTEPS: nothing changed
             self._auto = True
             return
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SUBSTEPS:
@@ -380,9 +386,10 @@ class World:
         in which the bodies, their parameters, the grabs, ``dt`` or the integrator changed."""
         return self._auto
 
-    def _auto_substeps(self, error):
-        """The substeps ``"auto"`` asks now: ``ceil(dt / stable_dt())``; ``error`` (a
-        one-line exception type, or a callable taking the message) past ``MAX_SUBSTEPS``."""
+    def _auto_substeps(self):
+        """The substeps ``"auto"`` asks now: ``ceil(dt / stable_dt())``; past ``MAX_SUBSTEPS``
+        raises :class:`~deforma.physics.diagnostics.StepTooLong` (a ``SimulationUnstable`` and a
+        ``ValueError``, one line), whoever asks: the setter and a step alike."""
         if self._grabs_dirty:
             self._rebuild_grabs()
         model, control = self._model, self._control
@@ -398,9 +405,7 @@ class World:
             # was put out, and bounced off with 22 % more energy than it came with; none at 1/120 s
             need = max(need, math.ceil(self._dt / RIGID_SUBSTEP * (1.0 - 1e-9)))
         if need > MAX_SUBSTEPS:
-            raise error(f"substeps = \"auto\" would need {need} substeps of dt = {self._dt:g} s (stable step "
-                        f"{stable:.3g} s), more than {MAX_SUBSTEPS}: lower dt, soften the bodies, or use "
-                        f"integrator=\"implicit-euler\"")
+            raise diagnostics.step_too_long(self, model, control, need, stable)
         self._auto_key = key
         return need
 
@@ -410,7 +415,8 @@ class World:
             raise ValueError(f"dt / substeps must be >= {MIN_SUBSTEP:g} s, got {dt:g} / {substeps} = "
                              f"{dt / substeps:.3g} s")
 
-    def _world_param(name, unit, check):  # noqa: N805 - a property factory used in the class body
+    @staticmethod  # callable in the class body (Python >= 3.10)
+    def _world_param(name: str, unit: str, check: Callable[[Any, str, str], float]) -> property:
         def get(self):
             return getattr(self, "_" + name)
 
@@ -450,7 +456,7 @@ class World:
         return self._grab_strength
 
     @grab_strength.setter
-    def grab_strength(self, value):
+    def grab_strength(self, value: float) -> None:
         self._grab_strength = _positive(value, "grab_strength", "N/m")
 
     @property
@@ -459,7 +465,7 @@ class World:
         return self._max_speed
 
     @max_speed.setter
-    def max_speed(self, value):
+    def max_speed(self, value: float) -> None:
         try:
             v = float(value)
         except (TypeError, ValueError):
@@ -474,7 +480,7 @@ class World:
         return self._air_drag
 
     @air_drag.setter
-    def air_drag(self, value):
+    def air_drag(self, value: float) -> None:
         self._air_drag = self._model.air_drag = _non_negative(value, "air_drag", "1/s")
 
     @property
@@ -483,7 +489,7 @@ class World:
         return self._contact_thickness
 
     @contact_thickness.setter
-    def contact_thickness(self, value):
+    def contact_thickness(self, value: float | None) -> None:
         if value is None:
             self._contact_thickness = None
         else:
@@ -520,7 +526,7 @@ class World:
         return self._material
 
     @material.setter
-    def material(self, value):
+    def material(self, value: Material | None) -> None:
         value = _material(value)
         if value is not None and value.is_fem:
             for body in self._bodies:
@@ -554,7 +560,7 @@ class World:
         return self._integrator.name
 
     @integrator.setter
-    def integrator(self, name):
+    def integrator(self, name: str) -> None:
         made = make_integrator(name)
         if not made.solves_rigid:
             for j in self._joints:
@@ -614,7 +620,7 @@ class World:
         return self._integrator.options
 
     @integrator_options.setter
-    def integrator_options(self, options):
+    def integrator_options(self, options: Mapping[str, Any]) -> None:
         self._integrator.configure(options)
 
     @property
@@ -629,9 +635,11 @@ class World:
         """The bodies, in the order added (a new list; use add_body / remove_body to change)."""
         return list(self._bodies)
 
-    def add_body(self, mesh, *, position=None, material=None, mass=None, stiffness=None, damping=None, collide=True,
-                 self_collision=True, friction=None, static_friction=None, pressure=None, angle=0.0,
-                 velocity=(0.0, 0.0), angular_velocity=0.0) -> Body:
+    def add_body(self, mesh: Mesh | Any, *, position: ArrayLike | None = None, material: Material | None = None,
+                 mass: float | None = None, stiffness: float | None = None, damping: float | None = None,
+                 collide: bool = True, self_collision: bool = True, friction: float | None = None,
+                 static_friction: float | None = None, pressure: float | None = None, angle: float = 0.0,
+                 velocity: ArrayLike = (0.0, 0.0), angular_velocity: float = 0.0) -> Body:
         """Make a soft body from a mesh: springs on its edges, or finite elements on its triangles.
 
         Parameters
@@ -750,7 +758,7 @@ class World:
             body.velocities[...] = rigid_motion.rigid_velocities(body.positions, body.vertex_masses, vel, spin)
         if self._auto and not self._integrator.unconditionally_stable:
             try:  # say so now, not at the first step
-                self._substeps = self._auto_substeps(ValueError)
+                self._substeps = self._auto_substeps()
             except ValueError as e:
                 warnings.warn(str(e), StepBeyondStableWarning, stacklevel=2)
         elif not self._integrator.unconditionally_stable:
@@ -944,7 +952,7 @@ class World:
         """
         return list(self._pairs().values())
 
-    def contacts_between(self, a, b) -> ContactPair | None:
+    def contacts_between(self, a: Body | Collider, b: Body | Collider) -> ContactPair | None:
         """The contact of ``a`` and ``b`` (bodies or colliders, either order) over the last
         step, seen from ``a`` (its ``impulse`` acts on ``a``), or None if they do not touch
         (see :meth:`contact_pairs`)."""
@@ -988,7 +996,7 @@ class World:
         self._events.joint_break.append(Events.checked(callback, "on_joint_break"))
         return callback
 
-    def remove_listener(self, callback) -> None:
+    def remove_listener(self, callback: Callable[..., Any]) -> None:
         """Stop calling a callback registered with :meth:`on_contact` or :meth:`on_joint_break`.
 
         Raises
@@ -1097,8 +1105,9 @@ class World:
         """The joints, in the order they were made (a new list)."""
         return list(self._joints)
 
-    def join(self, a: Body, b: Body | None = None, at=None, *, kind: str = "pin", stiffness=None, damping=None,
-             motor_speed=None, max_torque=None, break_force=None) -> Joint:
+    def join(self, a: Body, b: Body | None = None, at: ArrayLike | None = None, *, kind: str = "pin",
+             stiffness: float | None = None, damping: float | None = None, motor_speed: float | None = None,
+             max_torque: float | None = None, break_force: float | None = None) -> Joint:
         """Join body ``a`` to body ``b`` (None: to the world) at the point ``at``.
 
         Parameters
@@ -1200,7 +1209,10 @@ class World:
             turn += angle[k] if side == 0 else -angle[k]
         # each side's point as a rigid body carries it (a frame of two vertices) and as a soft
         # body does (the triangle under it): a body's material may change while joined
-        frames, tris, weights, ref = [None, None], [None, None], [None, None], 0.0
+        frames: list[Any] = [None, None]
+        tris: list[Any] = [None, None]
+        weights: list[Any] = [None, None]
+        ref = 0.0
         for side, body in enumerate((a, b)):
             if body is None:
                 continue
@@ -1250,7 +1262,7 @@ class World:
         self._rigid_solve_changed()
 
     # -- interaction ------------------------------------------------------------------------
-    def explode(self, strength: float, *, center=None, radius=None) -> None:
+    def explode(self, strength: float, *, center: ArrayLike | None = None, radius: float | None = None) -> None:
         """A kick to every vertex: ``strength`` m/s upward (the original's space key), or a
         blast away from ``center``.
 
@@ -1297,7 +1309,7 @@ class World:
             scale *= 1.0 - n / reach
         v[ok] += (scale[ok] / n[ok])[:, None] * d[ok]
 
-    def grab(self, point, *, strength=None, radius=None) -> Grab:
+    def grab(self, point: ArrayLike, *, strength: float | None = None, radius: float | None = None) -> Grab:
         """Take hold of the body under ``point`` (the mouse press).
 
         Picks the vertices of the triangle under the point, plus, with ``radius``, every
@@ -1360,7 +1372,7 @@ class World:
         if not isinstance(g, Grab) or g._world is not self:
             raise ValueError(f"unknown grab {g!r}: pass one returned by this world's grab()")
 
-    def drag(self, g: Grab, target) -> None:
+    def drag(self, g: Grab, target: ArrayLike) -> None:
         """Move the pull target of an active grab to ``target`` (metres)."""
         self._own_grab(g)
         if not g.active:
@@ -1395,7 +1407,8 @@ class World:
         """
         stepper.step(self)
 
-    def solve_static(self, *, tolerance: float = 1e-6, max_iterations: int = 1000) -> int:
+    def solve_static(self, *, tolerance: float = 1e-6, max_iterations: int = 1000, max_seconds: float = 60.0,
+                     progress: Callable[..., Any] | bool | None = None) -> int:
         """Move every body to its static equilibrium under its pins, gravity, the forces
         applied with ``body.apply_force`` and its contacts (:mod:`deforma.physics.statics`:
         backward Euler relaxation from rest, whatever the world's integrator).
@@ -1406,6 +1419,15 @@ class World:
             m (> 0): done when no vertex is estimated farther than this from where it settles.
         max_iterations : int, optional
             Relaxation steps at most (in [1, 100000]); each is one converged implicit solve.
+        max_seconds : float, optional
+            Wall-time budget, s (> 0, ``inf`` for none; Numba's one-time compiling is not
+            counted), checked after each relaxation step. Default 60.
+        progress : None, False or callable, optional
+            ``None``: a bar on stderr when it is a terminal, once the solve has taken a second;
+            ``False``: nothing; a callable is given a
+            :class:`~deforma.physics.statics.StaticProgress` (``iteration``, ``moved``,
+            ``remaining``, ``tolerance``, ``elapsed``, ``max_seconds``) after every step, and
+            an exception it raises stops the solve (the World is put back).
 
         Returns
         -------
@@ -1416,9 +1438,13 @@ class World:
         Raises
         ------
         ValueError
-            A bad argument; bodies nothing holds (no pinned vertex, no collider); a
-            material that tears or yields; no rest within ``max_iterations`` (the World is
-            put back as it was). One line each.
+            One line each, and the World is put back as it was. Before any step: a bad
+            argument; bodies nothing holds (no pinned vertex, no collider); a material that
+            tears or yields; a ``tolerance`` below what float64 resolves at the bodies'
+            coordinates. Once seen: a body that fell past every collider (slid or rolled off);
+            a relaxation that stopped getting closer for 100 steps (naming the body: one that
+            slides freely on frictionless colliders, one that jitters, a tolerance below the
+            solve's noise); no rest within ``max_iterations`` or ``max_seconds``.
 
         Examples
         --------
@@ -1434,7 +1460,8 @@ class World:
         """
         from .statics import solve_static
 
-        return solve_static(self, tolerance=tolerance, max_iterations=max_iterations)
+        return solve_static(self, tolerance=tolerance, max_iterations=max_iterations, max_seconds=max_seconds,
+                            progress=progress)
 
     # -- diagnostics ------------------------------------------------------------------------
     def stable_dt(self, *, explicit: bool = False) -> float:
