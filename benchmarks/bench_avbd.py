@@ -32,8 +32,8 @@ def bunny_world(resolution: int, integrator: str | None):
     """The README bunny 20 cm above a floor, under ``integrator`` at 1/60 s (None: symplectic Euler at
     1/600 s with automatic substeps, the default before avbd)."""
     mesh = deforma.mesh.from_image("bunny", resolution=resolution, detect_edges=True, edge_step=2, scale=0.01)
-    w = deforma.World(dt=1 / 600, integrator="symplectic-euler") if integrator is None else \
-        deforma.World(dt=1 / 60, substeps=1, integrator=integrator)
+    w = deforma.World(sleep=False, dt=1 / 600, integrator="symplectic-euler") if integrator is None else \
+        deforma.World(sleep=False, dt=1 / 60, substeps=1, integrator=integrator)
     w.add_collider(deforma.Rect((0.0, -0.25), (8.0, 0.5), 0.0))
     w.add_body(mesh, position=(0.0, np.ptp(mesh.vertices[:, 1]) / 2 + 0.2))
     return w

@@ -40,7 +40,7 @@ def sheet_world(detail: int, integrator: str, **behaviours):
     1e4 vertices, 22 at 2500); the other two take one.
     """
     mat = deforma.Material("corotated", **BASE, **behaviours)
-    w = deforma.World(gravity=(0.0, 0.0), integrator=integrator, material=mat)
+    w = deforma.World(sleep=False, gravity=(0.0, 0.0), integrator=integrator, material=mat)
     body = w.add_body(deforma.mesh.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=detail, edges=True), position=None)
     x = body.positions
     right = np.flatnonzero(x[:, 0] > 2.0 - 1e-9)

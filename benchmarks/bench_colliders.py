@@ -36,7 +36,7 @@ def peg(kind: str, center) -> deforma.physics.Collider:
 
 def board(mixed: bool, bodies: int) -> deforma.World:
     """The peg board with ``bodies`` soft boxes (11 x 11 vertices each) dropped into it."""
-    w = deforma.World(dt=1 / 600, substeps=4, stiffness=3000.0, damping=1.0, integrator="symplectic-euler")
+    w = deforma.World(sleep=False, dt=1 / 600, substeps=4, stiffness=3000.0, damping=1.0, integrator="symplectic-euler")
     kinds = ["rect", "circle", "polygon", "segment"]
     for k in range(100):
         i, j = divmod(k, 10)

@@ -55,8 +55,8 @@ def heap_world(n_bodies: int):
     """``n_bodies`` bodies poured in ``ROWS`` rows into a container, settled for 1.5 s."""
     per_row = math.ceil(n_bodies / ROWS)
     width = per_row * (SIZE + 0.15)
-    w = deforma.World(dt=1 / 600, integrator="symplectic-euler", stiffness=5000.0, damping=0.5, friction=0.4,
-                      static_friction=0.6, air_drag=0.5)
+    w = deforma.World(sleep=False, dt=1 / 600, integrator="symplectic-euler", stiffness=5000.0, damping=0.5,
+                      friction=0.4, static_friction=0.6, air_drag=0.5)
     w.add_collider(deforma.Rect((0.0, -0.25), (width + 1.0, 0.5), 0.0))
     for side in (-1, 1):
         w.add_collider(deforma.Rect((side * (width / 2 + 0.3), 10.0), (0.4, 20.0), 0.0))
@@ -117,7 +117,7 @@ def run(quick: bool = False) -> list[Row]:
     rows.append(Row("contacts", f"stage time per body, {counts[-1]} vs {counts[0]} bodies", growth, "x",
                     "", "about linear growth: per body within 2x", growth < 2.0))
     n = 100 if quick else 316
-    w = deforma.World(dt=1 / 600, integrator="symplectic-euler", stiffness=2000.0, damping=0.5, mass=1.0)
+    w = deforma.World(sleep=False, dt=1 / 600, integrator="symplectic-euler", stiffness=2000.0, damping=0.5, mass=1.0)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     w.add_collider(deforma.Rect((-1.2, 0.5), (0.8, 0.1), 30.0))
     w.add_collider(deforma.Rect((1.0, 0.1), (0.2, 0.2), 10.0))

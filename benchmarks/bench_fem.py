@@ -38,7 +38,7 @@ def deforma_world(body: dict, model: str | None):
     mesh = deforma.mesh.Mesh(np.c_[xs.ravel(), ys.ravel()], body["tris"])
     mat = None if model is None else deforma.Material(model, youngs_modulus=1e4, poisson_ratio=0.3, density=1000.0)
     # springs: the same total mass (1000 kg/m^2 on 1 m^2) and a stiffness of the same order as E
-    w = deforma.World(dt=SUBSTEPS * body["h"], substeps=SUBSTEPS, material=mat, stiffness=1e4, damping=0.0,
+    w = deforma.World(sleep=False, dt=SUBSTEPS * body["h"], substeps=SUBSTEPS, material=mat, stiffness=1e4, damping=0.0,
                       mass=1000.0, integrator="symplectic-euler")
     w.add_collider(deforma.Rect((0.5, -0.5), (10.0, 1.0), 0.0))  # top face at y = 0: the peers' floor
     b = w.add_body(mesh, position=None, collide=False, self_collision=False)

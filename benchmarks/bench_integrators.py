@@ -49,7 +49,7 @@ SUBSTEPS = {"implicit-euler": 1, "xpbd": 64}
 
 def make_world(n: int, integrator: str, *, substeps: int = 1):
     """The bench_physics body (n*n vertices, touching the floor) under ``integrator``."""
-    w = deforma.World(dt=1 / 600, stiffness=2000.0, damping=0.5, mass=1.0, integrator=integrator)
+    w = deforma.World(sleep=False, dt=1 / 600, stiffness=2000.0, damping=0.5, mass=1.0, integrator=integrator)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     w.add_collider(deforma.Rect((-1.2, 0.5), (0.8, 0.1), 30.0))
     w.add_collider(deforma.Rect((1.0, 0.1), (0.2, 0.2), 10.0))
@@ -116,7 +116,7 @@ SOLVES = (("implicit-euler", {}, "3 iterations"), ("implicit-euler", {"tolerance
 
 def spinning_box(integrator: str):
     """The spinning box of the converged-solve tests: 1 m, corotated 1e4 Pa, 5 rad/s, no gravity."""
-    w = deforma.World(gravity=(0.0, 0.0), dt=1 / 60, integrator=integrator)
+    w = deforma.World(sleep=False, gravity=(0.0, 0.0), dt=1 / 60, integrator=integrator)
     m = deforma.Material("corotated", youngs_modulus=1e4, poisson_ratio=0.3, density=100.0)
     b = w.add_body(deforma.mesh.box(((0, 0), (1, 0), (1, 1), (0, 1)), detail=8, edges=True), position=(0, 0),
                    material=m)
@@ -205,7 +205,7 @@ def xpbd_sag() -> None:
     bunny = deforma.mesh.from_image("bunny", resolution=22, edge_step=16, scale=0.0022)
     for s in (2, 4, 8, 16):
         mat = deforma.Material("corotated", youngs_modulus=2000.0, poisson_ratio=0.3, density=5.5)
-        w = deforma.World(dt=1 / 60, substeps=s, integrator="xpbd", material=mat, friction=0.4,
+        w = deforma.World(sleep=False, dt=1 / 60, substeps=s, integrator="xpbd", material=mat, friction=0.4,
                           static_friction=0.6, air_drag=0.6)
         w.add_collider(deforma.Rect((0.0, -0.2), (4.4, 0.4), 0.0))
         body = w.add_body(bunny, position=(0.0, 0.45))

@@ -1,7 +1,7 @@
 """Joints: deforma's default integrator against pymunk, the peer of ``bench_rigid.py``.
 
-deforma runs ``avbd``, its default, with every default (``deforma.World(dt=1/60)``): its pins
-are rows of the rigid blocks' sweep. The peer is pymunk (Chipmunk 2), the usual 2D rigid-body
+deforma runs ``avbd``, its default, with every default but sleep (``deforma.World(sleep=False,
+dt=1/60)``: the peers do not sleep): its pins are rows of the rigid blocks' sweep. The peer is pymunk (Chipmunk 2), the usual 2D rigid-body
 engine for Python, with its defaults: 10 solver iterations, no sleeping, no damping. Both get
 the same bodies, the same joints and the same step:
 
@@ -176,7 +176,7 @@ class Engine:
 def engines(case: str, *, with_pymunk: bool = True) -> dict[str, Engine]:
     """{"deforma avbd": Engine, "pymunk": Engine} for ``case`` (one of ``CASES``)."""
     out = {}
-    w = deforma.World(dt=H)  # avbd, every default
+    w = deforma.World(sleep=False, dt=H)  # avbd, every default but sleep
     if case == "pendulum":
         body, _ = deforma_pendulum(w)
         follow = body

@@ -118,7 +118,7 @@ def lumped_masses(mesh: deforma.mesh.Mesh, density: float) -> np.ndarray:
 def deforma_world(mesh, model: str, *, integrator: str = "avbd", pinned=(), floor: bool = False,
                   damping: float = 0.0, air_drag: float = 0.0, position=None):
     """A World at 1/60 s x 1 holding ``mesh`` as ``model`` elements of E, nu, RHO."""
-    w = deforma.World(dt=H, substeps=1, integrator=integrator, air_drag=air_drag)
+    w = deforma.World(sleep=False, dt=H, substeps=1, integrator=integrator, air_drag=air_drag)
     if floor:
         w.add_collider(deforma.Rect((0.0, -0.25), (8.0, 0.5), 0.0))  # top face at y = 0
     mat = deforma.Material(model, youngs_modulus=E, poisson_ratio=NU, density=RHO, damping=damping)

@@ -48,8 +48,8 @@ def grid_mesh(n: int, size: float = 1.0) -> deforma.mesh.Mesh:
 
 def make_world(n: int):
     """A 1 m body of n*n vertices on a floor (its bottom row in contact), a slope and a box beside it."""
-    w = deforma.World(dt=1 / 600, integrator="symplectic-euler", gravity=GRAVITY, stiffness=2000.0, damping=0.5,
-                      mass=1.0)
+    w = deforma.World(sleep=False, dt=1 / 600, integrator="symplectic-euler", gravity=GRAVITY, stiffness=2000.0,
+                      damping=0.5, mass=1.0)
     w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
     w.add_collider(deforma.Rect((-1.2, 0.5), (0.8, 0.1), 30.0))
     w.add_collider(deforma.Rect((1.0, 0.1), (0.2, 0.2), 10.0))

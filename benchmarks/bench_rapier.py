@@ -97,7 +97,7 @@ def column(nx: int):
 
 def deforma_world(mesh, pinned):
     """deforma's avbd at 1/60 s, one step a frame, on ``mesh`` in plane strain, pinned at ``pinned``."""
-    w = deforma.World(integrator="avbd", dt=DT, substeps=1, air_drag=DRAG)
+    w = deforma.World(sleep=False, integrator="avbd", dt=DT, substeps=1, air_drag=DRAG)
     mat = deforma.Material("corotated", youngs_modulus=E, poisson_ratio=NU, density=RHO, plane="strain")
     b = w.add_body(mesh, material=mat, position=None, collide=False, self_collision=False)
     b.pin(pinned)

@@ -84,7 +84,7 @@ CASES = {"stack": stack_boxes, "pyramid": pyramid_boxes}
 
 def deforma_world(boxes):
     """A World holding ``boxes`` as rigid bodies on the floor; returns (world, bodies)."""
-    w = deforma.World(dt=H, substeps=1, gravity=(0.0, -G), friction=FRICTION, static_friction=FRICTION)
+    w = deforma.World(sleep=False, dt=H, substeps=1, gravity=(0.0, -G), friction=FRICTION, static_friction=FRICTION)
     w.add_collider(deforma.Rect(FLOOR_CENTRE, FLOOR_SIZE, 0.0))
     rigid = deforma.Material("rigid", density=RHO)
     bodies = [w.add_body(deforma.mesh.box(((0, 0), (bw, 0), (bw, bh), (0, bh)), detail=2),
