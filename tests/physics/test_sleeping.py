@@ -108,7 +108,7 @@ def test_what_wakes_a_sleeping_body():
     assert asleep()
     w.gravity = (0.0, -9.0)
     w.step()
-    assert not top._asleep or top._still < SLEEP_TIME
+    assert not top.sleeping or top._still < SLEEP_TIME
     assert asleep()
     g = w.grab(top.center_of_mass)
     assert not top.sleeping

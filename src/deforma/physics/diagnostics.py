@@ -91,14 +91,7 @@ def step_too_long(world, model, control, need: int, stable: float) -> StepTooLon
     stable integrator)."""
     body = world.bodies[0] if world.bodies else None
     if model.n_vertices:
-        n = model.n_vertices
-        ks, kd = np.zeros(n), np.zeros(n)
-        for kind in model.elements:
-            ks += kind.stiffness_rows(n)
-            kd += kind.damping_rows(n)
-        held = control.grab_slot >= 0
-        ks[held] += control.grab_pull[control.grab_slot[held], 0]
-        w2, gamma = 2 * ks * model.vertex_inv_mass, 2 * kd * model.vertex_inv_mass
+        w2, gamma = vertex_rates(model, control)
         first = int(np.argmax(np.hypot(gamma, 2.0 * np.sqrt(w2)) + gamma))  # the shortest 4 / (...)
         b = int(np.searchsorted(model.body_vertex_offsets, first, side="right") - 1)
         if 0 <= b < len(world.bodies):
@@ -159,9 +152,9 @@ def energy(model, state, gravity, vertices=slice(None), springs=slice(None), ele
     return Energy(kinetic, spring, gravitational, elastic)
 
 
-def explicit_rates(model, control) -> tuple[float, float]:
-    """``(omega^2, gamma)`` of :func:`stable_dt`: the largest stiffness and damping rates over
-    the vertices (1/s^2, 1/s), from every element kind's row sums and ``control``'s grabs."""
+def vertex_rates(model, control) -> tuple[np.ndarray, np.ndarray]:
+    """Per vertex, ``(omega^2, gamma)`` (N,) (1/s^2, 1/s): its stiffness and damping rates,
+    from every element kind's row sums and ``control``'s grabs."""
     n = model.n_vertices
     ks, kd = np.zeros(n), np.zeros(n)
     for kind in model.elements:
@@ -169,7 +162,14 @@ def explicit_rates(model, control) -> tuple[float, float]:
         kd += kind.damping_rows(n)
     held = control.grab_slot >= 0
     ks[held] += control.grab_pull[control.grab_slot[held], 0]
-    return float(np.max(2 * ks * model.vertex_inv_mass)), float(np.max(2 * kd * model.vertex_inv_mass))
+    return 2 * ks * model.vertex_inv_mass, 2 * kd * model.vertex_inv_mass
+
+
+def explicit_rates(model, control) -> tuple[float, float]:
+    """``(omega^2, gamma)`` of :func:`stable_dt`: the largest stiffness and damping rates over
+    the vertices (1/s^2, 1/s), :func:`vertex_rates`."""
+    w2, gamma = vertex_rates(model, control)
+    return float(np.max(w2)), float(np.max(gamma))
 
 
 def stable_dt(model, control) -> float:
