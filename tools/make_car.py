@@ -106,8 +106,10 @@ seconds = 8.0
 fps = 30
 
 [camera]
-center = [0.0, 1.6]
-size = [10.4, 5.85]
+# the chassis (body 0) in the middle, as a side-scroller keeps its car
+center = [-3.35, 0.64]
+size = [4.8, 2.7]
+follow = 0
 
 [physics]
 friction = 0.9

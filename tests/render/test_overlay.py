@@ -124,3 +124,25 @@ def test_show_overlay_marks_the_frames():
     marked = deforma.show("sample", overlay=True, **kwargs).last_frame
     diff = changed(plain, marked)
     assert diff[:36, :160].any() and diff[-36:, :160].any() and not diff[36:-36].any()
+
+
+def test_a_camera_that_follows_a_body_keeps_its_centre_of_mass_in_the_middle():
+    # the car scene's [camera] follows its chassis (body 0)
+    world = deforma.load_scene("car")
+    r = Renderer.headless((160, 90), samples=0)
+    try:
+        view = WorldView(r, world)
+        chassis = world.bodies[0]
+        assert view.follow is chassis
+        for _ in range(120):
+            world.step()
+        view.draw(read=False)
+        np.testing.assert_allclose(r.camera.center, chassis.center_of_mass)
+        assert chassis.center_of_mass[0] > -3.0  # it drove off (from -3.35 m): the camera went along
+        size = r.camera.size
+        view.follow = None  # a view that follows nothing keeps its camera
+        world.step()
+        view.draw(read=False)
+        assert r.camera.center != tuple(chassis.center_of_mass) and r.camera.size == size
+    finally:
+        r.release()

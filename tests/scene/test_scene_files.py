@@ -312,3 +312,21 @@ def test_an_unreadable_texture_file_is_refused_naming_its_key(tmp_path, content,
         scenes.load(p)
     text = str(e.value)
     assert "\n" not in text and text.startswith(f"{p}: body[0].texture: cannot read image") and why in text
+
+
+def test_a_camera_follows_a_body_named_by_its_place(tmp_path):
+    p = tmp_path / "follow.toml"
+    body = '[[body]]\nshape = "box"\ncorners = [[0, 0], [1, 0], [1, 1], [0, 1]]\n'
+    p.write_text("[camera]\nfollow = 1\n" + body + body.replace("[[0, 0], [1, 0], [1, 1], [0, 1]]",
+                                                                   "[[2, 0], [3, 0], [3, 1], [2, 1]]"))
+    scene = deforma.scene.load(p)
+    assert scene.camera.follow == 1
+    world = deforma.scene.build(scene)
+    again = deforma.scene.load(deforma.save_scene(world, tmp_path / "again.toml"))
+    assert again.camera.follow == 1
+    for follow, message in (("2", "camera.follow: there is no body 2: the scene has 2 [[body]] tables"),
+                            ("-1", "camera.follow"), ("0.5", "camera.follow")):
+        p.write_text(f"[camera]\nfollow = {follow}\n" + body + body)
+        with pytest.raises(deforma.scene.SceneError) as e:
+            deforma.scene.load(p)
+        assert message in str(e.value) and "\n" not in str(e.value)

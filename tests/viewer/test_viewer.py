@@ -609,3 +609,19 @@ def test_the_join_key_and_two_clicks_hinge_a_crate_to_the_world(viewer):
     key(pygame.K_j)
     run(viewer, 1)
     assert len(world.joints) == n + 1 and "cancelled" in viewer.inspector.message
+
+
+def test_the_car_scene_camera_follows_the_chassis_until_panned(demo):
+    demo.load("car")
+    pygame.event.clear()
+    run(demo, 90)
+    chassis = demo.session.world.bodies[0]
+    np.testing.assert_allclose(demo.renderer.camera.center, chassis.center_of_mass, atol=0.05)  # a frame behind
+    post(pygame.MOUSEBUTTONDOWN, pos=(400, 300), button=3)
+    post(pygame.MOUSEMOTION, pos=(500, 300), rel=(100, 0), buttons=(0, 0, 1))
+    post(pygame.MOUSEBUTTONUP, pos=(500, 300), button=3)
+    run(demo, 1)
+    assert demo.session.follow is None
+    where = demo.renderer.camera.center
+    run(demo, 30)  # the car drives on; the camera stays where the pan put it
+    assert demo.renderer.camera.center == where

@@ -67,6 +67,8 @@ class WorldView:
         renderer.background_top = _as_rgba(cam.background[0])[:3]
         renderer.background_bottom = _as_rgba(cam.background[1])[:3]
         self.wireframe = cam.wireframe
+        #: The body the camera keeps in the middle (``[camera] follow``), or None.
+        self.follow = world.bodies[cam.follow] if cam.follow is not None and cam.follow < len(world.bodies) else None
         self.overlay = bool(overlay)
         self.dim_sleeping = False  # draw sleeping bodies darker (the viewer turns it on)
         self.collider_colors = None
@@ -149,6 +151,8 @@ class WorldView:
                 or len(self.world.colliders) != self._n_colliders:
             self.sync()
         r = self.renderer
+        if self.follow is not None and any(b is self.follow for b in bodies):
+            r.camera = Camera(tuple(map(float, self.follow.center_of_mass)), r.camera.size)
         r.render([(h, b.positions, self.dim_sleeping and b.sleeping) for h, b in zip(self._handles, self._bodies)],
                  self.world.colliders,
                  wireframe=self.wireframe, collider_colors=self.collider_colors)

@@ -550,6 +550,11 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
                         _check_joint(out[-1], p, len(values.get("body", ())))
                 values[name] = tuple(out)
         _check_materials(values)
+        follow = values["camera"].follow if "camera" in values else None
+        if follow is not None and follow >= len(values.get("body", ())):
+            n = len(values.get("body", ()))
+            raise _Problem("camera.follow", f"there is no body {follow}: the scene has {n} [[body]] table"
+                                            f"{'' if n == 1 else 's'}")
     except _Problem as e:
         where = f"{e.path}: " if e.path else ""
         raise SceneError(f"{source}: {where}{e.message}") from None

@@ -134,6 +134,10 @@ class CameraSettings:
                        doc="Width and height that must be visible; the view grows along one axis to "
                            "match the picture's aspect ratio.")
     wireframe: bool = spec("bool", False, doc="Draw every spring over the bodies.")
+    follow: int | None = spec("int", None, lo=0,
+                              doc="A body the camera keeps in the middle (its centre of mass), by its place among "
+                                  "the [[body]] tables (from 0), as a side-scroller does; the viewer stops following "
+                                  "once you pan.")
     background: tuple = spec("colors2", ("#dbe8f5", "#f7f2e8"),
                              doc="Top and bottom colours of the background gradient.")
 

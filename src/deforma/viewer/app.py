@@ -144,6 +144,7 @@ class Viewer:
         self._Camera = Camera
         self.renderer = Renderer(self.ctx, self.window_size, target=self.ctx.screen)
         self.view = WorldView(self.renderer, session.world)
+        self.view.follow = None  # the session moves the camera (Session.follow_camera), panning stops it
         self.view.dim_sleeping = True
         self.overlay = Overlay(self.ctx)
         name = session.scene.scene.name or "scene"
@@ -535,6 +536,7 @@ class Viewer:
                 s.move_collider((p[0] + dx, p[1] + dy))
             elif self._pan is not None:
                 a, b = self.to_world(self._pan), self.to_world(e.pos)
+                s.follow = None  # panned: the camera stays where it is put
                 cx, cy = s.camera_center
                 s.camera_center = (cx - (b[0] - a[0]), cy - (b[1] - a[1]))
                 self._pan = tuple(e.pos)
@@ -630,6 +632,7 @@ class Viewer:
         self._sync_view()
         r = self.renderer
         r.resize(self.world_size)
+        s.follow_camera()
         cam = r.camera
         if cam.center != tuple(s.camera_center) or cam.size != tuple(s.camera_size):
             r.camera = self._Camera(s.camera_center, s.camera_size)

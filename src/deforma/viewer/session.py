@@ -198,6 +198,9 @@ class Session:
         self.explosive_force = float(scene.interaction.explosive_force)
         self.camera_center = tuple(scene.camera.center)
         self.camera_size = tuple(scene.camera.size)
+        #: The body the camera keeps in the middle (its index, ``[camera] follow``); None once
+        #: the view is panned.
+        self.follow = scene.camera.follow
         self.wireframe = bool(scene.camera.wireframe)
         # one colour per collider of the world (an image collider is several polygons)
         self.collider_colors = [c.color for c in scene_of(self.world).collider]
@@ -231,6 +234,19 @@ class Session:
             values["material_damping"] = float(physics.material_damping)
         return values
 
+    def follow_camera(self) -> None:
+        """Put the camera's centre on the followed body's centre of mass (:attr:`follow`; a
+        body index no longer in the world follows nothing).
+
+        Examples
+        --------
+        >>> s = Session("car")
+        >>> s.follow_camera(); s.camera_center == tuple(s.world.bodies[s.follow].center_of_mass)
+        True
+        """
+        if self.follow is not None and self.follow < len(self.world.bodies):
+            self.camera_center = tuple(map(float, self.world.bodies[self.follow].center_of_mass))
+
     # -- what the inspector reads --------------------------------------------------------------
     @property
     def scene(self) -> Scene:
@@ -239,7 +255,7 @@ class Session:
         colliders = tuple(replace(c, color=self.collider_colors[i] if i < len(self.collider_colors) else None)
                           for i, c in enumerate(s.collider))
         camera = replace(s.camera, center=tuple(map(float, self.camera_center)),
-                         size=tuple(map(float, self.camera_size)), wireframe=bool(self.wireframe))
+                         size=tuple(map(float, self.camera_size)), wireframe=bool(self.wireframe), follow=self.follow)
         return replace(s, collider=colliders, camera=camera,
                        interaction=replace(s.interaction, explosive_force=float(self.explosive_force)))
 
