@@ -26,6 +26,9 @@ TYPED_MODULES = [
     "src/deforma/physics/material.py", "src/deforma/physics/joint.py", "src/deforma/physics/colliders/shapes.py",
     "src/deforma/physics/integrators/__init__.py", "src/deforma/physics/integrators/base.py",
     "src/deforma/scene/__init__.py", "src/deforma/scene/build.py",
+    "src/deforma/render/renderer.py", "src/deforma/render/video.py", "src/deforma/render/world_view.py",
+    "src/deforma/render/notebook.py", "src/deforma/render/recorder.py",
+    "src/deforma/sweeps.py",
 ]
 
 LINTED = ["src", "tests", "benchmarks", "tools"]

@@ -47,6 +47,12 @@ import sys
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable
+
+if TYPE_CHECKING:
+    import pyarrow as pa
+
+    from .scene import Scene
 
 __all__ = ["Run", "SweepError", "SweepResult", "SweepSpec", "connect", "load_spec", "plan", "sweep"]
 
@@ -128,7 +134,7 @@ def _read_toml(path: Path, what: str) -> dict:
     try:
         import tomllib
     except ModuleNotFoundError:  # Python < 3.11
-        import tomli as tomllib
+        import tomli as tomllib  # type: ignore[no-redef]
     try:
         return tomllib.loads(path.read_bytes().decode("utf-8"))
     except OSError as e:
@@ -162,7 +168,7 @@ def _count(n: int) -> str:
     return str(n) if n < 10**100 else "over 1e100"
 
 
-def load_spec(path) -> SweepSpec:
+def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
     """Read and check a sweep file: its own keys, the base scene, and every key path and value.
 
     Raises
@@ -275,7 +281,7 @@ def _set_key(data: dict, key: str, value, source: str) -> None:
         if int(index) >= count:
             raise SweepError(f"{source}: {key}: the scene has {count} [[{table}]] table{'s' if count != 1 else ''}"
                              + (f" (indices 0 to {count - 1})" if count else ""))
-        items[int(index)][name] = value
+        items[int(index)][name] = value  # type: ignore[index]  # a list: count > index
     elif table in SECTIONS:
         if index is not None:
             raise SweepError(f"{source}: {key}: [{table}] is a table, not an array; write {table}.{name}")
@@ -286,7 +292,7 @@ def _set_key(data: dict, key: str, value, source: str) -> None:
         raise SweepError(f"{source}: {key}: unknown table {table!r}; {hint}allowed: {', '.join(tables)}")
 
 
-def scene_for(spec: SweepSpec, parameters: dict, *, source: str):
+def scene_for(spec: SweepSpec, parameters: dict, *, source: str) -> Scene:
     """The base scene with ``parameters`` set, validated by the scene loader; raises SweepError."""
     from .scene.schema import parse_scene
 
@@ -329,13 +335,14 @@ def plan(spec: SweepSpec) -> list[Run]:
 
         rng = np.random.default_rng(spec.seed)
         combos = []
-        for _ in range(spec.samples):
+        for _ in range(spec.samples):  # type: ignore[arg-type]  # random mode: load_spec set it
             combo = {}
             for k in keys:
                 v = spec.parameters[k]
                 if isinstance(v, dict):
                     drawn = rng.uniform(v["min"], v["max"])
-                    combo[k] = drawn.tolist() if isinstance(v["min"], list) else float(drawn)
+                    # an array when min and max are lists
+                    combo[k] = drawn.tolist() if isinstance(v["min"], list) else float(drawn)  # type: ignore[attr-defined]
                 else:
                     combo[k] = v[int(rng.integers(len(v)))]
             combos.append(combo)
@@ -397,7 +404,8 @@ def _video_view(world, size):
         raise
 
 
-def simulate(scene, *, states=False, video: str | None = None, video_size=VIDEO_SIZE) -> dict:
+def simulate(scene: Scene, *, states: bool | str | os.PathLike[str] = False, video: str | None = None,
+             video_size: tuple[int, int] = VIDEO_SIZE) -> dict:
     """Run one scene for its ``run.seconds``; the row's status, message and metrics (and the states NPZ
     and video bytes).
 
@@ -455,10 +463,12 @@ def simulate(scene, *, states=False, video: str | None = None, video_size=VIDEO_
         row["final_energy_j"] = float(world.energy().total)
         row["centroid"] = [[float(v) for v in np.mean(b.positions, axis=0)] for b in world.bodies]
         if states:
-            row["states"] = playback.recording.to_bytes(kept_in=None if states is True else states)
+            # record=True: the playback keeps a recording
+            row["states"] = playback.recording.to_bytes(  # type: ignore[union-attr]
+                kept_in=None if states is True else states)
         if writer is not None:
             writer.close()
-            row["video"] = (folder / f"video.{video}").read_bytes()
+            row["video"] = (folder / f"video.{video}").read_bytes()  # type: ignore[operator]  # made with writer
     except SimulationUnstable as e:
         row.update(status="unstable", message=str(e), hint=e.hint)
     except _NoVideo as e:
@@ -529,7 +539,7 @@ def connect(*, workers: int | None = None, address: str | None = None) -> bool:
         _check_reachable(address)
     import logging
 
-    kwargs = dict(include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR,
+    kwargs: dict[str, Any] = dict(include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR,
                   runtime_env={"env_vars": {"NUMBA_NUM_THREADS": "1"}})
     if not address:  # num_cpus is refused when joining an existing cluster: it has its own
         kwargs["num_cpus"] = workers or os.cpu_count() or 1
@@ -601,7 +611,7 @@ def _row_table(spec: SweepSpec, run: Run, row: dict, states_path: str | None, vi
     return pa.Table.from_pylist([record], schema=schema)
 
 
-def read_results(outdir):
+def read_results(outdir: str | os.PathLike[str]) -> pa.Table | None:
     """The sweep table in ``outdir`` (a pyarrow Table), or None when there is none yet."""
     import pyarrow.parquet as pq
 
@@ -632,9 +642,10 @@ def _done(outdir: Path, spec: SweepSpec, *, retry_failed: bool, force: bool) -> 
 
 
 # -- the sweep -------------------------------------------------------------------------------------
-def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None = None, states: bool = False,
-          video: str | bool | None = None, video_size=VIDEO_SIZE, retry_failed: bool = False, force: bool = False,
-          progress=None) -> SweepResult:
+def sweep(spec_path: str | os.PathLike[str], outdir: str | os.PathLike[str], *, workers: int | None = None,
+          address: str | None = None, states: bool = False,
+          video: str | bool | None = None, video_size: tuple[int, int] = VIDEO_SIZE, retry_failed: bool = False,
+          force: bool = False, progress: Callable[[int, int, int], object] | None = None) -> SweepResult:
     r"""Run every run of a sweep file on Ray; one row per run in ``outdir/results.parquet``.
 
     Parameters
@@ -745,12 +756,12 @@ def sweep(spec_path, outdir, *, workers: int | None = None, address: str | None 
             states_path = None
             if row.get("states") is not None:
                 target = outdir / STATES_FOLDER / f"{run.run_id}.npz"
-                write_atomic(target, lambda f, data=row["states"]: f.write(data))
+                write_atomic(target, lambda f, data=row["states"]: f.write(data))  # type: ignore[misc]
                 states_path = f"{STATES_FOLDER}/{run.run_id}.npz"
             video_path = None
             if row.get("video") is not None:
                 video_path = f"{VIDEOS_FOLDER}/{run.run_id}.{video}"
-                write_atomic(outdir / video_path, lambda f, data=row["video"]: f.write(data))
+                write_atomic(outdir / video_path, lambda f, data=row["video"]: f.write(data))  # type: ignore[misc]
             table = _row_table(spec, run, row, states_path, video_path)
             write_atomic(outdir / RESULTS_NAME / f"part-{run.run_id}.parquet", lambda f: pq.write_table(table, f))
             counts[row["status"]] += 1

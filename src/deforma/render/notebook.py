@@ -19,8 +19,15 @@ import os
 import tempfile
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ..physics import World
+    from ..scene import Scene
 
 __all__ = ["MAX_EMBED_BYTES", "MAX_FRAMES", "Animation", "show"]
 
@@ -73,7 +80,8 @@ class Animation:
     (36, 64, 3)
     """
 
-    def __init__(self, data: bytes, *, format: str, fps: float, size, n_frames: int, last_frame):
+    def __init__(self, data: bytes, *, format: str, fps: float, size: tuple[int, int], n_frames: int,
+                 last_frame: ArrayLike) -> None:
         self.data = bytes(data)
         self.format = format
         self.fps = float(fps)
@@ -110,7 +118,7 @@ class Animation:
 
         return png_bytes(Image.fromarray(self.last_frame))
 
-    def frames(self):
+    def frames(self) -> Iterator[np.ndarray]:
         """The frames decoded again, one (H, W, 3) uint8 array at a time (MP4 is lossy: close,
         not equal, to what was drawn)."""
         w, h = self.size
@@ -135,7 +143,7 @@ class Animation:
             finally:
                 reader.close()
 
-    def save(self, path) -> Path:
+    def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the animation to ``path``: ``.mp4``, ``.gif``, or a folder of PNG frames.
 
         The same format as :attr:`format` is written byte for byte; another is converted from
@@ -179,7 +187,7 @@ def _number(value, name: str, hi: float, unit: str) -> float | None:
     return float(value)
 
 
-def _side(value) -> bool:
+def _side(value: object) -> bool | np.bool_:
     return (isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
             and SIDE_RANGE[0] <= value <= SIDE_RANGE[1])
 
@@ -249,7 +257,9 @@ def _picture_size(width, height, camera) -> tuple[int, int]:
     return width, height
 
 
-def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, overlay=False) -> Animation:
+def show(scene_or_world: str | os.PathLike[str] | Scene | World, *, seconds: float | None = None,
+         fps: float | None = None, size: int | tuple[int, int] | None = None, format: str | None = None,
+         overlay: bool = False) -> Animation:
     """Simulate a scene or a world and return an animation that plays inline in a notebook.
 
     Parameters
@@ -357,4 +367,5 @@ def show(scene_or_world, *, seconds=None, fps=None, size=None, format=None, over
             data = path.read_bytes()
     finally:
         renderer.release()
-    return Animation(data, format=format, fps=fps, size=picture, n_frames=n_frames, last_frame=recorder.last_frame)
+    return Animation(data, format=format, fps=fps, size=picture, n_frames=n_frames,
+                     last_frame=recorder.last_frame)  # type: ignore[arg-type]  # n_frames >= 1 were drawn

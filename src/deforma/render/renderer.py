@@ -11,11 +11,15 @@ moderngl is imported lazily so that ``import deforma`` works without it.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Sequence
 
 import numpy as np
 
 from .collider_mesh import FLOATS_PER_VERTEX, ColliderGeometry, collider_corners, collider_shape
+
+if TYPE_CHECKING:
+    import moderngl  # imported lazily at run time (see above)
+    from numpy.typing import ArrayLike
 
 __all__ = ["Camera", "MeshHandle", "Renderer", "collider_corners"]
 
@@ -86,7 +90,7 @@ class Camera:
         hx, _ = self.extent(viewport)
         return 2.0 * hx / viewport[0]
 
-    def world_to_pixel(self, points, viewport: tuple[int, int]) -> np.ndarray:
+    def world_to_pixel(self, points: ArrayLike, viewport: tuple[int, int]) -> np.ndarray:
         """Map world points (..., 2) in metres to pixel coordinates (column, row), row 0 on top."""
         p = np.asarray(points, dtype=np.float64)
         hx, hy = self.extent(viewport)
@@ -95,7 +99,7 @@ class Camera:
         row = (self.center[1] + hy - p[..., 1]) / (2 * hy) * h
         return np.stack([col, row], axis=-1)
 
-    def pixel_to_world(self, pixels, viewport: tuple[int, int]) -> np.ndarray:
+    def pixel_to_world(self, pixels: ArrayLike, viewport: tuple[int, int]) -> np.ndarray:
         """Inverse of :meth:`world_to_pixel` (a mouse position to metres)."""
         q = np.asarray(pixels, dtype=np.float64)
         hx, hy = self.extent(viewport)
@@ -109,7 +113,7 @@ class Camera:
 DIM = 0.6
 
 
-def _as_rgba(color) -> tuple[float, float, float, float]:
+def _as_rgba(color: str | Sequence[float]) -> tuple[float, float, float, float]:
     """A colour as RGBA floats: accepts '#rrggbb', '#rrggbbaa', or 3/4 numbers in [0, 1]."""
     if isinstance(color, str):
         s = color.lstrip("#")
@@ -122,7 +126,7 @@ def _as_rgba(color) -> tuple[float, float, float, float]:
         vals.append(1.0)
     if len(vals) != 4 or not all(0.0 <= v <= 1.0 for v in vals):
         raise ValueError(f"colour must be 3 or 4 numbers in [0, 1] or a hex string, got {color!r}")
-    return tuple(vals)
+    return tuple(vals)  # type: ignore[return-value]  # four values, checked above
 
 
 _BACKGROUND_VS = """
@@ -237,7 +241,8 @@ class MeshHandle:
     Made by :meth:`Renderer.add_mesh`; pass it to :meth:`Renderer.draw_mesh`.
     """
 
-    def __init__(self, renderer: "Renderer", triangles, uv, texture, color, edges):
+    def __init__(self, renderer: "Renderer", triangles: ArrayLike, uv: np.ndarray | Sequence[Sequence[float]] | None,
+                 texture: ArrayLike | None, color: str | Sequence[float] | None, edges: ArrayLike | None) -> None:
         ctx = renderer.ctx
         tris = np.ascontiguousarray(triangles, dtype=np.int32)
         if tris.ndim != 2 or tris.shape[1] != 3 or len(tris) == 0:
@@ -273,8 +278,8 @@ class MeshHandle:
         self._outline_ibo = ctx.buffer(outline.tobytes()) if len(outline) else None
         self.outline_vao = None if self._outline_ibo is None else ctx.vertex_array(
             renderer._flat_prog, [(self._pos, "2f", "in_pos")], self._outline_ibo)
-        self.texture = None
-        self.mipmapped = None
+        self.texture: moderngl.Texture | None = None
+        self.mipmapped: bool | None = None
         opaque_texture = True
         if texture is not None:
             self.texture = renderer._make_texture(texture)
@@ -286,7 +291,7 @@ class MeshHandle:
         # opaque bodies skip blending: a measurable share of the frame on a software rasteriser
         self.opaque = opaque_texture and self.color[3] >= 1.0
 
-    def upload(self, positions) -> None:
+    def upload(self, positions: ArrayLike) -> None:
         p = np.asarray(positions)
         if p.shape != self._scratch.shape:
             raise ValueError(f"positions must have shape {self._scratch.shape} (one per vertex), got {p.shape}")
@@ -333,7 +338,12 @@ class Renderer:
     >>> r.release()
     """
 
-    def __init__(self, ctx, size=(1280, 720), *, samples: int = 4, target=None, camera: Camera | None = None):
+    _img_tex_key: tuple[int, int, int]  # set with _img_tex (draw_image)
+
+    # ctx is a moderngl.Context, typed Any: moderngl's stubs type a program's members as a union
+    # (uniform, attribute, ...) that every ``prog[name].value = ...`` would have to narrow
+    def __init__(self, ctx: Any, size: tuple[int, int] = (1280, 720), *, samples: int = 4,
+                 target: moderngl.Framebuffer | None = None, camera: Camera | None = None) -> None:
         self.ctx = ctx
         self.camera = camera if camera is not None else Camera()
         self.background_top = BACKGROUND_TOP
@@ -348,20 +358,23 @@ class Renderer:
         self._grid_vao = ctx.vertex_array(self._flat_prog, [(self._grid_vbo, "2f", "in_pos")])
         self._img_prog = ctx.program(vertex_shader=_IMAGE_VS, fragment_shader=_IMAGE_FS)
         self._img_vao = ctx.vertex_array(self._img_prog, [])
-        self._img_tex = None
-        self._coll_vbo = None
-        self._coll_vao = None
+        self._img_tex: moderngl.Texture | None = None
+        self._coll_vbo: moderngl.Buffer | None = None
+        self._coll_vao: moderngl.VertexArray | None = None
         self._coll_capacity = 0
         self._coll_count = 0
-        self._coll_key = None     # what the collider buffer holds (see draw_colliders)
-        self._coll_cache = {}     # id(collider) -> (collider, _version, ColliderGeometry)
-        self._white = None
+        self._coll_key: tuple | None = None     # what the collider buffer holds (see draw_colliders)
+        # id(collider) -> (collider, _version, ColliderGeometry)
+        self._coll_cache: dict[int, tuple[Any, Any, ColliderGeometry]] = {}
+        self._white: moderngl.Texture | None = None
         self._meshes: list[MeshHandle] = []
         self._owns_ctx = False
         self._target = target
         self._owns_fbo = target is None
-        self._msaa = self._resolve = None
-        self._buffers = []        # off-screen (msaa or None, resolve) pairs; the current is _msaa/_resolve
+        self._msaa: moderngl.Framebuffer | None = None
+        self._resolve: moderngl.Framebuffer | None = None
+        # off-screen (msaa or None, resolve) pairs; the current is _msaa/_resolve
+        self._buffers: list[tuple[moderngl.Framebuffer | None, moderngl.Framebuffer]] = []
         self._buffer = 0
         self.size = (0, 0)
         self._samples = 0
@@ -371,7 +384,8 @@ class Renderer:
         self.resize(size)
 
     @classmethod
-    def headless(cls, size=(1280, 720), *, samples: int = 4, camera: Camera | None = None) -> "Renderer":
+    def headless(cls, size: tuple[int, int] = (1280, 720), *, samples: int = 4,
+                 camera: Camera | None = None) -> "Renderer":
         """A renderer on its own standalone OpenGL context, no window or display needed.
 
         Uses EGL (Mesa's llvmpipe software rasteriser when there is no GPU). On Debian the
@@ -388,7 +402,7 @@ class Renderer:
         return r
 
     # -- framebuffer ---------------------------------------------------------------------
-    def resize(self, size) -> None:
+    def resize(self, size: tuple[int, int]) -> None:
         """Change the picture size in pixels (re-creates the off-screen framebuffer)."""
         w, h = (int(v) for v in size)
         if w < 1 or h < 1 or w > 16384 or h > 16384:
@@ -423,11 +437,11 @@ class Renderer:
         self._msaa = self._resolve = None
 
     @property
-    def framebuffer(self):
+    def framebuffer(self) -> moderngl.Framebuffer:
         """The framebuffer drawn into."""
         if self._target is not None:
             return self._target
-        return self._msaa if self._msaa is not None else self._resolve
+        return self._msaa if self._msaa is not None else self._resolve  # type: ignore[return-value]  # until release()
 
     # -- resources -----------------------------------------------------------------------
     def _make_texture(self, image):
@@ -446,7 +460,9 @@ class Renderer:
         tex.repeat_x = tex.repeat_y = False
         return tex
 
-    def add_mesh(self, triangles, uv=None, *, texture=None, color=None, edges=None) -> MeshHandle:
+    def add_mesh(self, triangles: ArrayLike, uv: np.ndarray | Sequence[Sequence[float]] | None = None, *,
+                 texture: ArrayLike | None = None, color: str | Sequence[float] | None = None,
+                 edges: ArrayLike | None = None) -> MeshHandle:
         """Upload a body's constant data once; draw it each frame with :meth:`draw_mesh`.
 
         Parameters
@@ -561,7 +577,8 @@ class Renderer:
         p["u_pixel"].value = (2.0 / self.size[0], 2.0 / self.size[1])
         self.ctx.enable(moderngl.BLEND)
         self.ctx.blend_func = _blend()
-        self._coll_vao.render(moderngl.TRIANGLES, vertices=self._coll_count)
+        # _coll_vao is made with the first colliders (_coll_count > 0)
+        self._coll_vao.render(moderngl.TRIANGLES, vertices=self._coll_count)  # type: ignore[union-attr]
 
     @staticmethod
     def _collider_key(c):
@@ -575,8 +592,8 @@ class Renderer:
         return (id(c), tuple(map(float, c.center)), tuple(map(float, c.size)), float(c.angle))
 
     def _upload_colliders(self, items, fills) -> None:
-        cache = {}
-        rows = []
+        cache: dict[int, tuple[Any, Any, ColliderGeometry]] = {}
+        rows: list[np.ndarray] = []
         for c, fill in zip(items, fills):
             version = getattr(c, "_version", None)
             old = self._coll_cache.get(id(c))
@@ -596,13 +613,13 @@ class Renderer:
         if data.nbytes > self._coll_capacity:
             if self._coll_vao is not None:
                 self._coll_vao.release()
-                self._coll_vbo.release()
+                self._coll_vbo.release()  # type: ignore[union-attr]  # made with _coll_vao
             self._coll_capacity = max(data.nbytes, 2 * self._coll_capacity)
             self._coll_vbo = self.ctx.buffer(reserve=self._coll_capacity, dynamic=True)
             self._coll_vao = self.ctx.vertex_array(
                 self._coll_prog, [(self._coll_vbo, "2f 2f 4f", "in_pos", "in_offset", "in_color")])
         if len(data):
-            self._coll_vbo.write(data.tobytes())
+            self._coll_vbo.write(data.tobytes())  # type: ignore[union-attr]  # made above
 
     def _choose_filter(self, handle: MeshHandle) -> None:
         """Mipmaps only when the picture is drawn smaller than it is (they cost ~10% of a frame)."""
@@ -616,10 +633,13 @@ class Renderer:
         # a little shrinking is fine with bilinear filtering; beyond it texels would shimmer
         mip = shrink > 1.25
         if mip != handle.mipmapped:
-            handle.texture.filter = ((moderngl.LINEAR_MIPMAP_NEAREST if mip else moderngl.LINEAR), moderngl.LINEAR)
+            # only a textured handle comes here (draw_mesh)
+            handle.texture.filter = ((moderngl.LINEAR_MIPMAP_NEAREST if mip else moderngl.LINEAR),  # type: ignore[union-attr]
+                                     moderngl.LINEAR)
             handle.mipmapped = mip
 
-    def draw_mesh(self, handle: MeshHandle, positions, *, wireframe: bool = False, wire_color=None,
+    def draw_mesh(self, handle: MeshHandle, positions: ArrayLike, *, wireframe: bool = False,
+                  wire_color: str | Sequence[float] | None = None,
                   dim: bool = False) -> None:
         """Draw one body at ``positions`` (N, 2) metres: textured or flat, optionally its springs;
         ``dim`` darkens it (the viewer's sleeping bodies)."""
@@ -655,7 +675,7 @@ class Renderer:
             f["u_color"].value = (0.6 * shade * r, 0.6 * shade * g, 0.6 * shade * b, a)
             handle.outline_vao.render(moderngl.LINES)
 
-    def draw_image(self, image, position=(0, 0)) -> None:
+    def draw_image(self, image: ArrayLike, position: tuple[int, int] = (0, 0)) -> None:
         """Draw a picture in pixel coordinates over what is drawn, e.g. an inspector panel.
 
         Parameters
@@ -843,16 +863,16 @@ _HEADLESS_HELP = (
 )
 
 
-def create_headless_context():
+def create_headless_context() -> moderngl.Context:
     """A standalone OpenGL 3.3 context: EGL first (no display), then the platform default."""
     try:
         import moderngl
     except ImportError as e:  # pragma: no cover - depends on the environment
         raise RuntimeError(_HEADLESS_HELP.format(err=e)) from None
-    errors = []
+    errors: list[str] = []
     for kwargs in ({"backend": "egl"}, {}):
         try:
-            return moderngl.create_standalone_context(require=330, **kwargs)
+            return moderngl.create_standalone_context(require=330, **kwargs)  # type: ignore[arg-type]  # backend=
         except Exception as e:  # noqa: BLE001 - glcontext raises plain Exceptions
             errors.append(f"{kwargs.get('backend', 'default')}: {e}")
     raise RuntimeError(_HEADLESS_HELP.format(err="; ".join(errors)))

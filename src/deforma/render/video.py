@@ -21,8 +21,13 @@ import queue
 import shutil
 import threading
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+    from PIL import Image
 
 from ..files import check_folder, failed_write, publish, temp_beside, temp_folder_in
 
@@ -31,7 +36,7 @@ __all__ = ["FrameWriter", "GifWriter", "Mp4Writer", "PngFolderWriter", "check_ou
 VIDEO_SUFFIXES = {".mp4": "mp4", ".gif": "gif"}
 
 
-def output_kind(path) -> str:
+def output_kind(path: str | os.PathLike[str]) -> str:
     """'mp4', 'gif' or 'png' (a folder of frames) from the output path.
 
     A path ending in ``/`` is a folder; otherwise ``.mp4`` and ``.gif`` name videos, and an
@@ -54,7 +59,7 @@ def output_kind(path) -> str:
     return kind
 
 
-def check_output(path) -> str:
+def check_output(path: str | os.PathLike[str]) -> str:
     """Check, before any work, that ``path`` can be written; returns its kind (see :func:`output_kind`).
 
     The parent folder must exist and be writable; a PNG folder may not exist yet (its
@@ -94,7 +99,7 @@ class FrameWriter:
     #: the one being handed over).
     QUEUE_FRAMES = 2
 
-    def __init__(self, path, *, fps: float):
+    def __init__(self, path: str | os.PathLike[str], *, fps: float) -> None:
         if not (isinstance(fps, (int, float)) and np.isfinite(fps) and 0 < fps <= 1000):
             raise ValueError(f"fps must be a number in (0, 1000], got {fps!r}")
         self.path = Path(str(path).rstrip("/" + os.sep) or ".")
@@ -103,7 +108,7 @@ class FrameWriter:
         self.size: tuple[int, int] | None = None
         self._closed = False
         self._finished = False
-        self._queue: queue.Queue | None = None
+        self._queue: queue.Queue[np.ndarray | None] | None = None
         self._thread: threading.Thread | None = None
         self._failure: BaseException | None = None   # what the thread's last frame raised
         self._dropping = False                       # the thread skips the frames left (abort)
@@ -120,7 +125,7 @@ class FrameWriter:
             raise ValueError(f"every frame must have the first frame's size {self.size}, got {size}")
         return f
 
-    def write(self, frame) -> None:
+    def write(self, frame: ArrayLike) -> None:
         """Append one frame: a copy goes to the writer's thread (this waits while
         :attr:`QUEUE_FRAMES` frames are waiting there).
 
@@ -141,13 +146,13 @@ class FrameWriter:
             self._queue = queue.Queue(maxsize=self.QUEUE_FRAMES)
             self._thread = threading.Thread(target=self._work, name=f"deforma writer {self.path.name}", daemon=True)
             self._thread.start()
-        self._queue.put(f)
+        self._queue.put(f)  # type: ignore[union-attr]  # made with the thread
 
     def _work(self) -> None:
         """The writer's thread: encodes frames in order until it is given None; after a failure
         (kept for the caller's thread to raise) or an abort it only empties the queue."""
         while True:
-            f = self._queue.get()
+            f = self._queue.get()  # type: ignore[union-attr]  # the thread's own queue
             if f is None:
                 return
             if self._failure is not None or self._dropping:
@@ -169,7 +174,7 @@ class FrameWriter:
             self._dropping = True
             while True:  # only the caller's thread puts: after this there is room for None
                 try:
-                    self._queue.get_nowait()
+                    self._queue.get_nowait()  # type: ignore[union-attr]  # made with the thread
                 except queue.Empty:
                     break
         interrupt = None
@@ -177,7 +182,8 @@ class FrameWriter:
         while t.is_alive():
             try:
                 if not queued:
-                    self._queue.put(None)  # waits for room while the thread works through the frames
+                    # waits for room while the thread works through the frames
+                    self._queue.put(None)  # type: ignore[union-attr]
                     queued = True
                 t.join()
             except BaseException as e:  # noqa: BLE001 - the thread's frame takes milliseconds
@@ -281,7 +287,7 @@ class FrameWriter:
         raise NotImplementedError
 
 
-def mp4_complete(path) -> bool:
+def mp4_complete(path: str | os.PathLike[str]) -> bool:
     """Whether ``path`` is a whole MP4 file: its top-level boxes (4-byte size, 4-byte type; a
     size of 1 is followed by an 8-byte one, 0 runs to the end) tile it exactly, and it has
     its ``ftyp``, ``moov`` and ``mdat``. ffmpeg that runs out of disk while it finishes the
@@ -333,7 +339,7 @@ class Mp4Writer(FrameWriter):
     Odd widths or heights are padded by one pixel, as yuv420p needs even sizes.
     """
 
-    def __init__(self, path, *, fps: float, quality: float = 7.0):
+    def __init__(self, path: str | os.PathLike[str], *, fps: float, quality: float = 7.0) -> None:
         super().__init__(path, fps=fps)
         try:
             import imageio_ffmpeg  # noqa: F401
@@ -419,11 +425,11 @@ class GifWriter(FrameWriter):
     this), so a still ending costs nothing.
     """
 
-    def __init__(self, path, *, fps: float):
+    def __init__(self, path: str | os.PathLike[str], *, fps: float) -> None:
         super().__init__(path, fps=fps)
         self._pending: list[np.ndarray] = []
-        self._frames = []
-        self._palette = None
+        self._frames: list[Image.Image] = []
+        self._palette: Image.Image | None = None
         self._palette_after = max(1, int(round(self.fps)))
         # the temporary file exists from the start, like the MP4's: it reserves the name and
         # shows a run is in progress; it gets its bytes at the end (GIF needs all frames)
@@ -488,7 +494,7 @@ class PngFolderWriter(FrameWriter):
     are left alone.
     """
 
-    def __init__(self, path, *, fps: float, compress_level: int = 3):
+    def __init__(self, path: str | os.PathLike[str], *, fps: float, compress_level: int = 3) -> None:
         super().__init__(path, fps=fps)
         self.compress_level = compress_level
         self._staging: Path | None = None
@@ -542,7 +548,7 @@ class PngFolderWriter(FrameWriter):
                 pass
 
 
-def open_writer(path, *, fps: float) -> FrameWriter:
+def open_writer(path: str | os.PathLike[str], *, fps: float) -> FrameWriter:
     """The writer for ``path``: ``.mp4``, ``.gif``, or a folder (``frames/``) of PNGs.
 
     Parameters
@@ -584,7 +590,7 @@ _MP4_BYTES_PER_PIXEL = 115
 _MP4_BASE_BYTES = 40 * 2**20
 
 
-def run_memory(size, *, samples: int, kind: str, frames: int, fps: float) -> dict[str, int]:
+def run_memory(size: tuple[int, int], *, samples: int, kind: str, frames: int, fps: float) -> dict[str, int]:
     """Estimate the peak memory of a headless run writing ``frames`` frames of ``size``.
 
     Parameters
@@ -632,8 +638,8 @@ def run_memory(size, *, samples: int, kind: str, frames: int, fps: float) -> dic
     return parts
 
 
-def check_run_memory(path, size, *, samples: int, frames: int, fps: float, size_option: str = "--size",
-                     who: str = "deforma run") -> None:
+def check_run_memory(path: str | os.PathLike[str], size: tuple[int, int], *, samples: int, frames: int, fps: float,
+                     size_option: str = "--size", who: str = "deforma run") -> None:
     """Refuse, before anything runs, a run whose :func:`run_memory` is over :data:`MAX_RUN_MEMORY`.
 
     ``size_option`` and ``who`` are how the message names the size option and the command (a

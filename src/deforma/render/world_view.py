@@ -6,9 +6,16 @@ once and then, per frame, only the positions.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .renderer import Camera, Renderer, _as_rgba
+
+if TYPE_CHECKING:
+    from ..physics import Body, World
+    from ..scene import Scene
+    from .renderer import MeshHandle
 
 __all__ = ["BODY_PALETTE", "WorldView"]
 
@@ -55,7 +62,8 @@ class WorldView:
     >>> view.renderer.release()
     """
 
-    def __init__(self, renderer: Renderer, world, scene=None, *, overlay: bool = False, looks_from=None):
+    def __init__(self, renderer: Renderer, world: World, scene: Scene | None = None, *, overlay: bool = False,
+                 looks_from: World | None = None) -> None:
         from ..scene import scene_of
 
         self.renderer = renderer
@@ -71,11 +79,12 @@ class WorldView:
         self.follow = world.bodies[cam.follow] if cam.follow is not None and cam.follow < len(world.bodies) else None
         self.overlay = bool(overlay)
         self.dim_sleeping = False  # draw sleeping bodies darker (the viewer turns it on)
-        self.collider_colors = None
-        self._handles = []
-        self._bodies = []
-        self._shown = None
-        self._markers = None  # the joints' dots (a dark disc, a light one on it), made when first needed
+        self.collider_colors: list | None = None
+        self._handles: list[MeshHandle] = []
+        self._bodies: list[Body] = []
+        self._shown: list[tuple[int, int]] | None = None
+        # the joints' dots (a dark disc, a light one on it), made when first needed
+        self._markers: tuple[MeshHandle, MeshHandle] | None = None
         self.sync()
 
     def sync(self) -> None:
@@ -101,6 +110,7 @@ class WorldView:
         self._handles = []
         for k, (b, spec) in enumerate(zip(bodies, current.body)):
             # a texture named in the scene wins; else the picture an image mesh carries
+            image: np.ndarray | None
             if spec.texture is not None:
                 image = load_texture(spec.texture)
             else:
@@ -139,7 +149,7 @@ class WorldView:
         # view given another world (the viewer's, when a scene is loaded) takes that world's
         return self.world if self.looks_from is None else self.looks_from
 
-    def draw(self, *, read: bool = True):
+    def draw(self, *, read: bool = True) -> np.ndarray | None:
         """Paint the world's current state; returns the picture (H, W, 3) uint8 when ``read``.
 
         With :attr:`overlay` on, the picture returned carries the time and scale overlay (it is
@@ -152,7 +162,8 @@ class WorldView:
             self.sync()
         r = self.renderer
         if self.follow is not None and any(b is self.follow for b in bodies):
-            r.camera = Camera(tuple(map(float, self.follow.center_of_mass)), r.camera.size)
+            r.camera = Camera(tuple(map(float, self.follow.center_of_mass)),  # type: ignore[arg-type]  # (x, y)
+                              r.camera.size)
         r.render([(h, b.positions, self.dim_sleeping and b.sleeping) for h, b in zip(self._handles, self._bodies)],
                  self.world.colliders,
                  wireframe=self.wireframe, collider_colors=self.collider_colors)
@@ -164,7 +175,7 @@ class WorldView:
             self.overlay_onto(frame, time=self.world.time)
         return frame
 
-    def overlay_onto(self, frame, *, time: float, metres_per_pixel: float | None = None) -> None:
+    def overlay_onto(self, frame: np.ndarray, *, time: float, metres_per_pixel: float | None = None) -> None:
         """Write the time and scale overlay onto ``frame`` (a picture this view drew, read back
         later: :class:`deforma.render.recorder.FrameRecorder`); the scale defaults to the camera's now."""
         from .overlay import draw_overlay
