@@ -130,6 +130,34 @@ def test_a_failure_in_the_writers_thread_is_raised_once_and_leaves_nothing(tmp_p
         w.write(np.zeros((16, 16, 3), np.uint8))
 
 
+@pytest.mark.parametrize("then", ["write", "close"])
+def test_a_writer_its_thread_closed_as_it_failed_raises_that_failure(tmp_path, monkeypatch, then):
+    # an MP4's failed ffmpeg closes the writer from the thread before the failure is kept: a
+    # write or close in between must wait for it, not say "writer is closed" (or nothing)
+    import time
+
+    import deforma.render.video as video
+
+    started = threading.Event()
+
+    def fail(self, frame):
+        self._closed = True  # as Mp4Writer._failed does, in the writer's thread
+        started.set()
+        time.sleep(0.2)
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(video.PngFolderWriter, "_write", fail)
+    w = open_writer(tmp_path / "frames", fps=2)
+    w.write(np.zeros((16, 16, 3), np.uint8))
+    assert started.wait(5)
+    with pytest.raises(OSError) as e:
+        if then == "write":
+            w.write(np.zeros((16, 16, 3), np.uint8))
+        else:
+            w.close()
+    assert "no space left on the device" in str(e.value) and "\n" not in str(e.value)
+
+
 def test_an_interrupt_while_the_thread_works_discards_the_output(tmp_path, monkeypatch):
     import time
 

@@ -196,6 +196,11 @@ class FrameWriter:
     def _raise_failure(self) -> None:
         """Raise what the thread's encoding raised, as :meth:`write` raised it before threads:
         the output discarded, an OSError as one line naming the file."""
+        if self._failure is None and self._closed and self._thread is not None:
+            # closed by the writer's thread (an MP4's failed ffmpeg closes it as it fails): its
+            # failure is on its way; without the wait, a write in between said only "writer is
+            # closed" and a finish said nothing
+            self._join(drop=True)
         e = self._failure
         if e is None:
             return
