@@ -262,7 +262,7 @@ class World:
         dt = self.dt
         # how far each awake body may get this step: its fastest vertex, and gravity's pull
         # from rest, plus both sides' contact thickness
-        thick = np.array([b.contact_thickness for b in bodies])
+        thick = self._model.contact.body_thickness  # (the Model's: no median of edges each step)
         reach = fastest_vertex(self._state.v, offsets) * dt + math.hypot(*self._gravity) * dt * dt + thick
         lo_a, hi_a = lo[~asleep] - reach[~asleep, None], hi[~asleep] + reach[~asleep, None]
         moving = [c for c in self._colliders if c.moving]
