@@ -330,3 +330,114 @@ def test_run_that_cannot_step_at_its_dt_says_so_in_one_line_and_writes_nothing(t
                                f"need 3802 substeps"), lines[0]
     assert "lower dt to 0.0263 s or less" in lines[0] and lines[0].endswith("; nothing was written")
     assert os.listdir(tmp_path) == ["stiff.toml"]
+
+
+# a body too big to be useful: more than MAX_BODY_POINTS points is refused from the count, before
+# any triangulation (detail = 1000 meshed for 27 s, then took 29 s a step; resolution = 1 on a big
+# picture ran past 240 s with nothing shown)
+def _disc_picture(side):
+    """A white disc filling a black side x side picture: about 0.785 side**2 foreground pixels."""
+    y, x = np.mgrid[:side, :side]
+    return np.where((x - side / 2 + 0.5) ** 2 + (y - side / 2 + 0.5) ** 2 < (side / 2 - 2) ** 2, 255, 0).astype(np.uint8)
+
+
+def test_a_box_past_the_point_limit_is_refused_from_its_count_naming_the_detail_that_fits():
+    from deforma.checks import MAX_BODY_POINTS, MAX_DETAIL, box_point_count
+
+    corners = ((0, 0), (1, 0), (1, 1), (0, 1))
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError) as e:
+        deforma.mesh.box(corners, detail=1000)
+    assert time.perf_counter() - t0 < 1  # counted, not meshed
+    one_line(e.value)
+    assert str(e.value) == ("detail=1000 gives a box of 1004004 points (with edges), more than the 100000 one body "
+                            "may have (MAX_BODY_POINTS): give detail=314 or less")
+    with pytest.raises(ValueError, match=r"^detail=317 gives a box of 100493 points, .*: give detail=316 or less$"):
+        deforma.mesh.box(corners, detail=317, edges=False)
+    with pytest.raises(ValueError, match=r"^detail must be at most 314: .* got an integer of 401 digits$") as e:
+        deforma.mesh.box(corners, detail=10**400)
+    one_line(e.value)
+    # the details it names are the largest that fit, with edges and without
+    assert MAX_BODY_POINTS == 100_000 and MAX_DETAIL == 316
+    assert box_point_count(314, True) <= MAX_BODY_POINTS < box_point_count(315, True)
+    assert box_point_count(316, False) <= MAX_BODY_POINTS < box_point_count(317, False)
+    assert len(deforma.mesh.box(corners, detail=20).vertices) == box_point_count(20, True)
+    assert len(deforma.mesh.box(corners, detail=20, edges=False).vertices) == box_point_count(20, False)
+
+
+def test_a_picture_past_the_point_limit_is_refused_before_triangulating_naming_a_resolution_that_fits():
+    # 785,000 foreground pixels: under the old limit (a million points), meshed for minutes
+    from deforma.checks import MAX_BODY_POINTS
+
+    picture = _disc_picture(1000)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError) as e:
+        deforma.mesh.from_image(picture, resolution=1)
+    assert time.perf_counter() - t0 < 5  # read and counted, not triangulated
+    one_line(e.value)
+    m = re.fullmatch(r"the picture would give about (\d+) points with resolution=1 and edge_step=2; at most 100000 "
+                     r"\(MAX_BODY_POINTS, the most one body may have\) allowed: give resolution=(\d+) or more",
+                     str(e.value))
+    assert m, str(e.value)
+    assert int(m.group(1)) > 780_000
+    fits = int(m.group(2))
+    assert len(deforma.mesh.from_image(picture, resolution=fits).vertices) <= MAX_BODY_POINTS
+    with pytest.raises(ValueError, match=r"the picture would give about"):
+        deforma.mesh.from_image(picture, resolution=fits - 1)  # and it is the smallest that does
+    # max_points may lower the limit, not raise it
+    with pytest.raises(ValueError, match=r"^max_points must be an integer in \[3, 100000\], got 1000000$"):
+        deforma.mesh.from_image(picture, max_points=1_000_000)
+
+
+def test_an_outline_too_long_for_the_limit_names_the_edge_step_too():
+    # a grid of 1 px specks is no shape; 2 px wide stripes are: their outline alone passes half the limit
+    picture = np.zeros((1000, 1000), np.uint8)
+    picture[:, 2::5] = picture[:, 3::5] = 255
+    picture[:2], picture[-2:], picture[:, :2], picture[:, -2:] = 0, 0, 0, 0
+    with pytest.raises(ValueError, match=r"allowed: give edge_step=\d+ or more and resolution=\d+ or more$") as e:
+        deforma.mesh.from_image(picture, resolution=1, edge_step=1)
+    one_line(e.value)
+
+
+@pytest.mark.parametrize("body, names", [
+    ('shape = "box"\ndetail = 1000\n',
+     "body[0].detail: detail=1000 gives a box of 1004004 points (with edges), more than the 100000 one body may have "
+     "(MAX_BODY_POINTS): give detail=314 or less"),
+    ('shape = "image"\nsource = "disc.png"\nresolution = 1\n',
+     "body[0]: the picture would give about"),
+])
+def test_run_of_a_body_past_the_point_limit_is_one_line_before_anything_runs(tmp_path, body, names):
+    from PIL import Image
+
+    Image.fromarray(_disc_picture(1000)).save(tmp_path / "disc.png")
+    scene = tmp_path / "big.toml"
+    scene.write_text(f"[[body]]\n{body}[[collider]]\ncenter = [0.0, -6.0]\nsize = [20.0, 1.0]\n")
+    t0 = time.perf_counter()
+    rc, err, peak = _peak_of(["deforma", "run", scene, "--seconds", "0.1", "-o", tmp_path / "o.mp4",
+                              "--states", tmp_path / "s.npz"], tmp_path)
+    assert time.perf_counter() - t0 < 30
+    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith("deforma: compiling")]
+    assert rc == 1 and len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith("deforma: error: ") and f"big.toml: {names}" in lines[0], lines[0]
+    assert sorted(os.listdir(tmp_path)) == ["big.toml", "disc.png"]
+    assert peak < REFUSED_PEAK_MB, f"{peak:.0f} MB before refusing"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["box", "--detail", "1000"], "deforma: error: --detail=1000 gives a box of 1004004 points (with edges), more "
+                                  "than the 100000 one body may have (MAX_BODY_POINTS): give --detail=314 or less"),
+    (["disc.png", "--resolution", "1"], "deforma: error: the picture would give about"),
+])
+def test_mesh_of_a_body_past_the_point_limit_is_one_line_writing_nothing(tmp_path, capsys, args, message):
+    from PIL import Image
+
+    from deforma.cli import main
+
+    Image.fromarray(_disc_picture(1000)).save(tmp_path / "disc.png")
+    t0 = time.perf_counter()
+    code = main(["mesh", *[str(tmp_path / a) if a.endswith(".png") else a for a in args], "-o", str(tmp_path / "m.png")])
+    err = capsys.readouterr().err
+    assert time.perf_counter() - t0 < 5
+    assert code == 1 and len(err.splitlines()) == 1 and "Traceback" not in err, err
+    assert err.startswith(message), err
+    assert sorted(os.listdir(tmp_path)) == ["disc.png"]

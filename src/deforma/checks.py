@@ -49,10 +49,22 @@ MAX_LOAD = 1e12
 MAX_SUBSTEPS = 1000
 #: Smallest substep (s): dt / substeps below this is refused.
 MIN_SUBSTEP = 1e-7
-#: Largest box ``detail`` (mesh.box, scene files, ``deforma mesh --detail``): (detail + 2)**2
-#: points, about a million, is as far as a mass-spring body is still useful and stays well
-#: inside memory.
-MAX_DETAIL = 1000
+#: Most points one body's mesh may have: ``mesh.box``, ``mesh.from_image``, scene files,
+#: ``deforma run`` and ``deforma mesh`` refuse more, counted before any triangulation (a box's
+#: from its detail, a picture's from its foreground pixels per resolution**2 and its outline).
+#: Measured on the project's 2-core machine (shared), a box resting on a floor under avbd at the
+#: default dt = 1/60 s, kernels compiled; meshing, then a step:
+#:   2e4 points  0.3 s, 0.2-0.3 s       5e4  0.9 s, 0.5-0.8 s      1e5  1.6 s, 1.5-1.7 s
+#:   2.5e5       4.9 s, 4-6 s           5e5  7.2 s, 9-14 s         1e6  27 s,  29 s
+#: (a picture's 1.1e5 points: 4.4 s to mesh, 0.7-1.1 s a step). A step costs about linear time
+#: in the points, so 1e5 is where a scene's default 5 s (300 steps) still runs in minutes
+#: (about 8) and meshing in seconds (no progress bar needed); a million took over two hours for
+#: those 5 s and 29 s before the first frame, with nothing shown. The built-in scenes' bodies
+#: have at most 1346 points; 1e5 is far beyond what a step at 60 Hz carries.
+MAX_BODY_POINTS = 100_000
+#: Largest box ``detail`` whose points can fit in MAX_BODY_POINTS: detail**2 + 4 points without
+#: edges (316); with edges (the default) the box has (detail + 2)**2 points, so 314.
+MAX_DETAIL = math.isqrt(MAX_BODY_POINTS - 4)
 
 
 def number(value, name: str) -> float:
@@ -113,6 +125,36 @@ def pair(value, name: str, *, positive: bool = False, limit: float = MAX_COORDIN
     if np.any(np.abs(a) > limit):
         raise ValueError(f"{name} must lie within +-{limit:g}, got {value!r}")
     return float(a[0]), float(a[1])
+
+
+def box_point_count(detail: int, edges: bool) -> int:
+    """How many points ``mesh.box(corners, detail=detail, edges=edges)`` has, before it is built.
+
+    >>> box_point_count(8, True), box_point_count(8, False), box_point_count(0, True)
+    (100, 68, 4)
+    """
+    return (detail + 2) ** 2 if edges and detail > 0 else detail * detail + 4
+
+
+def check_box_points(detail: int, edges: bool, name: str = "detail") -> None:
+    """Refuse, in one line, a box whose points would pass ``MAX_BODY_POINTS``; ``name`` is how
+    the caller spells the option (``"detail"``, ``"--detail"``).
+
+    >>> check_box_points(1000, True)
+    Traceback (most recent call last):
+    ...
+    ValueError: detail=1000 gives a box of 1004004 points (with edges), more than the 100000 one body may have (MAX_BODY_POINTS): give detail=314 or less
+    """
+    count = box_point_count(detail, edges)
+    if count <= MAX_BODY_POINTS:
+        return
+    fit = math.isqrt(MAX_BODY_POINTS) - 2 if edges else MAX_DETAIL
+    if detail > 10**9:  # and str() of an integer past 4300 digits would fail
+        raise ValueError(f"{name} must be at most {fit}: a body may have {MAX_BODY_POINTS} points (MAX_BODY_POINTS), "
+                         f"got an integer of {digit_count(detail)} digits")
+    raise ValueError(f"{name}={detail} gives a box of {count} points"
+                     f"{' (with edges)' if edges else ''}, more than the {MAX_BODY_POINTS} one body may have "
+                     f"(MAX_BODY_POINTS): give {name}={fit} or less")
 
 
 def switch(value, name: str) -> bool:

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .checks import MAX_DETAIL, StepBeyondStableWarning
+from .checks import StepBeyondStableWarning, check_box_points
 
 __all__ = ["main"]
 
@@ -110,15 +110,15 @@ def _positive(kind, *, hi=None):
     return parse
 
 
-def _count(hi):
-    """An argparse type: a whole number in [0, hi]."""
+def _count(hi=None):
+    """An argparse type: a whole number in [0, hi] (>= 0 without ``hi``)."""
     def parse(text):
         try:
             v = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-        if not 0 <= v <= hi:
-            raise argparse.ArgumentTypeError(f"must be >= 0 and <= {hi}, got {text!r}")
+        if v < 0 or (hi is not None and v > hi):
+            raise argparse.ArgumentTypeError(f"must be >= 0{'' if hi is None else f' and <= {hi}'}, got {text!r}")
         return v
     return parse
 
@@ -163,7 +163,9 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--threshold", type=float, metavar="T",
                    help="image: how far from the background a pixel must be to be the shape, 0 <= T < 1 of full "
                         "scale in the channel that differs most (default 0.06; for alpha 0.5)")
-    m.add_argument("--detail", type=_count(MAX_DETAIL), default=8, help="box: n*n interior points (default 8)")
+    # its upper bound is the box's point count, refused in one line by cmd_mesh (checks.MAX_BODY_POINTS)
+    m.add_argument("--detail", type=_count(), default=8,
+                   help="box: n*n interior points (default 8; at most 100,000 points: 314 with edges)")
     m.add_argument("--edges", action=argparse.BooleanOptionalAction, default=True,
                    help="box: points on the sides too (default on, as in mesh.box and scene files; "
                         "--no-edges gives the original's thin side triangles)")
@@ -585,6 +587,7 @@ def cmd_mesh(a) -> int:
     _check_folder(a.output)
     t0 = time.perf_counter()
     if a.source == "box":
+        check_box_points(a.detail, a.edges, "--detail")  # named as typed, before anything is built
         m = meshes.box(((0, 0), (2, 0), (2, 1), (0, 1)), detail=a.detail, edges=a.edges)
         picture = None
         what = f"box, detail {a.detail}{', edges' if a.edges else ''}"

@@ -375,7 +375,7 @@ def test_no_foreground():
         ({"scale": float("inf")}, r"scale must be finite"),
         ({"detect_edges": "yes"}, "detect_edges must be True or False"),
         ({"threshold": 1.0}, r"threshold must be a number in \[0, 1\)"),
-        ({"max_points": 0}, r"max_points must be an integer >= 3"),
+        ({"max_points": 0}, r"max_points must be an integer in \[3, 100000\]"),
     ],
 )
 def test_bad_parameters(kwargs, match):

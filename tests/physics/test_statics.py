@@ -157,6 +157,30 @@ def test_the_time_budget_bounds_a_solve_and_progress_is_reported():
     assert all(p.tolerance == 1e-6 and p.moved > 0 for p in seen)
 
 
+def test_the_defaults_show_a_bar_on_a_terminal_and_bound_the_time(monkeypatch):
+    # solve_static() with its defaults ran past 60 s on crates, balloon, pile and playground with
+    # nothing shown: a bar on a terminal (tqdm, once a second has passed), and max_seconds = 60
+    import inspect
+    import io
+    import sys
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    w, b = box_on_floor(force=(0.05, 0.0))
+    assert inspect.signature(w.solve_static).parameters["max_seconds"].default == 60.0
+    screen = Terminal()
+    monkeypatch.setattr(sys, "stderr", screen)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"^solve_static stopped getting closer after 200 relaxation steps") as e:
+        w.solve_static()
+    assert "\n" not in str(e.value)
+    if time.perf_counter() - t0 > 1.5:  # the bar waits a second before it shows (8.9 s here)
+        assert re.search(r"solve_static: +\d+%.*\d+/1000 .*step", screen.getvalue()), screen.getvalue()[-300:]
+        assert screen.getvalue().endswith("\r")  # and is cleared when the solve ends (leave=False)
+
+
 def test_an_exception_from_progress_stops_the_solve_and_puts_the_world_back():
     w, b = box_on_floor(force=(0.05, 0.0))
     before = b.positions.copy()

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..checks import MAX_COORDINATE, MAX_DETAIL
+from ..checks import MAX_COORDINATE, MAX_DETAIL, check_box_points  # noqa: F401  (MAX_DETAIL: public here too)
 from .delaunay import delaunay
 from .mesh import Mesh
 
@@ -25,8 +25,10 @@ def box(corners: ArrayLike, *, detail: int = 8, edges: bool = True) -> Mesh:
         corners on a line) raises ``ValueError``.
     detail : int, keyword-only
         ``n``: ``n * n`` interior points at the bilinear positions ``(i/(n+1), j/(n+1))``,
-        ``i, j = 1..n``, between the corners. 0 gives the bare quad (two triangles).
-        Allowed range ``[0, MAX_DETAIL]``.
+        ``i, j = 1..n``, between the corners. 0 gives the bare quad (two triangles). At
+        least 0, and at most what keeps the box within ``checks.MAX_BODY_POINTS``
+        (100,000) points: 314 with edges, ``MAX_DETAIL`` (316) without; more is refused
+        from the count before anything is built (a step of a million points took 29 s).
     edges : bool, keyword-only
         Also put ``n`` points on each of the four sides at the same parameters, so the points
         form a full ``(n+2) x (n+2)`` grid and the triangles along the sides are as good as
@@ -60,6 +62,7 @@ def box(corners: ArrayLike, *, detail: int = 8, edges: bool = True) -> Mesh:
     n = _check_detail(detail)
     if not isinstance(edges, (bool, np.bool_)):
         raise ValueError(f"edges must be True or False, got {edges!r}")
+    check_box_points(n, bool(edges))  # from the count, before a point is made
 
     a, b, cc, d = c
     s = np.arange(1, n + 1, dtype=np.float64) / (n + 1)
@@ -193,12 +196,13 @@ def _check_corners(corners) -> np.ndarray:
 
 
 def _check_detail(detail) -> int:
+    """An integer >= 0; its upper bound is the box's point count (``check_box_points``)."""
     if isinstance(detail, (bool, np.bool_)):
-        raise ValueError(f"detail must be an integer in [0, {MAX_DETAIL}], got {detail!r}")
+        raise ValueError(f"detail must be an integer >= 0, got {detail!r}")
     try:
         n = operator.index(detail)
     except TypeError:
-        raise ValueError(f"detail must be an integer in [0, {MAX_DETAIL}], got {detail!r}") from None
-    if not 0 <= n <= MAX_DETAIL:
-        raise ValueError(f"detail must be an integer in [0, {MAX_DETAIL}], got {n}")
+        raise ValueError(f"detail must be an integer >= 0, got {detail!r}") from None
+    if n < 0:
+        raise ValueError(f"detail must be an integer >= 0, got {n}")
     return n

@@ -64,7 +64,7 @@ from numba import njit
 from numpy.typing import ArrayLike
 from PIL import Image, UnidentifiedImageError
 
-from ..checks import positive
+from ..checks import MAX_BODY_POINTS, positive
 from . import quality
 from .delaunay import delaunay
 from .mesh import Mesh, split_pinches
@@ -104,9 +104,10 @@ BUILTIN_TEXTURES = tuple(builtin_textures())
 #: Largest picture accepted, in pixels (about 6300 x 6300): the per-pixel arrays of a
 #: larger one take gigabytes before a single point is made.
 MAX_PIXELS = 40_000_000
-#: Default cap on the number of mesh points: beyond it triangulation and the soft body
-#: need more memory and time than an interactive simulation can use.
-DEFAULT_MAX_POINTS = 1_000_000
+#: Default cap on the number of mesh points: the most one body may have
+#: (``deforma.checks.MAX_BODY_POINTS``, where the measurements behind it are), also the
+#: largest ``max_points`` accepted.
+DEFAULT_MAX_POINTS = MAX_BODY_POINTS
 #: Rounds of outline recovery (split missing segments, triangulate again).
 RECOVERY_ROUNDS = 8
 
@@ -171,8 +172,11 @@ def from_image(
         0.06, about 15 of 255). With transparency: the alpha level above which a pixel is
         foreground (default ``ALPHA_THRESHOLD`` = 0.5).
     max_points : int, keyword-only
-        Refuse pictures that would give more mesh points than this (they would exhaust
-        memory or take minutes); raise ``resolution`` and ``edge_step`` instead.
+        Refuse pictures that would give more mesh points than this, counted from the
+        foreground pixels on the ``resolution`` grid and the outline's length before any
+        triangulation; the message names the ``resolution`` (and, where the outline alone
+        is too long, the ``edge_step``) that fits. In [3, ``MAX_BODY_POINTS``] (100,000,
+        the default: the most one body may have; a step of a million points took 29 s).
 
     Returns
     -------
@@ -186,7 +190,8 @@ def from_image(
         On a missing or unreadable file, a picture larger than ``MAX_PIXELS``, an unknown
         or malformed ``background``, ``threshold`` outside [0, 1), a border with no main
         colour for ``"auto"``, no foreground or nothing but foreground (the picture is not
-        on that background), a parameter out of range, or more points than ``max_points``.
+        on that background), a parameter out of range, or more points than ``max_points``
+        (at most ``MAX_BODY_POINTS``).
 
     Examples
     --------
@@ -207,7 +212,7 @@ def from_image(
     """
     r = _check_int("resolution", resolution, 1)
     e = _check_int("edge_step", edge_step, 1)
-    limit = _check_int("max_points", max_points, 3)
+    limit = _check_int("max_points", max_points, 3, MAX_BODY_POINTS)
     if not isinstance(detect_edges, (bool, np.bool_)):
         raise ValueError(f"detect_edges must be True or False, got {detect_edges!r}")
     scale = positive(scale, "scale", "m per pixel")
@@ -223,12 +228,12 @@ def from_image(
     grid[off::r, off::r] = True
     grid &= mask
     n_grid = int(grid.sum())
-    n_outline = _boundary_pixel_count(mask) // e if detect_edges else 0
-    if n_grid + n_outline > limit:
-        raise ValueError(
-            f"the picture would give about {n_grid + n_outline} points with resolution={r} and "
-            f"edge_step={e}; at most max_points={limit} allowed (raise resolution or edge_step)"
-        )
+    n_border = _boundary_pixel_count(mask) if detect_edges else 0
+    if n_grid + n_border // e > limit:
+        allowed = (f"max_points={limit}" if limit < MAX_BODY_POINTS else
+                   f"{limit} (MAX_BODY_POINTS, the most one body may have)")
+        raise ValueError(f"the picture would give about {n_grid + n_border // e} points with resolution={r} and "
+                         f"edge_step={e}; at most {allowed} allowed: {_what_fits(mask, r, e, n_border, limit)}")
 
     if detect_edges:
         if by_alpha:
@@ -1155,13 +1160,35 @@ def _peel(points, tris, outline_edges, keep_all=False):
     return tris
 
 
-def _check_int(name, value, low):
+def _what_fits(mask, r, e, n_border, limit):
+    """Say the smallest ``resolution`` (and, if the outline alone passes half the limit, the
+    ``edge_step``) whose points fit in ``limit``: grid points at resolution q are counted on
+    the mask as from_image samples it (about foreground / q**2), outline points n_border / e."""
+    hint = ""
+    if n_border // e > limit // 2:
+        e = -(-n_border // (limit // 2))  # ceil: the outline in half the points
+        hint = f"edge_step={e} or more and "
+    room = limit - n_border // e
+
+    def fits(q):
+        return int(mask[q // 2::q, q // 2::q].sum()) <= room
+
+    q = max(r + 1, int(np.sqrt(mask.sum() / max(room, 1))))
+    while not fits(q):
+        q += 1
+    while q - 1 > r and fits(q - 1):
+        q -= 1
+    return f"give {hint}resolution={q} or more"
+
+
+def _check_int(name, value, low, high=None):
+    allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
     if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+        raise ValueError(f"{name} must be an integer {allowed}, got {value!r}")
     try:
         v = operator.index(value)
     except TypeError:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}") from None
-    if v < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {v}")
+        raise ValueError(f"{name} must be an integer {allowed}, got {value!r}") from None
+    if v < low or (high is not None and v > high):
+        raise ValueError(f"{name} must be an integer {allowed}, got {v}")
     return v

@@ -53,7 +53,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 # an image body's background: the rule of deforma.mesh.from_image itself
-from ..checks import LIMITS, MAX_COORDINATE, digit_count
+from ..checks import LIMITS, MAX_COORDINATE, check_box_points, digit_count
 from ..mesh.image import check_background
 from .assets import picture_reference, resolve_picture, resolve_texture, texture_reference
 from .construct import build
@@ -328,6 +328,11 @@ def _kind(data, path, kinds: dict, default: str):
 def _body(data, path, ctx):
     _, cls = _kind(data, path, BODY_KINDS, "box")
     body = _table(cls, data, path, ctx)
+    if isinstance(body, BoxBody):
+        try:  # the box's point count, from detail and edges, before anything is built
+            check_box_points(body.detail, body.edges)
+        except ValueError as e:
+            raise _Problem(f"{path}.detail", str(e)) from None
     if isinstance(body, MeshBody):
         n = len(body.vertices)
         if n == 0 or not body.triangles:

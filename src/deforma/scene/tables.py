@@ -36,8 +36,6 @@ from __future__ import annotations
 from dataclasses import MISSING, dataclass, field
 from typing import Any
 
-from ..checks import MAX_DETAIL
-
 # an image body's background: the names of deforma.mesh.from_image itself
 from ..mesh.image import BACKGROUND_NAMES
 from ..physics.material import MODELS, PLANES, PRESETS, material_models
@@ -298,7 +296,9 @@ class BoxBody(BodyPhysics):
     shape: str = spec("str", "box", choices=("box", "image", "mesh"), doc="Which kind of body.")
     corners: tuple = spec("quad", ((-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)), unit="m",
                           doc="Four corners in order around a convex quadrilateral.")
-    detail: int = spec("int", 8, lo=0, hi=MAX_DETAIL, doc="n: n*n points inside, spread evenly.")
+    # at most what keeps the box within checks.MAX_BODY_POINTS points, checked with edges (schema._body)
+    detail: int = spec("int", 8, lo=0, doc="n: n*n points inside, spread evenly; the box at most 100,000 points "
+                                           "(314 with edges, 316 without).")
     edges: bool = spec("bool", True, doc="Also put n points on each side (on by default, as in mesh.box: "
                                          "without them the triangles along the sides are thin).")
     position: tuple | None = spec("vec2", None, unit="m", doc=_BODY_COMMON_DOC["position"])
@@ -312,7 +312,9 @@ class ImageBody(BodyPhysics):
 
     shape: str = spec("str", "image", choices=("box", "image", "mesh"), doc="Which kind of body.")
     source: str = spec("file", "bunny", doc="Built-in texture name (bunny, donut, armadillo) or an image path.")
-    resolution: int = spec("int", 4, lo=1, hi=10000, unit="px", doc="Sample every n-th pixel; smaller gives more points.")
+    resolution: int = spec("int", 4, lo=1, hi=10000, unit="px",
+                           doc="Sample every n-th pixel; smaller gives more points (at most 100,000, counted when "
+                               "the picture is read: the message names the resolution that fits).")
     detect_edges: bool = spec("bool", True, doc="Add points along the outline so the mesh follows the picture.")
     edge_step: int = spec("int", 2, lo=1, hi=10000, unit="px", doc="Take every n-th outline pixel.")
     scale: float = spec("float", 0.01, lo=0.0, lo_open=True, unit="m/px", doc="Metres per pixel.")
