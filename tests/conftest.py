@@ -1,7 +1,14 @@
 """Fixtures shared by the test packages."""
 
+import os
+
 import numpy as np
 import pytest
+
+# No background warm-up from the tests' runs (tests/test_warmup.py turns it on where it is
+# tested): a test that fakes a cold cache in a temporary folder would start one compiling
+# every kernel into that folder, and wait minutes for it; subprocesses inherit this.
+os.environ.setdefault("DEFORMA_WARMUP", "0")
 
 
 @pytest.fixture(scope="module")

@@ -173,6 +173,9 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("-o", "--output", required=True, metavar="OUT.png", help="the picture to write")
 
     sub.add_parser("scenes", help="list the built-in scenes and textures")
+    sub.add_parser("warmup", help="compile every built-in scene's kernels now (a first run does it in the background)",
+                   description="Compile the physics kernels of every built-in scene, as the first run that "
+                               "compiles does in a second process: for an image or a CI cache built ahead.")
 
     v = sub.add_parser("view", help="open a window: watch, pull, blow up and edit a scene live",
                        description="The interactive viewer: a window with the inspector panel, mouse pull (left "
@@ -236,13 +239,13 @@ def _check_folder(path) -> None:
         raise CliError(str(e)) from None
 
 
-def _progress(total: int, enabled: bool, label: str):
+def _progress(total: int, enabled: bool, label: str, unit: str = "frame"):
     try:
         from tqdm import tqdm
     except ImportError:  # pragma: no cover - tqdm is a dependency; degrade to no bar
         return None
     # disable=None: tqdm draws only on a terminal, never into logs or pipes
-    return tqdm(total=total, unit="frame", desc=label, disable=None if enabled else True, leave=False,
+    return tqdm(total=total, unit=unit, desc=label, disable=None if enabled else True, leave=False,
                 dynamic_ncols=True)
 
 
@@ -349,8 +352,24 @@ def cmd_run(a) -> int:
         else:
             warn(COMPILE_MESSAGE)
 
-    with CompileWatch(on_first=say_compiling) as watch:
-        return _run_scene(a, watch, shown)
+    background = []
+
+    def first_compile():
+        say_compiling()
+        # the other scenes' kernels in a second process, on the core the compiler leaves idle
+        from .scene.assets import builtin_scenes
+        from .warmup import start_background
+
+        job = start_background(a.scene if a.scene in builtin_scenes() else None)
+        if job is not None:
+            background.append(job)
+
+    try:
+        with CompileWatch(on_first=first_compile) as watch:
+            return _run_scene(a, watch, shown)
+    finally:
+        for job in background:
+            job.wait(warn)
 
 
 def _run_scene(a, watch, shown: dict) -> int:
@@ -633,6 +652,30 @@ def cmd_scenes(a) -> int:
     return 0
 
 
+def cmd_warmup(a) -> int:
+    from .startup import CompileWatch
+    from .warmup import warm_up
+
+    on_terminal = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    from .scene.assets import builtin_scenes
+
+    bar = _progress(len(builtin_scenes()), on_terminal, "warm-up", "scene") if on_terminal else None
+
+    def progress(name: str) -> None:
+        if bar is not None:
+            bar.set_postfix_str(name)
+            bar.update(1)
+
+    with CompileWatch() as watch:
+        seconds = warm_up(progress=progress)
+    if bar is not None:
+        bar.close()
+    print(f"warm-up: {len(builtin_scenes())} built-in scenes in {seconds:.1f} s "
+          + (f"({watch.seconds:.1f} s compiling {watch.compiled} kernels)" if watch.compiled
+             else "(every kernel was already compiled)"))
+    return 0
+
+
 # -- sweep --------------------------------------------------------------------------------------------
 def cmd_sweep(a) -> int:
     from . import sweeps
@@ -706,7 +749,8 @@ def main(argv=None) -> int:
     parser = _parser()
     a = parser.parse_args(argv)
     a.started = started
-    commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view, "sweep": cmd_sweep}
+    commands = {"run": cmd_run, "mesh": cmd_mesh, "scenes": cmd_scenes, "view": cmd_view, "sweep": cmd_sweep,
+                "warmup": cmd_warmup}
     restore_signals = _stop_on_signals()
     with warnings.catch_warnings():  # put back as they were when the command returns
         # a warning of the physics (an unconverged solve) once per command, whatever came

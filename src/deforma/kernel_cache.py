@@ -24,7 +24,7 @@ import os
 import shutil
 from pathlib import Path
 
-__all__ = ["KEEP", "cache_home", "source_key", "use_source_keyed_cache"]
+__all__ = ["KEEP", "cache_home", "kernel_folder", "source_key", "use_source_keyed_cache"]
 
 KEEP = 3  # kernel folders kept: the current one and the most recently used others
 
@@ -91,3 +91,12 @@ def _forget_old(base: Path, current: Path) -> None:
         return
     for old in others[KEEP - 1:]:
         shutil.rmtree(old, ignore_errors=True)  # another process may be using it: best effort
+
+
+def kernel_folder() -> Path | None:
+    """The folder Numba caches this process's compiled kernels in (this module's, or the
+    user's ``NUMBA_CACHE_DIR``), or None where Numba keeps them beside the sources."""
+    import numba
+
+    folder = numba.config.CACHE_DIR
+    return Path(folder) if folder else None

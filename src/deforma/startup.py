@@ -19,8 +19,8 @@ from typing import Callable
 __all__ = ["CompileWatch", "is_cached_kernel", "seconds_since_process_start"]
 
 #: What ``deforma run`` says on stderr when the first kernel starts compiling.
-COMPILE_MESSAGE = ("deforma: compiling the physics kernels (once per install or upgrade: 20 s to 2 minutes, "
-                   "see docs/benchmarks.md#start-up; later runs load them from the cache)...")
+COMPILE_MESSAGE = ("deforma: compiling the physics kernels (once per install or upgrade: 1 to 4 minutes on 2 "
+                   "cores, see docs/benchmarks.md#start-up; later runs load them from the cache)...")
 
 _IMPORTED = time.perf_counter()
 

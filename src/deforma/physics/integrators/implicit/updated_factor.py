@@ -494,7 +494,9 @@ class UpdatedFactor:
                 used.update(int(t) for t in self._slots)
             free = [t for t in range(self._store.shape[1]) if t not in used]
             if len(free) < len(missing):  # grow the store (to 2 max_rank + 16 columns: older ones are dropped)
-                cap = max(len(used) + len(missing), min(2 * self._store.shape[1], 2 * self.max_rank + 16))
+                # (at least 2 columns: a one-column array is C-contiguous too, and the kernels
+                # compiled a second time for it, 1.6 s into a run of `crates`)
+                cap = max(2, len(used) + len(missing), min(2 * self._store.shape[1], 2 * self.max_rank + 16))
                 grown = np.empty((self._n0, cap), order="F")
                 grown[:, :self._store.shape[1]] = self._store
                 free += list(range(self._store.shape[1], cap))
