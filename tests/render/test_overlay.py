@@ -1,4 +1,5 @@
-"""The time/scale overlay: where it draws, how long the bar is, and that it is off unless asked."""
+"""The time/scale overlay: where it draws, how long the bar is, that it is off unless asked, and
+that the world is framed between its text so that the text covers nothing the scene shows."""
 
 import numpy as np
 import pytest
@@ -7,7 +8,7 @@ from PIL import Image
 import deforma
 from deforma.cli import main
 from deforma.render import Renderer, WorldView
-from deforma.render.overlay import draw_overlay, format_length, scale_bar_length
+from deforma.render.overlay import draw_overlay, format_length, overlay_insets, scale_bar_length
 
 BACKGROUND = (200, 210, 220)
 
@@ -76,21 +77,47 @@ def test_bad_input_is_one_clear_error(kwargs, message):
         draw_overlay(frame, **args)
 
 
-def test_world_view_overlay_is_off_by_default_and_only_touches_the_corners(gl_ctx):
+def in_bands(diff):
+    """The overlay's pixels lie in its top and bottom rows, in the picture's left half."""
+    h, w = diff.shape
+    top, bottom = overlay_insets(h)
+    return (diff[:top, : w // 2].any() and diff[h - bottom :, : w // 2].any()
+            and not diff[top : h - bottom].any() and not diff[:, w // 2 :].any())
+
+
+def test_world_view_overlay_is_off_by_default_and_only_writes_in_its_bands(gl_ctx):
     world = deforma.load_scene("sample")
     view = WorldView(Renderer(gl_ctx, (320, 180), samples=0), world)
     try:
         plain = view.draw()
         view.overlay = True
         marked = view.draw()
+        framed = view.renderer.read()              # the same frame without the text
         view.overlay = False
         again = view.draw()
     finally:
         view.renderer.release()
     assert np.array_equal(plain, again)            # off: the frame is exactly the renderer's
-    diff = changed(plain, marked)
-    assert diff[:36, :160].any() and diff[-36:, :160].any()
-    assert not diff[36:-36].any() and not diff[:, 160:].any()
+    assert in_bands(changed(framed, marked))
+
+
+@pytest.mark.parametrize("size", [(320, 180), (1280, 720), (400, 400)])
+@pytest.mark.parametrize("name", ["explode", "demo", "dent", "balloon", "pile", "jelly", "car"])
+def test_the_overlay_covers_no_collider_or_body(gl_ctx, name, size):
+    # issue 50: the scale bar's label lay over the floor of explode, demo, dent and balloon
+    view = WorldView(Renderer(gl_ctx, size, samples=0), deforma.load_scene(name), overlay=True)
+    r = view.renderer
+    try:
+        marked = view.draw()
+        framed = r.read()                          # the frame the text was written onto
+        r.render()                                 # the same camera with nothing in the world
+        empty = r.read()
+    finally:
+        r.release()
+    text = changed(framed, marked)
+    assert in_bands(text)
+    covered = changed(framed, empty) & text
+    assert not covered.any(), f"{name} {size}: the overlay covers {covered.sum()} pixels of the scene"
 
 
 def read_frames(folder):
@@ -110,20 +137,25 @@ def test_deforma_run_overlay_flag(tmp_path, capsys):
         assert np.array_equal(plain[0], view.draw())
     finally:
         view.renderer.release()
-    for p, m in zip(plain, marked):
-        diff = changed(p, m)
-        assert diff[:36, :160].any() and diff[-36:, :160].any()
-        assert not diff[36:-36].any() and not diff[:, 160:].any()
-    # the frames' clocks differ (0.00 s, 0.05 s), and nothing else is drawn in that corner
-    assert changed(marked[0][:36, :160], marked[1][:36, :160]).any()
+    # with it the first frame is the scene framed between the text, and the text
+    view = WorldView(Renderer.headless((320, 180), samples=0), deforma.load_scene("sample"), overlay=True)
+    try:
+        assert np.array_equal(marked[0], view.draw())
+        assert in_bands(changed(view.renderer.read(), marked[0]))
+    finally:
+        view.renderer.release()
+    # the frames' clocks differ (0.00 s, 0.05 s)
+    top = overlay_insets(180)[0]
+    assert changed(marked[0][:top, :160], marked[1][:top, :160]).any()
 
 
 def test_show_overlay_marks_the_frames():
     kwargs = {"seconds": 0.1, "fps": 10, "size": (320, 180), "format": "gif"}
     plain = deforma.show("sample", **kwargs).last_frame
     marked = deforma.show("sample", overlay=True, **kwargs).last_frame
-    diff = changed(plain, marked)
-    assert diff[:36, :160].any() and diff[-36:, :160].any() and not diff[36:-36].any()
+    top, bottom = overlay_insets(180)
+    diff = changed(plain, marked)  # framed between the text, so the whole picture moved a little
+    assert diff[:top, :160].any() and diff[-bottom:, :160].any()
 
 
 def test_a_camera_that_follows_a_body_keeps_its_centre_of_mass_in_the_middle():

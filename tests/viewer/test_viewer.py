@@ -525,15 +525,22 @@ def test_a_torn_body_keeps_drawing_and_stays_grabbable(viewer):
     viewer.panel_visible = True
     pygame.event.clear()
     run(viewer, 1)
-    b = body(viewer)
-    n0 = b.n_vertices
-    x = b.positions
-    press = vertex_pixel_of(viewer, x[np.argmin(np.linalg.norm(x - (0.0, 0.85), axis=1))])
-    post(pygame.MOUSEBUTTONDOWN, pos=press, button=1)
-    run(viewer, 1)
-    assert viewer.grab is not None
-    for k in range(240):  # pull the bottom edge down until the sheet tears
-        post(pygame.MOUSEMOTION, pos=(press[0], press[1] + min(300, 5 * k)), rel=(0, 5), buttons=(1, 0, 0))
+    n0 = body(viewer).n_vertices
+    # pull the bottom edge down until the sheet tears; how far one pull's crack runs depends on
+    # its details, down to which triangle the pointer's pixel lands on (moving the framing by a
+    # pixel gave 12 new vertices or 6), so, as a person would, pull again beside it while short
+    for target in ((0.0, 0.85), (-0.05, 0.85), (0.05, 0.85)):
+        x = body(viewer).positions
+        press = vertex_pixel_of(viewer, x[np.argmin(np.linalg.norm(x - target, axis=1))])
+        post(pygame.MOUSEBUTTONDOWN, pos=press, button=1)
+        run(viewer, 1)
+        assert viewer.grab is not None
+        for k in range(240):
+            post(pygame.MOUSEMOTION, pos=(press[0], press[1] + min(300, 5 * k)), rel=(0, 5), buttons=(1, 0, 0))
+            run(viewer, 1)
+            if body(viewer).n_vertices > n0 + 10:
+                break
+        post(pygame.MOUSEBUTTONUP, pos=press, button=1)
         run(viewer, 1)
         if body(viewer).n_vertices > n0 + 10:
             break
@@ -541,7 +548,6 @@ def test_a_torn_body_keeps_drawing_and_stays_grabbable(viewer):
     # torn: whether the crack also runs right across (two pieces) depends on the pull's
     # details; a crack that stops short leaves one piece with a slit, drawn just the same
     assert b.n_vertices > n0 + 10, "the sheet did not tear"
-    post(pygame.MOUSEBUTTONUP, pos=press, button=1)
     run(viewer, 10)
     assert viewer.unstable is None and np.isfinite(b.positions).all()
     assert viewer.view._topologies[0] is b.topology  # the view follows the new mesh
@@ -616,7 +622,10 @@ def test_the_car_scene_camera_follows_the_chassis_until_panned(demo):
     pygame.event.clear()
     run(demo, 90)
     chassis = demo.session.world.bodies[0]
-    np.testing.assert_allclose(demo.renderer.camera.center, chassis.center_of_mass, atol=0.05)  # a frame behind
+    # in the middle of the area the panel and the status line leave, a frame behind
+    left, top, right, bottom = demo.free_rect()
+    np.testing.assert_allclose(demo.to_pixel(chassis.center_of_mass), ((left + right) / 2, (top + bottom) / 2),
+                               atol=0.05 / demo._metres_per_pixel())
     post(pygame.MOUSEBUTTONDOWN, pos=(400, 300), button=3)
     post(pygame.MOUSEMOTION, pos=(500, 300), rel=(100, 0), buttons=(0, 0, 1))
     post(pygame.MOUSEBUTTONUP, pos=(500, 300), button=3)

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-__all__ = ["draw_overlay", "scale_bar_length", "format_length"]
+__all__ = ["draw_overlay", "format_length", "overlay_insets", "scale_bar_length"]
 
 TEXT_COLOR = (25, 28, 34)
 OUTLINE_COLOR = (255, 255, 255)
@@ -78,6 +78,44 @@ def format_length(metres: float) -> str:
     return f"{metres * 1e6:.12g} µm"
 
 
+def _metrics(h: int) -> tuple[int, int, int, int, int]:
+    """Text size, margin, outline, bar thickness and tick height (pixels) for a picture ``h`` high:
+    everything follows the picture's height, so a thumbnail and a 4K frame look alike."""
+    size = max(9, round(h / 30))
+    return size, max(3, size // 2), max(1, size // 10), max(2, size // 8), max(3, size // 3)
+
+
+#: Every character a label can hold (the time's and the scale bar's), for the rows they can reach.
+_LABEL_CHARS = "t = -0123456789.s kmcµ"
+
+
+def overlay_insets(height: int) -> tuple[int, int]:
+    """Rows ``(top, bottom)`` of a picture ``height`` pixels high that the overlay's text may use.
+
+    The time's label lies in the top rows, the scale bar and its label in the bottom rows, each
+    with a gap of half a margin toward the picture. :class:`deforma.render.WorldView` frames the
+    world between them (:func:`deforma.render.framing.fit_camera`) when its overlay is on, so the
+    overlay never covers what the scene shows at its start.
+
+    Examples
+    --------
+    >>> overlay_insets(720)
+    (45, 39)
+    """
+    from PIL import Image, ImageDraw
+
+    size, margin, stroke, thick, tick = _metrics(int(height))
+    font = _font(size)
+    probe = ImageDraw.Draw(Image.new("RGB", (1, 1)))
+    box = probe.textbbox((0, 0), _LABEL_CHARS, font=font, stroke_width=stroke)
+    t, b = math.floor(box[1]), math.ceil(box[3])
+    gap = max(2, margin // 2)
+    top = margin + b + 1 + gap                               # the time: drawn at (margin, margin)
+    bar = margin + thick + tick + stroke                     # the bar's ticks and outline
+    label = margin + b - t                                   # its label ends level with the bar
+    return top, max(bar, label) + gap
+
+
 def draw_overlay(frame, *, time: float, metres_per_pixel: float) -> np.ndarray:
     """Write the simulated time (top left) and a scale bar (bottom left) onto a frame, in place.
 
@@ -121,11 +159,8 @@ def draw_overlay(frame, *, time: float, metres_per_pixel: float) -> np.ndarray:
     if not (math.isfinite(metres_per_pixel) and metres_per_pixel > 0):
         raise ValueError(f"metres_per_pixel must be a finite number > 0, got {metres_per_pixel!r}")
     h, w = frame.shape[:2]
-    # everything follows the picture's height, so a thumbnail and a 4K frame look alike
-    size = max(9, round(h / 30))
+    size, margin, stroke, thick, tick = _metrics(h)
     font = _font(size)
-    margin = max(3, size // 2)
-    stroke = max(1, size // 10)
 
     def region(x0, y0, x1, y1, paint):
         # draw only into the corner's pixels: converting a whole frame costs more than the text
@@ -146,8 +181,6 @@ def draw_overlay(frame, *, time: float, metres_per_pixel: float) -> np.ndarray:
     length = scale_bar_length(metres_per_pixel, w)
     bar_px = max(1, round(length / metres_per_pixel))
     text = format_length(length)
-    tick = max(3, size // 3)
-    thick = max(2, size // 8)
     bar_y = h - margin - thick  # the bar's top row
     l, t, r, b = probe.textbbox((0, 0), text, font=font, stroke_width=stroke)
     text_x = margin + bar_px + margin // 2

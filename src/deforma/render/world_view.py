@@ -41,7 +41,10 @@ class WorldView:
     overlay : bool, optional
         Write the simulated time and a scale bar onto every picture :meth:`draw` reads
         (see :func:`deforma.render.overlay.draw_overlay`). Default off; the ``overlay``
-        attribute turns it on or off later.
+        attribute turns it on or off later. While it is on, the world is framed between the
+        rows the text uses (:func:`deforma.render.overlay.overlay_insets`): the camera's
+        rectangle, grown to the height of every collider and body at the start, fits in the
+        band between the time and the scale bar, so the text covers none of them.
     looks_from : deforma.World, optional
         The world whose scene gives the bodies' and colliders' looks (colours, textures), body
         by body and collider by collider, when ``world`` is a copy of it
@@ -72,6 +75,11 @@ class WorldView:
         self.scene = scene if scene is not None else scene_of(self._looks())
         cam = self.scene.camera
         renderer.camera = Camera(cam.center, cam.size)
+        # the camera asked for (the scene's, or one set on the renderer since); what the
+        # renderer shows may differ from it by the overlay's framing (see _place_camera)
+        self._wanted: Camera = renderer.camera
+        self._placed: Camera = renderer.camera
+        self._content_height: tuple[float, float] | None = None
         renderer.background_top = _as_rgba(cam.background[0])[:3]
         renderer.background_bottom = _as_rgba(cam.background[1])[:3]
         self.wireframe = cam.wireframe
@@ -161,9 +169,7 @@ class WorldView:
                 or len(self.world.colliders) != self._n_colliders:
             self.sync()
         r = self.renderer
-        if self.follow is not None and any(b is self.follow for b in bodies):
-            r.camera = Camera(tuple(map(float, self.follow.center_of_mass)),  # type: ignore[arg-type]  # (x, y)
-                              r.camera.size)
+        self._place_camera()
         r.render([(h, b.positions, self.dim_sleeping and b.sleeping) for h, b in zip(self._handles, self._bodies)],
                  self.world.colliders,
                  wireframe=self.wireframe, collider_colors=self.collider_colors)
@@ -174,6 +180,37 @@ class WorldView:
         if self.overlay:
             self.overlay_onto(frame, time=self.world.time)
         return frame
+
+    def _place_camera(self) -> None:
+        """Set the renderer's camera for this frame: the one wanted, on the followed body, and
+        with the overlay on, framed between the overlay's rows."""
+        from .framing import camera_box, fit_camera
+        from .overlay import overlay_insets
+
+        r = self.renderer
+        if r.camera is not self._placed:  # set by the caller since: that is the camera wanted now
+            self._wanted = r.camera
+        cam = self._wanted
+        if self.follow is not None and any(b is self.follow for b in self.world.bodies):
+            cam = Camera(tuple(map(float, self.follow.center_of_mass)), cam.size)  # type: ignore[arg-type]  # (x, y)
+        if self.overlay:
+            if self._content_height is None:  # the scene's extent at the start, kept: no zooming along
+                self._content_height = self._height()
+            x0, y0, x1, y1 = camera_box(cam.center, cam.size)
+            lo, hi = self._content_height
+            top, bottom = overlay_insets(r.size[1])
+            cam = fit_camera((x0, min(y0, lo), x1, max(y1, hi)), r.size, insets=(0, top, 0, bottom))
+        r.camera = self._placed = cam
+
+    def _height(self) -> tuple[float, float]:
+        """Lowest and highest point of every collider and body now (m); only the height matters:
+        what lies beyond the picture's sides is not drawn, so no text can cover it."""
+        from .framing import content_bounds
+
+        box = content_bounds(self.world)
+        if box is None:
+            return (np.inf, -np.inf)
+        return (box[1], box[3])
 
     def overlay_onto(self, frame: np.ndarray, *, time: float, metres_per_pixel: float | None = None) -> None:
         """Write the time and scale overlay onto ``frame`` (a picture this view drew, read back

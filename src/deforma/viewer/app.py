@@ -58,6 +58,11 @@ HEADLESS_FRAME_TIME = 1 / 60
 #: keeps the window responsive when a setting makes the physics slower than real time.
 PHYSICS_BUDGET = 0.05
 STATUS_INTERVAL = 0.25   # seconds between status line updates
+#: Pixels between the status line and the window's left and bottom edges.
+STATUS_MARGIN = 10
+#: Pixels kept free between the framed world and the edges of the area it is framed in, so
+#: that no collider or body touches an edge or the status line.
+FRAME_PAD = 8
 GREETING = "Left-drag the body to pull it, Space blows it up, H lists every key."
 SELECTED_COLLIDER_COLOR = "#6d8fcb"  # a bluer slate: selected, not shouting
 #: How far off a body's outline (pixels) the pin key and shift+click still find a vertex, and
@@ -132,7 +137,7 @@ class Viewer:
         self._open_window(vsync=vsync, samples=samples)
         import moderngl
 
-        from ..render import Camera, Renderer, WorldView
+        from ..render import Renderer, WorldView
         from .inspector import Inspector
         from .overlay import Overlay
 
@@ -141,11 +146,11 @@ class Viewer:
         except Exception as e:  # noqa: BLE001 - moderngl raises plain Exceptions
             pygame.display.quit()
             raise RuntimeError(f"cannot use OpenGL 3.3 in the window ({e})") from None
-        self._Camera = Camera
         self.renderer = Renderer(self.ctx, self.window_size, target=self.ctx.screen)
         self.view = WorldView(self.renderer, session.world)
         self.view.follow = None  # the session moves the camera (Session.follow_camera), panning stops it
         self.view.dim_sleeping = True
+        self._frame_scene()
         self.overlay = Overlay(self.ctx)
         name = session.scene.scene.name or "scene"
         self.save_path = save_path or f"{name}-edited.toml"
@@ -193,6 +198,8 @@ class Viewer:
         #: screenshots that could not be saved: path -> why (a scripted run reports them)
         self.screenshot_errors: dict[str, str] = {}
         self._keymap = self._make_keymap()
+        self.renderer.resize(self.world_size)
+        self.renderer.camera = self.view_camera()
         pygame.display.set_caption(f"deforma - {name}")
 
     # -- window ------------------------------------------------------------------------------
@@ -228,6 +235,59 @@ class Viewer:
         if self.panel_visible:
             w = max(1, w - PANEL_WIDTH)
         return (w, h)
+
+    @property
+    def status_band(self) -> int:
+        """Rows at the bottom of the window that the status line covers, with its margin."""
+        h = self.status_layer.size[1] if self.status_layer is not None else self.small_font.get_height() + 10
+        return h + STATUS_MARGIN
+
+    def free_rect(self) -> tuple[int, int, int, int]:
+        """``(left, top, right, bottom)`` window pixels the world is framed in: left of the panel,
+        above the status line, :data:`FRAME_PAD` in from each."""
+        w, h = self.world_size
+        return (FRAME_PAD, FRAME_PAD, w - FRAME_PAD, h - self.status_band - FRAME_PAD)
+
+    def _frame_scene(self) -> None:
+        """Grow the session's camera rectangle to hold every collider and body of the scene as
+        it starts: a scene file's camera may cut off a wall or a floor the picture should show.
+
+        A camera that follows a body (``[camera] follow``, a side-scroller such as ``car``)
+        keeps its width around that body, since its level runs on past the picture's sides on
+        purpose; it grows to every body and to the colliders' full height, centred on the body
+        as :meth:`Session.follow_camera` will put it.
+        """
+        from ..render.framing import camera_box, content_bounds, union
+
+        s = self.session
+        world = s.world
+        box = camera_box(s.camera_center, s.camera_size)
+        if s.follow is not None and s.follow < len(world.bodies):
+            bodies = content_bounds(world, colliders=False)
+            colliders = content_bounds(world, bodies=False)
+            box = union(box, bodies)
+            if colliders is not None:
+                box = union(box, (box[0], colliders[1], box[2], colliders[3]))
+            cx, cy = (float(v) for v in world.bodies[s.follow].center_of_mass)
+            hw, hh = max(cx - box[0], box[2] - cx), max(cy - box[1], box[3] - cy)
+            box = (cx - hw, cy - hh, cx + hw, cy + hh)
+        else:
+            box = union(box, content_bounds(world))
+        x0, y0, x1, y1 = box
+        s.camera_center = ((x0 + x1) / 2, (y0 + y1) / 2)
+        s.camera_size = (x1 - x0, y1 - y0)
+
+    def view_camera(self):
+        """The camera the world is drawn with: the session's camera rectangle, whole and as
+        large as fits, centred in :meth:`free_rect` (so the panel and the status line cover
+        none of it)."""
+        from ..render.framing import camera_box, fit_camera
+
+        s = self.session
+        w, h = self.world_size
+        left, top, right, bottom = self.free_rect()
+        return fit_camera(camera_box(s.camera_center, s.camera_size), (w, h),
+                          insets=(left, top, w - right, h - bottom))
 
     def _resize(self, size) -> None:
         # a window dragged smaller is laid out at the smallest size (the rest is cut off)
@@ -337,6 +397,7 @@ class Viewer:
         """Open another scene (a name, a file, or a Session) in the same window."""
         self._release_grab()
         self.session = scene if isinstance(scene, Session) else Session(scene)
+        self._frame_scene()
         self.inspector = self._Inspector(self.session, self.window_size[1], save_path=self.save_path,
                                          actions=self._actions)
         if self.session.note:  # e.g. a scene under XPBD with too few substeps
@@ -556,7 +617,7 @@ class Viewer:
         before = self.to_world(self.pointer)
         w, h = s.camera_size
         s.camera_size = (min(max(w * f, 0.2), 500.0), min(max(h * f, 0.2), 500.0))
-        self.renderer.camera = self._Camera(s.camera_center, s.camera_size)
+        self.renderer.camera = self.view_camera()
         after = self.to_world(self.pointer)
         cx, cy = s.camera_center
         s.camera_center = (cx + before[0] - after[0], cy + before[1] - after[1])  # zoom about the pointer
@@ -633,9 +694,9 @@ class Viewer:
         r = self.renderer
         r.resize(self.world_size)
         s.follow_camera()
-        cam = r.camera
-        if cam.center != tuple(s.camera_center) or cam.size != tuple(s.camera_size):
-            r.camera = self._Camera(s.camera_center, s.camera_size)
+        cam = self.view_camera()
+        if cam != r.camera:
+            r.camera = cam
         self.view.draw(read=False)
         win = self.window_size
         self._draw_pins(win)
@@ -727,7 +788,7 @@ class Viewer:
                 self.status_layer = self.overlay.layer(box.get_size())
             self.status_layer.upload(box)
         h = self.status_layer.size[1]
-        self.overlay.draw(self.status_layer, (10, win[1] - h - 10), win)
+        self.overlay.draw(self.status_layer, (STATUS_MARGIN, win[1] - h - STATUS_MARGIN), win)
 
     def _text_box(self, rows, *, width, fg, bg, title=None, key_width=0):
         """A rounded box of text rows; a row is a string or (key, text) drawn in two columns."""
@@ -817,6 +878,30 @@ def _no_display() -> bool:
     return not any(os.environ.get(k) for k in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER"))
 
 
+def _refuse_invisible_fallback() -> None:
+    """RuntimeError if SDL's video driver is one that draws nowhere a person sees.
+
+    The environment can say there is a display and SDL still end up off-screen: ``DISPLAY``
+    naming an X server that is not there, or a list such as ``SDL_VIDEODRIVER=x11,offscreen``
+    whose first driver fails. SDL then falls back to its ``offscreen`` driver without a word
+    and the window ran until it was killed; so the driver SDL actually chose is asked.
+    """
+    import pygame
+
+    try:
+        pygame.display.init()
+    except pygame.error:
+        return  # opening the window says why, in its own words
+    driver = (pygame.display.get_driver() or "").lower()
+    if driver in INVISIBLE_DRIVERS:
+        pygame.display.quit()
+        shown = ", ".join(f"{k}={os.environ[k]}" for k in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")
+                          if os.environ.get(k)) or "no display variables"
+        raise RuntimeError(f"no display could be opened ({shown}), only SDL's invisible '{driver}' window, "
+                           f"which nobody could see or close; give --frames N (and --screenshot out.png) "
+                           f"to run N frames and stop, or use deforma run")
+
+
 def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot: str | None = None,
         panel: bool = True, wireframe: bool = False, samples: int = 0, paused: bool = False) -> Viewer | None:
     """Open the viewer on ``scene``: until the window is closed, or for ``frames`` frames.
@@ -864,6 +949,8 @@ def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot
         # nobody can see or close such a window: it ran until killed
         raise RuntimeError(f"SDL_VIDEODRIVER={driver} opens a window nobody can see or close; "
                            f"give --frames N (and --screenshot out.png) to run N frames and stop")
+    if frames is None:
+        _refuse_invisible_fallback()
     v = Viewer(session, size=size, panel=panel, vsync=frames is None, samples=samples)
     v.paused = paused
     try:
