@@ -17,7 +17,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: The public API and the physics seams, fully annotated and checked.
+#: The public API, the physics seams, the renderer and the viewer, fully annotated and checked.
 TYPED_MODULES = [
     "src/deforma/__init__.py",
     "src/deforma/mesh/__init__.py", "src/deforma/mesh/box.py", "src/deforma/mesh/delaunay.py",
@@ -28,6 +28,11 @@ TYPED_MODULES = [
     "src/deforma/scene/__init__.py", "src/deforma/scene/build.py",
     "src/deforma/render/renderer.py", "src/deforma/render/video.py", "src/deforma/render/world_view.py",
     "src/deforma/render/notebook.py", "src/deforma/render/recorder.py",
+    "src/deforma/render/__init__.py", "src/deforma/render/collider_mesh.py", "src/deforma/render/fill.py",
+    "src/deforma/render/framing.py", "src/deforma/render/overlay.py",
+    "src/deforma/viewer/__init__.py", "src/deforma/viewer/app.py", "src/deforma/viewer/clock.py",
+    "src/deforma/viewer/controls.py", "src/deforma/viewer/inspector.py", "src/deforma/viewer/overlay.py",
+    "src/deforma/viewer/params.py", "src/deforma/viewer/session.py",
     "src/deforma/sweeps.py",
 ]
 

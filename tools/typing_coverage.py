@@ -31,9 +31,12 @@ MODULES = [
     "physics/__init__.py", "physics/world.py", "physics/body.py", "physics/material.py", "physics/joint.py",
     "physics/colliders/shapes.py", "physics/integrators/__init__.py", "physics/integrators/base.py",
     "scene/__init__.py", "scene/build.py",
-    "render/__init__.py", "render/renderer.py", "render/video.py", "render/world_view.py", "render/notebook.py",
     "sweeps.py",
 ]
+# and every module of the drawing and the viewer (typed whole, as mypy checks them)
+MODULES += sorted(str(p.relative_to(Path(__file__).resolve().parents[1] / "src" / "deforma"))
+                  for folder in ("render", "viewer")
+                  for p in (Path(__file__).resolve().parents[1] / "src" / "deforma" / folder).glob("*.py"))
 
 
 @dataclass

@@ -16,6 +16,8 @@ Pure NumPy; it reads colliders only through their public attributes (``loops``,
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -40,7 +42,7 @@ SHADE = 0.08
 FLOATS_PER_VERTEX = 8
 
 
-def collider_corners(center, size, angle) -> np.ndarray:
+def collider_corners(center: Sequence[float], size: Sequence[float], angle: float) -> np.ndarray:
     """The four corners (4, 2) of a rectangle, counter-clockwise; ``angle`` in degrees."""
     cx, cy = center
     hw, hh = size[0] / 2.0, size[1] / 2.0
@@ -59,7 +61,8 @@ class ColliderShape:
 
     __slots__ = ("loops", "wire", "center", "angle", "spoke")
 
-    def __init__(self, loops, *, wire=False, center=(0.0, 0.0), angle=0.0, spoke=None):
+    def __init__(self, loops: list[np.ndarray], *, wire: bool = False, center: Sequence[float] = (0.0, 0.0),
+                 angle: float = 0.0, spoke: np.ndarray | None = None) -> None:
         self.loops = loops
         self.wire = wire
         self.center = center
@@ -67,7 +70,7 @@ class ColliderShape:
         self.spoke = spoke
 
 
-def collider_shape(c) -> ColliderShape:
+def collider_shape(c: Any) -> ColliderShape:
     """The :class:`ColliderShape` of a collider as it is now.
 
     ``c`` is a ``deforma`` collider (Rect, Circle, Polygon, Segment), anything with
@@ -151,10 +154,10 @@ class ColliderGeometry:
 
     __slots__ = ("fill_pos", "fill_shade", "border_pos", "border_off", "core_pos", "core_off", "triangles")
 
-    def __init__(self, shape: ColliderShape, triangles=None):
+    def __init__(self, shape: ColliderShape, triangles: np.ndarray | None = None) -> None:
         loops = shape.loops
         empty2 = np.zeros((0, 2))
-        self.triangles = None
+        self.triangles: np.ndarray | None = None
         if shape.wire:
             line = loops[0]
             self.fill_pos, self.fill_shade = empty2, np.zeros(0)
@@ -185,7 +188,7 @@ class ColliderGeometry:
         self.border_off = np.concatenate([b for _, b in parts])
         self.core_pos, self.core_off = empty2, empty2
 
-    def vertices(self, fill, edge, out: list) -> None:
+    def vertices(self, fill: Sequence[float], edge: Sequence[float], out: list[np.ndarray]) -> None:
         """Append this collider's rows (position, offset, colour) to ``out``, fill first."""
         if len(self.fill_pos):
             rgba = np.empty((len(self.fill_pos), 4))

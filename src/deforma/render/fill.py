@@ -13,6 +13,8 @@ Pure NumPy: nothing here needs a GL context.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ..mesh.polygons import inside_loops, segments_meet, signed_area
@@ -133,7 +135,7 @@ def _walk(nxt, start, count):
         i = nxt[i]
 
 
-def fill_triangles(loops) -> np.ndarray:
+def fill_triangles(loops: Sequence[np.ndarray]) -> np.ndarray:
     """Triangles that fill the region inside ``loops[0]`` and outside ``loops[1:]``.
 
     Inside and outside are even-odd, as :meth:`deforma.Polygon.contains` has them: a loop
@@ -192,13 +194,13 @@ def fill_triangles(loops) -> np.ndarray:
     return np.asarray(tris, dtype=np.int32).reshape(-1, 3)
 
 
-def _nesting(loops) -> list[list[bool]]:
+def _nesting(loops: Sequence[np.ndarray]) -> list[list[bool]]:
     """``[k][j]``: whether loop k lies inside loop j (k != j; loops do not cross, so one
     vertex tells)."""
     return [[j != k and inside_loops(loops[k][:1], [loops[j]])[0] for j in range(len(loops))] for k in range(len(loops))]
 
 
-def loop_depths(loops) -> list[int]:
+def loop_depths(loops: Sequence[np.ndarray]) -> list[int]:
     """How many other loops each loop lies in. Even-odd, as the colliders' inside test: a
     loop at an odd depth is a hole, one at an even depth bounds solid (the outer boundary,
     or an island in a hole)."""
@@ -218,7 +220,7 @@ def triangles_still_fit(points: np.ndarray, triangles: np.ndarray, area: float) 
     return bool(len(a)) and bool(np.all(a > 0)) and abs(float(a.sum()) - area) <= 1e-6 * abs(area)
 
 
-def loops_area(loops, depths=None) -> float:
+def loops_area(loops: Sequence[np.ndarray], depths: Sequence[int] | None = None) -> float:
     """Area of the solid the loops bound (either orientation; even-odd, see :func:`loop_depths`)."""
     depths = loop_depths(loops) if depths is None else depths
     return sum(abs(signed_area(np.asarray(p, np.float64))) * (-1) ** d for p, d in zip(loops, depths))

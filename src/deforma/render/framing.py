@@ -11,7 +11,7 @@ it) wholly inside the free part of the picture, centred in it, with square pixel
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
@@ -39,6 +39,12 @@ def camera_box(center: Sequence[float], size: Sequence[float]) -> Box:
     return (cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2)
 
 
+@overload
+def union(a: Box, b: Box | None) -> Box: ...
+@overload
+def union(a: Box | None, b: Box) -> Box: ...
+@overload
+def union(a: Box | None, b: Box | None) -> Box | None: ...
 def union(a: Box | None, b: Box | None) -> Box | None:
     """The smallest box holding both (``None`` is empty)."""
     if a is None or b is None:

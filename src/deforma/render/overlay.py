@@ -116,7 +116,7 @@ def overlay_insets(height: int) -> tuple[int, int]:
     return top, max(bar, label) + gap
 
 
-def draw_overlay(frame, *, time: float, metres_per_pixel: float) -> np.ndarray:
+def draw_overlay(frame: np.ndarray, *, time: float, metres_per_pixel: float) -> np.ndarray:
     """Write the simulated time (top left) and a scale bar (bottom left) onto a frame, in place.
 
     Parameters

@@ -24,6 +24,14 @@ buffer costs 20 bytes a pixel with multisampling (:func:`pipeline_bytes`), and
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from .video import FrameWriter
+    from .world_view import WorldView
 
 __all__ = ["FrameRecorder", "PIPELINE_MAX_PIXELS", "frames_in_flight", "pipeline_bytes"]
 
@@ -36,7 +44,7 @@ PIPELINE_MAX_PIXELS = 2560 * 1440
 _BUFFER_BYTES_PER_PIXEL = {0: 4, 4: 20}
 
 
-def frames_in_flight(size, *, samples: int = 4) -> int:
+def frames_in_flight(size: Sequence[float], *, samples: int = 4) -> int:
     """How many frames a :class:`FrameRecorder` draws ahead of the one it reads: 2, or 1 above
     :data:`PIPELINE_MAX_PIXELS`.
 
@@ -48,7 +56,7 @@ def frames_in_flight(size, *, samples: int = 4) -> int:
     return 2 if int(size[0]) * int(size[1]) <= PIPELINE_MAX_PIXELS else 1
 
 
-def pipeline_bytes(size, *, samples: int) -> int:
+def pipeline_bytes(size: Sequence[float], *, samples: int) -> int:
     """Memory (bytes) the second off-screen buffer of a pipelined recorder adds; 0 when frames
     of ``size`` are drawn one at a time.
 
@@ -97,7 +105,7 @@ class FrameRecorder:
     >>> view.renderer.release()
     """
 
-    def __init__(self, view, writer, *, in_flight: int | None = None):
+    def __init__(self, view: WorldView, writer: FrameWriter, *, in_flight: int | None = None) -> None:
         r = view.renderer
         if in_flight is None:
             in_flight = frames_in_flight(r.size, samples=getattr(r, "_samples", 0))
@@ -107,7 +115,7 @@ class FrameRecorder:
         self.writer = writer
         self.in_flight = in_flight
         self.frames = 0          # frames handed to the writer
-        self.last_frame = None   # the last of them, (H, W, 3) uint8
+        self.last_frame: np.ndarray | None = None  # the last of them, (H, W, 3) uint8
         self._drawn: deque = deque()  # frames drawn, not yet read: [buffer, time, scale, resolved]
 
     def add(self) -> None:
@@ -115,7 +123,9 @@ class FrameRecorder:
         (or :meth:`finish`)."""
         view, r = self.view, self.view.renderer
         if self.in_flight == 1:
-            self._deliver(view.draw())
+            frame = view.draw()
+            assert frame is not None  # draw() reads the picture back by default
+            self._deliver(frame)
             return
         drawn = self._drawn
         if len(drawn) == 2:
@@ -148,7 +158,7 @@ class FrameRecorder:
             self.view.overlay_onto(frame, time=time, metres_per_pixel=scale)
         self._deliver(frame)
 
-    def _deliver(self, frame) -> None:
+    def _deliver(self, frame: np.ndarray) -> None:
         self.last_frame = frame
         self.writer.write(frame)
         self.frames += 1

@@ -369,7 +369,7 @@ def _inline_short_arrays(text: str) -> str:
         text = new
 
 
-def save_scene(world: World, path: str | os.PathLike[str]) -> Path:
+def save_scene(world: World | Scene, path: str | os.PathLike[str]) -> Path:
     """Write ``world`` (or a :class:`Scene`) to a TOML scene file that :func:`load_scene` reads back.
 
     Every key is written, defaults included, except integrator options, of which only those

@@ -16,7 +16,10 @@ Examples
 2500.0
 """
 
+from __future__ import annotations
+
 import os
+from typing import TYPE_CHECKING, Any
 
 # pygame prints a banner on import; a command-line tool should not
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
@@ -24,15 +27,19 @@ os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 from .clock import FixedStepClock  # noqa: E402
 from .session import Session  # noqa: E402
 
+if TYPE_CHECKING:
+    from ..scene import Scene
+    from .app import Viewer
 
-def run(scene="demo", **kwargs):
+
+def run(scene: Scene | str | os.PathLike[str] = "demo", **kwargs: Any) -> Viewer | None:
     """Open the viewer (see :func:`deforma.viewer.app.run`)."""
     from .app import run as _run
 
     return _run(scene, **kwargs)
 
 
-def __getattr__(name):
+def __getattr__(name: str) -> Any:
     if name == "Viewer":  # imported on demand: it pulls in pygame
         from .app import Viewer
 

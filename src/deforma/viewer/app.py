@@ -21,13 +21,24 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .clock import FixedStepClock
 from .controls import KEYS, help_rows
 from .session import Session
+
+if TYPE_CHECKING:
+    import pygame
+
+    from ..physics import Grab
+    from ..render.renderer import Camera
+    from ..scene import Scene
+    from .overlay import OverlayLayer
 
 #: Smallest window (pixels) the viewer lays out: the inspector panel (340 px wide: 104 px of
 #: buttons, a scrolling list showing at least 4 rows of 26 px, a 64 px message box) beside a
@@ -38,7 +49,7 @@ from .session import Session
 MIN_WINDOW_SIZE = (340 + 300, 104 + 4 * 26 + 64)
 
 
-def check_window_size(size) -> tuple[int, int]:
+def check_window_size(size: Iterable[float]) -> tuple[int, int]:
     """``size`` as two ints, or ValueError naming it and :data:`MIN_WINDOW_SIZE`."""
     try:
         w, h = (int(v) for v in size)
@@ -80,8 +91,9 @@ def _font_path() -> str | None:
         return None
 
 
-def _wrap(text: str, font, width: int) -> list[str]:
-    lines, line = [], ""
+def _wrap(text: str, font: pygame.font.Font, width: int) -> list[str]:
+    lines: list[str] = []
+    line = ""
     for word in text.split():
         trial = f"{line} {word}".strip()
         if line and font.size(trial)[0] > width:
@@ -127,8 +139,9 @@ class Viewer:
     >>> v.close()
     """
 
-    def __init__(self, scene="demo", *, size=(1280, 720), panel: bool = True, vsync: bool = False,
-                 samples: int = 0, save_path: str | None = None):
+    def __init__(self, scene: Session | Scene | str | os.PathLike[str] = "demo", *,
+                 size: Sequence[float] = (1280, 720), panel: bool = True, vsync: bool = False, samples: int = 0,
+                 save_path: str | None = None) -> None:
         import pygame
 
         self.pg = pygame
@@ -167,20 +180,20 @@ class Viewer:
         fp = _font_path()
         self.font = pygame.font.Font(fp, 15)
         self.small_font = pygame.font.Font(fp, 14)
-        self.status_layer = None
-        self.help_layer = None
-        self.message_layer = None
-        self._message_key = None
+        self.status_layer: OverlayLayer | None = None
+        self.help_layer: OverlayLayer | None = None
+        self.message_layer: OverlayLayer | None = None
+        self._message_key: tuple[str | None, tuple[int, int]] | None = None
         self.help_visible = False
         self.clock = FixedStepClock()
         self.paused = False
         self.unstable: str | None = None
         self.running = True
-        self.grab = None
-        self._joining = None           # the J key's clicks so far (world points), while joining
-        self._collider_drag = None     # offset from the pointer to the collider centre
-        self._pan = None               # last pointer position while panning
-        self.pointer = (0, 0)
+        self.grab: Grab | None = None
+        self._joining: list[tuple[float, float]] | None = None  # the J key's clicks (world points) while joining
+        self._collider_drag: tuple[float, float] | None = None  # offset from the pointer to the collider centre
+        self._pan: tuple[float, ...] | None = None              # last pointer position while panning
+        self.pointer: tuple[float, ...] = (0, 0)
         self._generation = session.generation
         self._n_colliders = len(session.world.colliders)
         self._single = 0
@@ -192,7 +205,7 @@ class Viewer:
         self._stat_steps = 0
         self.fps = 0.0
         self.steps_per_second = 0.0
-        self._status_text = None
+        self._status_text: str | None = None
         self._screenshot_requests: list[str] = []
         self.last_screenshot: np.ndarray | None = None
         #: screenshots that could not be saved: path -> why (a scripted run reports them)
@@ -277,7 +290,7 @@ class Viewer:
         s.camera_center = ((x0 + x1) / 2, (y0 + y1) / 2)
         s.camera_size = (x1 - x0, y1 - y0)
 
-    def view_camera(self):
+    def view_camera(self) -> Camera:
         """The camera the world is drawn with: the session's camera rectangle, whole and as
         large as fits, centred in :meth:`free_rect` (so the panel and the status line cover
         none of it)."""
@@ -289,7 +302,7 @@ class Viewer:
         return fit_camera(camera_box(s.camera_center, s.camera_size), (w, h),
                           insets=(left, top, w - right, h - bottom))
 
-    def _resize(self, size) -> None:
+    def _resize(self, size: Sequence[float]) -> None:
         # a window dragged smaller is laid out at the smallest size (the rest is cut off)
         self.window_size = (max(MIN_WINDOW_SIZE[0], int(size[0])), max(MIN_WINDOW_SIZE[1], int(size[1])))
         message = (self.inspector.message, self.inspector.message_is_error)
@@ -308,9 +321,9 @@ class Viewer:
         self.pg.display.quit()
 
     # -- actions -----------------------------------------------------------------------------
-    def _make_keymap(self) -> dict:
+    def _make_keymap(self) -> dict[int, str]:
         pg = self.pg
-        out = {}
+        out: dict[int, str] = {}
         for names, action, _ in KEYS:
             for n in names:
                 out[pg.key.key_code(n)] = action
@@ -342,7 +355,7 @@ class Viewer:
         """The space key: every vertex gets the explosive force upward (m/s)."""
         self.session.world.explode(self.session.explosive_force)
 
-    def toggle_pin(self, pos=None) -> None:
+    def toggle_pin(self, pos: Sequence[float] | None = None) -> None:
         """Pin the vertex nearest the pointer (window pixel ``pos``) on the body under it, or
         free it if it is pinned: the F key and shift+click."""
         pos = self.pointer if pos is None else pos
@@ -368,7 +381,8 @@ class Viewer:
         self.inspector.say("join: click a rigid body where the hinge goes, then the body to hinge it to "
                            "(the background or the same body: the world)")
 
-    def _join_click(self, pos) -> None:
+    def _join_click(self, pos: Sequence[float]) -> None:
+        assert self._joining is not None  # only called while joining
         self._joining.append(self.to_world(pos))
         if len(self._joining) < 2:
             self.inspector.say("now click the body to hinge it to (the background: the world)")
@@ -393,7 +407,7 @@ class Viewer:
         self._release_grab()
         self.inspector.apply_object(name)
 
-    def load(self, scene) -> None:
+    def load(self, scene: Session | Scene | str | os.PathLike[str]) -> None:
         """Open another scene (a name, a file, or a Session) in the same window."""
         self._release_grab()
         self.session = scene if isinstance(scene, Session) else Session(scene)
@@ -420,11 +434,12 @@ class Viewer:
         """Turn the selected collider about its centre (the Z and X keys)."""
         s = self.session
         # only one the person picked (it is drawn highlighted), not the panel's default choice
-        if s.collider is None or not s.collider_active:
+        i = s.collider_index  # None: no collider (s.collider is None)
+        if i is None or not s.collider_active:
             self.inspector.say("click a collider first to turn it")
             return
         angle = s.rotate_collider(degrees)
-        self.inspector.say(f"{s.collider_shape} {s.collider_index + 1} at {angle:g}°")
+        self.inspector.say(f"{s.collider_shape} {i + 1} at {angle:g}°")
         self.inspector.refresh()
 
     def remove_collider(self) -> None:
@@ -477,20 +492,20 @@ class Viewer:
             self.running = False
 
     # -- input -------------------------------------------------------------------------------
-    def to_world(self, pos) -> tuple[float, float]:
+    def to_world(self, pos: ArrayLike) -> tuple[float, float]:
         """Window pixel (column, row from the top) to world metres."""
         p = self.renderer.camera.pixel_to_world(np.asarray(pos, float), self.world_size)
         return float(p[0]), float(p[1])
 
-    def to_pixel(self, point) -> tuple[float, float]:
+    def to_pixel(self, point: ArrayLike) -> tuple[float, float]:
         """World metres to window pixel (column, row from the top)."""
         q = self.renderer.camera.world_to_pixel(np.asarray(point, float), self.world_size)
         return float(q[0]), float(q[1])
 
-    def _over_panel(self, pos) -> bool:
+    def _over_panel(self, pos: Sequence[float]) -> bool:
         return self.panel_visible and pos[0] >= self.world_size[0]
 
-    def _panel_event(self, e):
+    def _panel_event(self, e: pygame.event.Event) -> pygame.event.Event:
         pg = self.pg
         if e.type in (pg.MOUSEMOTION, pg.MOUSEBUTTONDOWN, pg.MOUSEBUTTONUP):
             d = dict(e.dict)
@@ -507,7 +522,7 @@ class Viewer:
             self.grab = None
         self._collider_drag = None
 
-    def handle_event(self, e) -> None:
+    def handle_event(self, e: pygame.event.Event) -> None:
         """React to one pygame event (the panel's, the world's or a shortcut)."""
         pg = self.pg
         t = e.type
@@ -557,7 +572,7 @@ class Viewer:
         # the panel's own events (button presses, entries finished, ...)
         self.inspector.process_event(e)
 
-    def _world_mouse(self, e) -> None:
+    def _world_mouse(self, e: pygame.event.Event) -> None:
         pg = self.pg
         s = self.session
         t = e.type
@@ -635,7 +650,7 @@ class Viewer:
         """
         now = time.perf_counter()
         live = frame_time is None
-        if live:
+        if frame_time is None:
             frame_time = now - self._last_time
         self._last_time = now
         for e in self.pg.event.get():
@@ -735,7 +750,7 @@ class Viewer:
         parts = [b.positions[b.pinned] for b in self.session.world.bodies]
         return np.concatenate(parts) if parts else np.zeros((0, 2))
 
-    def _draw_pins(self, win) -> None:
+    def _draw_pins(self, win: tuple[int, int]) -> None:
         points = self.pinned_points()
         if not len(points):
             return
@@ -775,7 +790,7 @@ class Viewer:
                                  f"{nv} vertices   {nt} triangles   energy {energy}   "
                                  f"t = {w.time:.2f} s{state}   H: help")
 
-    def _draw_status(self, win) -> None:
+    def _draw_status(self, win: tuple[int, int]) -> None:
         from .overlay import rounded_box
 
         prev = self._status_text
@@ -790,12 +805,13 @@ class Viewer:
         h = self.status_layer.size[1]
         self.overlay.draw(self.status_layer, (STATUS_MARGIN, win[1] - h - STATUS_MARGIN), win)
 
-    def _text_box(self, rows, *, width, fg, bg, title=None, key_width=0):
+    def _text_box(self, rows: Iterable[str | tuple[str, str]], *, width: int, fg: tuple[int, ...],
+                  bg: tuple[int, ...], title: str | None = None, key_width: int = 0) -> pygame.Surface:
         """A rounded box of text rows; a row is a string or (key, text) drawn in two columns."""
         from .overlay import rounded_box
 
         f = self.small_font
-        rendered = []
+        rendered: list[tuple[pygame.Surface | None, pygame.Surface, int]] = []
         if title:
             rendered.append((None, self.font.render(title, True, fg), 6))
         for row in rows:
@@ -816,7 +832,7 @@ class Viewer:
             y += t.get_height() + extra
         return box
 
-    def _draw_help(self, win) -> None:
+    def _draw_help(self, win: tuple[int, int]) -> None:
         if self.help_layer is None:
             rows = help_rows()
             key_width = max(self.small_font.size(k)[0] for k, _ in rows) + 18
@@ -828,7 +844,7 @@ class Viewer:
         ww, wh = self.world_size
         self.overlay.draw(self.help_layer, (max(0, (ww - w) // 2), max(0, (wh - h) // 2)), win)
 
-    def _draw_message(self, win) -> None:
+    def _draw_message(self, win: tuple[int, int]) -> None:
         key = (self.unstable, self.world_size)
         if self.message_layer is None or key != self._message_key:
             width = min(640, self.world_size[0] - 40)
@@ -902,7 +918,8 @@ def _refuse_invisible_fallback() -> None:
                            f"to run N frames and stop, or use deforma run")
 
 
-def run(scene="demo", *, size=(1280, 720), frames: int | None = None, screenshot: str | None = None,
+def run(scene: Scene | str | os.PathLike[str] = "demo", *, size: Sequence[float] = (1280, 720),
+        frames: int | None = None, screenshot: str | None = None,
         panel: bool = True, wireframe: bool = False, samples: int = 0, paused: bool = False) -> Viewer | None:
     """Open the viewer on ``scene``: until the window is closed, or for ``frames`` frames.
 

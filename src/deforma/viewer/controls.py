@@ -6,6 +6,8 @@ module imports nothing from pygame.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 __all__ = ["KEYS", "MOUSE", "help_rows", "key_label"]
 
 #: (key names, action, what it does). The first name is the one shown.
@@ -44,7 +46,7 @@ MOUSE: tuple[tuple[str, str], ...] = (
 )
 
 
-def key_label(names) -> str:
+def key_label(names: Iterable[str]) -> str:
     """How a key is written for people: ``("escape", "q")`` -> ``"Escape / Q"``."""
     return " / ".join(n.capitalize() if len(n) > 1 else n.upper() for n in names)
 

@@ -20,9 +20,12 @@ makes the panel drivable by posted events in tests, where there is no real point
 
 from __future__ import annotations
 
+from collections.abc import Callable, Collection, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
 import pygame
 import pygame_gui
-from pygame_gui.core import ObjectID
+from pygame_gui.core import ObjectID, UIElement
 from pygame_gui.elements import (UIButton, UICheckBox, UIDropDownMenu, UIHorizontalSlider, UILabel, UIPanel,
                                  UIScrollingContainer, UITextBox, UITextEntryLine)
 
@@ -30,6 +33,9 @@ from ..physics import available_integrators
 from .params import GROUPS, Param, format_value, integrator_params, parse_value
 from ..physics.material import material_models
 from .session import COLLIDER_FIELDS, COLLIDER_SHAPES, OBJECTS
+
+if TYPE_CHECKING:
+    from .session import Session
 
 __all__ = ["PANEL_WIDTH", "Inspector"]
 
@@ -81,31 +87,31 @@ THEME = {
 class _PanelManager(pygame_gui.UIManager):
     """A UIManager whose mouse position is set from events (in panel coordinates)."""
 
-    def __init__(self, *args, **kwargs):
-        self.pointer = (-1, -1)
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        self.pointer: tuple[int, int] = (-1, -1)
         super().__init__(*args, **kwargs)
 
-    def _update_mouse_position(self):
+    def _update_mouse_position(self) -> None:
         self.mouse_position = self.pointer
 
 
 class _Row:
     """The widgets of one parameter."""
 
-    def __init__(self, param: Param):
+    def __init__(self, param: Param) -> None:
         self.param = param
-        self.slider = None
-        self.entry = None
-        self.check = None
-        self.menu = None           # a choice's drop-down, and the value it was made showing
-        self.menu_rect = None
-        self.menu_made_for = None
-        self.label = None
+        self.slider: UIHorizontalSlider | None = None
+        self.entry: UITextEntryLine | None = None
+        self.check: UICheckBox | None = None
+        self.menu: UIDropDownMenu | None = None  # a choice's drop-down, and the value it was made showing
+        self.menu_rect: pygame.Rect | None = None
+        self.menu_made_for: Any = None
+        self.label: UILabel | None = None
         self.top = 0               # y of the row in the scrolling area, pixels
-        self.shown = object()      # value last shown, to touch widgets only on change
-        self.slider_value = None   # slider position last set by us; a different one was the user
+        self.shown: Any = object()  # value last shown, to touch widgets only on change
+        self.slider_value: float | None = None  # slider position last set by us; a different one was the user
 
-    def widgets(self) -> list:
+    def widgets(self) -> list[UIElement]:
         """The row's widgets, its label first."""
         return [w for w in (self.label, self.slider, self.entry, self.check, self.menu) if w is not None]
 
@@ -122,7 +128,8 @@ class Inspector:
         Initial file name in the "save scene" box.
     """
 
-    def __init__(self, session, height: int, *, save_path: str = "scene.toml", actions=None):
+    def __init__(self, session: Session, height: int, *, save_path: str = "scene.toml",
+                 actions: Mapping[str, Callable[[], object]] | None = None) -> None:
         self.session = session
         self.height = int(height)
         self.actions = actions if actions is not None else {}
@@ -132,7 +139,7 @@ class Inspector:
         self.rows: dict[str, _Row] = {}
         self.message = ""
         self.message_is_error = False
-        self._message_shown = None
+        self._message_shown: tuple[str, bool] | None = None
         self._save_path = save_path
         #: The shape the Add button makes (the menu beside it).
         self.new_shape = COLLIDER_SHAPES[0]
@@ -232,14 +239,17 @@ class Inspector:
                                         placeholder_text=p.off_text if p.optional else None)
         return row
 
-    def _make_choice_menu(self, row: _Row, shown) -> None:
+    def _make_choice_menu(self, row: _Row, shown: str) -> None:
+        assert row.menu_rect is not None  # a choice's row has one (_row)
         row.menu_made_for = shown
-        row.menu = UIDropDownMenu(list(row.param.choices), shown, row.menu_rect, self.manager, container=self.scroll,
+        choices: list[str | tuple[str, str]] = list(row.param.choices)
+        row.menu = UIDropDownMenu(choices, shown, row.menu_rect, self.manager, container=self.scroll,
                                   expansion_height_limit=len(row.param.choices) * 26)
 
     def _make_menu(self) -> None:
         self._menu_made_for = self._selected_text()
-        self.selected_menu = UIDropDownMenu(list(OBJECTS), self._menu_made_for, self._menu_rect, self.manager,
+        objects: list[str | tuple[str, str]] = list(OBJECTS)
+        self.selected_menu = UIDropDownMenu(objects, self._menu_made_for, self._menu_rect, self.manager,
                                             container=self.scroll, expansion_height_limit=4 * 26)
 
     def _make_shape_menu(self) -> None:
@@ -247,7 +257,8 @@ class Inspector:
                                          container=self.scroll, expansion_height_limit=len(COLLIDER_SHAPES) * 26)
 
     def _make_integrator_menu(self) -> None:
-        names = available_integrators()  # the registry: a user-registered integrator shows too
+        # the registry: a user-registered integrator shows too
+        names: list[str | tuple[str, str]] = list(available_integrators())
         self._integrator_menu_made_for = self.session.integrator
         self.integrator_menu = UIDropDownMenu(names, self._integrator_menu_made_for, self._integrator_rect,
                                               self.manager, container=self.scroll,
@@ -271,10 +282,10 @@ class Inspector:
         focus = self.manager.get_focus_set()
         return any(isinstance(e, UITextEntryLine) and e.is_focused for e in (focus or ()))
 
-    def process_event(self, event) -> bool:
+    def process_event(self, event: pygame.event.Event) -> bool:
         """Feed one event (mouse positions already in panel coordinates); True if the panel used it."""
         if event.type in (pygame.MOUSEMOTION, pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP):
-            self.manager.pointer = tuple(int(v) for v in event.pos)
+            self.manager.pointer = (int(event.pos[0]), int(event.pos[1]))
         self.dirty = True
         used = self.manager.process_events(event)
         t = event.type
@@ -309,7 +320,7 @@ class Inspector:
                     used = True
         return bool(used)
 
-    def _button(self, el) -> None:
+    def _button(self, el: UIButton) -> None:
         s = self.session
         if el is self.save_button:
             self.save()
@@ -320,6 +331,7 @@ class Inspector:
                 self.actions[name]()
         elif el is self.add_collider:
             if self._try(lambda: s.add_collider(self.new_shape)):
+                assert s.collider_index is not None  # add_collider selects the new collider
                 self.say(f"added a {self.new_shape} (collider {s.collider_index + 1}); drag it, turn it with Z / X "
                          f"or type its values")
         elif el is self.remove_collider:
@@ -330,7 +342,7 @@ class Inspector:
             s.select_collider((i + (1 if el is self.next_collider else -1)) % n)
         self.refresh()
 
-    def _entry(self, el) -> None:
+    def _entry(self, el: UITextEntryLine) -> None:
         if el is self.save_entry:
             self.save()
             return
@@ -345,7 +357,7 @@ class Inspector:
                 self.apply(name, value)
                 return
 
-    def apply(self, name: str, value) -> bool:
+    def apply(self, name: str, value: Any) -> bool:
         """Set a parameter through the session; a refusal becomes the panel's message. True if applied."""
         try:
             unchanged = self.session.get_param(name) == value
@@ -420,7 +432,7 @@ class Inspector:
             self.say(f"saved {path}; deforma run {path} renders it")
         return ok
 
-    def _try(self, fn) -> bool:
+    def _try(self, fn: Callable[[], object]) -> bool:
         try:
             fn()
         except (ValueError, OSError) as e:  # a refused value never reaches the world
@@ -486,10 +498,10 @@ class Inspector:
         # the rows of values the selected collider's shape does not have are greyed out
         has = set(s.collider_params())
         for name in COLLIDER_FIELDS:
-            row = self.rows.get(name)
-            if row is None:
+            field_row = self.rows.get(name)
+            if field_row is None:
                 continue
-            for widget in (row.slider, row.entry):
+            for widget in (field_row.slider, field_row.entry):
                 if widget is not None and widget.is_enabled != (name in has):
                     widget.enable() if name in has else widget.disable()
                     self.dirty = True
@@ -551,22 +563,23 @@ class Inspector:
         self._option_rows = taken
         self.dirty = True
 
-    def _shift_below(self, top: int, dy: int, *, skip=frozenset()) -> None:
+    def _shift_below(self, top: int, dy: int, *, skip: Collection[int] = frozenset()) -> None:
         """Move every widget of the scrolling area from ``top`` down by ``dy`` pixels (up if
         negative), and the places where drop-downs are made anew, except the widgets in ``skip``."""
         elements = self.scroll.scrollable_container.elements
         # a slider keeps its buttons in a container beside it, which it moves itself
         owned = {id(getattr(e, "button_container", None)) for e in elements}
         for e in list(elements):
-            r = e.relative_rect
+            r = e.get_relative_rect()
             if r.top >= top and id(e) not in owned and id(e) not in skip:
                 e.set_relative_position((r.left, r.top + dy))
         for rect in (self._menu_rect, self._integrator_rect, self._material_rect, self._shape_rect):
             if rect.top >= top:
                 rect.move_ip(0, dy)
 
-    def _refresh_choice(self, row: _Row, shown, force: bool) -> None:
+    def _refresh_choice(self, row: _Row, shown: Any, force: bool) -> None:
         # as the other drop-downs (see refresh): made anew when the value changed behind it
+        assert row.menu is not None  # called for the rows of a choice only
         if shown != row.menu_made_for or (force and row.menu.selected_option[0] != shown):
             row.menu.kill()
             self._make_choice_menu(row, shown)
@@ -597,7 +610,7 @@ class Inspector:
         self.manager.draw_ui(self.surface)
         return self.surface
 
-    def contains(self, panel_pos) -> bool:
+    def contains(self, panel_pos: Sequence[float]) -> bool:
         """True if ``panel_pos`` (panel coordinates) is on the panel."""
         x, y = panel_pos
         return 0 <= x < PANEL_WIDTH and 0 <= y < self.height

@@ -8,9 +8,13 @@ Markers are one instanced draw of squares at pixel centres: only their centres a
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import moderngl
 import numpy as np
 import pygame
+from numpy.typing import ArrayLike
 
 __all__ = ["PIN_MARK", "Overlay", "OverlayLayer"]
 
@@ -63,9 +67,12 @@ PIN_MARK = ((9.0, (0.96, 0.97, 0.98, 1.0)), (5.0, (0.09, 0.11, 0.15, 1.0)))
 class OverlayLayer:
     """One surface's texture; :meth:`upload` copies the surface's pixels when they changed."""
 
-    def __init__(self, ctx, size):
+    # ctx is a moderngl.Context, typed Any as in deforma.render.Renderer: moderngl's stubs type a
+    # program's members as a union (uniform, attribute, ...) that every ``prog[name].value = ...``
+    # would have to narrow
+    def __init__(self, ctx: Any, size: Sequence[float]) -> None:
         self.ctx = ctx
-        self.size = (int(size[0]), int(size[1]))
+        self.size: tuple[int, int] = (int(size[0]), int(size[1]))
         self.texture = ctx.texture(self.size, 4)
         self.texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
 
@@ -85,7 +92,7 @@ class OverlayLayer:
 class Overlay:
     """Draws :class:`OverlayLayer` textures at pixel rectangles of the window's framebuffer."""
 
-    def __init__(self, ctx):
+    def __init__(self, ctx: Any) -> None:  # a moderngl.Context (see OverlayLayer)
         self.ctx = ctx
         self.program = ctx.program(vertex_shader=_VS, fragment_shader=_FS)
         self.vao = ctx.vertex_array(self.program, [])
@@ -94,7 +101,8 @@ class Overlay:
         self.mark_vbo = ctx.buffer(reserve=self._mark_capacity * 8)
         self.mark_vao = ctx.vertex_array(self.mark_program, [(self.mark_vbo, "2f/i", "in_center")])
 
-    def draw_marks(self, centers, window_size, *, style=PIN_MARK) -> None:
+    def draw_marks(self, centers: ArrayLike, window_size: tuple[int, int], *,
+                   style: Sequence[tuple[float, Sequence[float]]] = PIN_MARK) -> None:
         """Draw a square marker centred on each pixel of ``centers`` ((N, 2), y down).
 
         Parameters
@@ -125,10 +133,11 @@ class Overlay:
             self.mark_program["u_color"].value = tuple(float(v) for v in color)
             self.mark_vao.render(moderngl.TRIANGLE_STRIP, vertices=4, instances=n)
 
-    def layer(self, size) -> OverlayLayer:
+    def layer(self, size: Sequence[float]) -> OverlayLayer:
         return OverlayLayer(self.ctx, size)
 
-    def draw(self, layer: OverlayLayer, pos, window_size, *, blend: bool = True) -> None:
+    def draw(self, layer: OverlayLayer, pos: Sequence[float], window_size: tuple[int, int], *,
+             blend: bool = True) -> None:
         """Draw ``layer`` with its top-left corner at pixel ``pos`` (y down) of the window."""
         ctx = self.ctx
         ctx.viewport = (0, 0, *window_size)
@@ -153,14 +162,14 @@ class Overlay:
         self.program.release()
 
 
-def rounded_box(size, color, radius: int = 8) -> pygame.Surface:
+def rounded_box(size: tuple[int, int], color: tuple[int, ...], radius: int = 8) -> pygame.Surface:
     """A translucent rounded rectangle to put text on."""
     s = pygame.Surface(size, pygame.SRCALPHA)
     pygame.draw.rect(s, color, s.get_rect(), border_radius=radius)
     return s
 
 
-def as_rgb_array(raw: bytes, size) -> np.ndarray:
+def as_rgb_array(raw: bytes, size: tuple[int, int]) -> np.ndarray:
     """Bytes read from the framebuffer (rows bottom-up) as an (H, W, 3) array, row 0 on top."""
     w, h = size
     return np.frombuffer(raw, dtype=np.uint8).reshape(h, w, 3)[::-1].copy()

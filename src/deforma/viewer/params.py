@@ -14,8 +14,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from ..physics.integrators import available_integrators, make_integrator
+
+if TYPE_CHECKING:
+    from ..physics.integrators.base import Option
 
 __all__ = ["GROUPS", "INTEGRATOR_PREFIX", "PARAMS", "Param", "format_value", "integrator_params", "option_param",
            "parse_value"]
@@ -56,7 +60,7 @@ class Param:
             t = (float(value) - self.lo) / (self.hi - self.lo)
         return min(1.0, max(0.0, t))
 
-    def from_slider(self, t: float):
+    def from_slider(self, t: float) -> float | int:
         """The value at slider position ``t`` in [0, 1], rounded to what reads well."""
         t = min(1.0, max(0.0, float(t)))
         v = self.lo * (self.hi / self.lo) ** t if self.log else self.lo + t * (self.hi - self.lo)
@@ -149,7 +153,7 @@ PARAMS: dict[str, Param] = {p.name: p for _, group in GROUPS for p in group}
 INTEGRATOR_PREFIX = "integrator_"
 
 
-def option_param(option) -> Param:
+def option_param(option: Option) -> Param:
     """The inspector row of an integrator option
     (:class:`deforma.physics.integrators.base.Option`).
 
@@ -186,14 +190,14 @@ def integrator_params() -> tuple[Param, ...]:
     >>> [p.name for p in integrator_params()][:3]
     ['integrator_mode', 'integrator_iterations', 'integrator_tolerance']
     """
-    rows = {}
+    rows: dict[str, Param] = {}
     for integrator in available_integrators():
         for option in type(make_integrator(integrator)).OPTIONS:
             rows.setdefault(option.name, option_param(option))
     return tuple(rows.values())
 
 
-def format_value(param: Param, value) -> str:
+def format_value(param: Param, value: Any) -> str:
     """Text for the value box: integers plain, floats with up to 4 significant digits."""
     if value is None:
         return ""
@@ -202,7 +206,7 @@ def format_value(param: Param, value) -> str:
     return f"{float(value):.4g}"
 
 
-def parse_value(param: Param, text: str):
+def parse_value(param: Param, text: str) -> float | int | None:
     """The number typed in a value box; for an optional parameter, ``None`` (off) when the box
     is empty or says ``off``, ``none`` or its ``off_text``.
 

@@ -24,23 +24,31 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 import warnings
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
+from typing import Any, TypedDict
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..checks import IgnoredSettingWarning
-from ..physics import Circle, Material, Polygon, Rect, Segment, available_integrators
+from ..physics import Body, Circle, Collider, Material, Polygon, Rect, Segment, available_integrators
 from ..physics.diagnostics import xpbd_advice
 from ..physics.integrators.base import unknown_option
-from ..scene import BoxBody, ImageBody, Scene, SceneError, build, load, scene_of
+from ..physics.joint import Joint
+from ..scene import BoxBody, ImageBody, MeshBody, Scene, SceneError, build, load, scene_of
 from ..scene.assets import builtin_textures
 from ..scene.construct import pin_mask
 from ..physics.material import material_models
 from ..physics.topology import triangles_under
-from ..scene.tables import MATERIAL_MODELS, BodyPhysics
+from ..scene.tables import MATERIAL_MODELS, BodyPhysics, PhysicsSettings
 from .params import INTEGRATOR_PREFIX, integrator_params
+
+#: A ``[[body]]`` of a scene, as ``Scene.body`` holds them.
+BodySpec = BoxBody | ImageBody | MeshBody
 
 def _builtin_texture_names() -> tuple:
     """The built-in textures the Selected menu offers, in the original's order where it has them
@@ -96,7 +104,7 @@ COLLIDER_FIELDS = {
 }
 
 
-def collider_shape_name(c) -> str:
+def collider_shape_name(c: Collider) -> str:
     """``rect``, ``circle``, ``polygon`` or ``segment``: what the inspector calls a collider's shape."""
     for name, cls in _SHAPE_CLASSES.items():
         if isinstance(c, cls):
@@ -104,7 +112,7 @@ def collider_shape_name(c) -> str:
     raise ValueError(f"colliders must be deforma.Rect, Circle, Polygon or Segment, found {type(c).__name__}")
 
 
-def _boundary_distance(c, point) -> float:
+def _boundary_distance(c: Collider, point: np.ndarray) -> float:
     """Metres from ``point`` to the nearest edge of a collider's boundary (its holes' too);
     a wire's boundary is the wire."""
     loops = c.loops if isinstance(c, Polygon) else [c.outline()]
@@ -123,7 +131,14 @@ MESH_LIMITS = {"detail": (0, 100), "resolution": (3, 64), "edge_step": (1, 64), 
 
 # Used when a body switches kind and has no value of the other kind yet: a 1.5 m object
 # either way, with a few hundred to a thousand points.
-_IMAGE_DEFAULTS = {"resolution": 10, "detect_edges": True, "edge_step": 5, "scale": 0.004}
+class _ImageDefaults(TypedDict):
+    resolution: int
+    detect_edges: bool
+    edge_step: int
+    scale: float
+
+
+_IMAGE_DEFAULTS: _ImageDefaults = {"resolution": 10, "detect_edges": True, "edge_step": 5, "scale": 0.004}
 _BOX_HALF = 0.75
 #: Substeps a mesh change may raise on its own (beyond, the unstable hint explains what to do).
 MAX_AUTO_SUBSTEPS = 64
@@ -144,7 +159,7 @@ class MeshSettings:
     scale: float = _IMAGE_DEFAULTS["scale"]
 
     @classmethod
-    def from_spec(cls, spec) -> "MeshSettings":
+    def from_spec(cls, spec: BodySpec | None) -> MeshSettings:
         """The settings a body spec implies; ``selected`` is the texture name, ``box`` or ``mesh``."""
         if isinstance(spec, BoxBody):
             return cls(selected="box", detail=spec.detail, edges=spec.edges, corners=spec.corners)
@@ -155,7 +170,7 @@ class MeshSettings:
         return cls(selected="mesh")
 
 
-def _check_int(value, name: str) -> int:
+def _check_int(value: Any, name: str) -> int:
     lo, hi = MESH_LIMITS[name]
     if isinstance(value, bool) or not float(value).is_integer():
         raise ValueError(f"{name} must be a whole number in [{lo}, {hi}], got {value!r}")
@@ -190,7 +205,7 @@ class Session:
     ValueError: detail must be in [0, 100] in the viewer, got 1000
     """
 
-    def __init__(self, scene):
+    def __init__(self, scene: Scene | str | os.PathLike[str]) -> None:
         if not isinstance(scene, Scene):
             scene = load(scene)
         self.world = build(scene)
@@ -222,7 +237,7 @@ class Session:
         # the option rows there are, read once: the registry is not walked for every frame's read
         self._option_rows = tuple(p.name for p in integrator_params())
 
-    def _initial_material_values(self, physics) -> dict:
+    def _initial_material_values(self, physics: PhysicsSettings) -> dict[str, float]:
         m = self.world.material
         if m is not None and m.is_fem:
             return {name: float(getattr(m, kw)) for name, kw in _MATERIAL_KEYWORD.items()}
@@ -260,20 +275,20 @@ class Session:
                        interaction=replace(s.interaction, explosive_force=float(self.explosive_force)))
 
     @property
-    def body_spec(self):
+    def body_spec(self) -> BodySpec | None:
         """The scene spec of the body the mesh values edit (None without bodies)."""
         bodies = scene_of(self.world).body
         return bodies[self.body_index] if bodies else None
 
     @property
-    def collider(self):
+    def collider(self) -> Collider | None:
         """The collider the inspector edits (a Rect, Circle, Polygon or Segment), or None."""
         if self.collider_index is None:
             return None
         return self.world.colliders[self.collider_index]
 
     # -- parameters ----------------------------------------------------------------------------
-    def get_param(self, name: str):
+    def get_param(self, name: str) -> Any:
         """Current value of an inspector parameter by name (see :data:`deforma.viewer.params.PARAMS`)."""
         w = self.world
         if name in ("gravity_x", "gravity_y"):
@@ -311,7 +326,7 @@ class Session:
             return w.integrator_options.get(name.removeprefix(INTEGRATOR_PREFIX))
         raise KeyError(f"unknown parameter {name!r}")
 
-    def set_param(self, name: str, value) -> None:
+    def set_param(self, name: str, value: Any) -> None:
         """Set an inspector parameter; physics applies at once, mesh values rebuild the body.
 
         Raises
@@ -388,7 +403,7 @@ class Session:
         m = self.world.material
         return "springs" if m is None else m.model
 
-    def _material(self, model: str, values: dict) -> Material | None:
+    def _material(self, model: str, values: dict[str, float]) -> Material | None:
         # a new model or elastic value keeps the world's behaviours (tearing, ...)
         if model == "springs":
             material = Material("springs", **self._world_behaviours())
@@ -399,7 +414,7 @@ class Session:
         return Material(model, **{kw: values[name] for name, kw in _MATERIAL_KEYWORD.items()}, plane=plane,
                         **self._world_behaviours())
 
-    def _world_behaviours(self) -> dict:
+    def _world_behaviours(self) -> dict[str, Any]:
         return {k: getattr(self.world.material or _SPRINGS, k) for k in BEHAVIOURS}
 
     def set_material(self, model: str) -> None:
@@ -424,7 +439,7 @@ class Session:
         self.world.material = material  # refuses (changing nothing) a body without triangles
         self._keep_stable(f"the {model} material")
 
-    def _set_material_value(self, name: str, value) -> None:
+    def _set_material_value(self, name: str, value: Any) -> None:
         if isinstance(value, bool):
             raise ValueError(f"{name} must be a number, got {value!r}")
         values = dict(self.material_values)
@@ -443,13 +458,13 @@ class Session:
             self._keep_stable(f"the {model} material")
         self.material_values = values
 
-    def _follows_world(self, body) -> bool:
+    def _follows_world(self, body: Body) -> bool:
         """True if ``body`` has no material of its own (it is made of the world's)."""
         m, wm = body.material, self.world.material
         # a body following a world without a material gets a fresh Material("springs")
         return m is wm if wm is not None else m == _SPRINGS
 
-    def _set_behaviour(self, name: str, value) -> None:
+    def _set_behaviour(self, name: str, value: Any) -> None:
         """Set tear_strain, yield_strain, plastic_rate or max_stretch of the selected body's
         material: the world's when the body follows it (then every body following the world
         gets it), else the body's own; state is kept."""
@@ -467,7 +482,7 @@ class Session:
             body.material = replace(body.material, **{name: value})
 
     # -- pins ---------------------------------------------------------------------------------
-    def vertex_at(self, point, *, radius: float = 0.0) -> tuple[int, int] | None:
+    def vertex_at(self, point: ArrayLike, *, radius: float = 0.0) -> tuple[int, int] | None:
         """``(body index, vertex index)`` of the vertex nearest ``point`` on the body under it.
 
         The body under the point is the topmost (last added) one with a triangle containing
@@ -516,7 +531,7 @@ class Session:
         return f"{what}: {len(motors)} motor{'s' if len(motors) > 1 else ''} at " + (
             "no spin" if direction == 0 else f"{'/'.join(f'{v:g}' for v in sorted(speeds))} degrees/s")
 
-    def toggle_pin(self, point, *, radius: float = 0.0) -> tuple[int, int, bool] | None:
+    def toggle_pin(self, point: ArrayLike, *, radius: float = 0.0) -> tuple[int, int, bool] | None:
         """Pin the vertex nearest ``point`` (metres) on the body under it, or free it if pinned.
 
         Returns
@@ -535,7 +550,7 @@ class Session:
             body.pin([i])
         return k, i, bool(body.pinned[i])
 
-    def join(self, first, second):
+    def join(self, first: Sequence[float], second: ArrayLike) -> Joint:
         """Hinge the body under ``first`` (metres) at that point to the body under ``second``,
         or to the world when ``second`` is on no body or on the same one: the J key and two
         clicks. Returns the :class:`deforma.Joint`.
@@ -591,16 +606,16 @@ class Session:
                          f"expect a blow-up unless you raise substeps")
 
     @property
-    def integrator_options(self) -> dict:
+    def integrator_options(self) -> dict[str, Any]:
         """The running world's integrator options by name (a new dict; ``docs/integrators.md``)."""
         return self.world.integrator_options
 
-    def integrator_params(self) -> tuple:
+    def integrator_params(self) -> tuple[str, ...]:
         """Names of the option rows the integrator in force takes (the others are greyed out)."""
         taken = self.world.integrator_options
         return tuple(n for n in self._option_rows if n.removeprefix(INTEGRATOR_PREFIX) in taken)
 
-    def set_integrator_option(self, name: str, value) -> None:
+    def set_integrator_option(self, name: str, value: Any) -> None:
         """Set one option of the running world's integrator; its other options keep their values.
 
         Parameters
@@ -653,7 +668,7 @@ class Session:
         self.body_index = index
         self.mesh = MeshSettings.from_spec(self.body_spec)
 
-    def _set_mesh(self, **changes) -> None:
+    def _set_mesh(self, **changes: Any) -> None:
         new = replace(self.mesh, **changes)
         spec = self.body_spec
         if spec is None:
@@ -669,6 +684,7 @@ class Session:
         common = {f.name: getattr(spec, f.name) for f in fields(BodyPhysics) if f.name not in ("pin", "pin_vertices")}
         common["position"] = position
         pinned_before = bool(self.world.bodies[self.body_index].pinned.any())
+        body: BoxBody | ImageBody
         if new.selected == "box":
             color = spec.color if isinstance(spec, BoxBody) else None
             texture = spec.texture if isinstance(spec, BoxBody) else None
@@ -678,9 +694,10 @@ class Session:
             source = new.selected
             if isinstance(spec, ImageBody) and MeshSettings.from_spec(spec).selected == new.selected:
                 source = spec.source  # an image file given by path keeps its path
-            keep = isinstance(spec, ImageBody) and source == spec.source
+            same = spec if isinstance(spec, ImageBody) and source == spec.source else None
+            keep = same is not None
             # the same picture keeps how its shape is cut from its background
-            cut = dict(background=spec.background, threshold=spec.threshold) if keep else {}
+            cut: dict[str, Any] = {} if same is None else dict(background=same.background, threshold=same.threshold)
             body = ImageBody(source=source, resolution=new.resolution, detect_edges=new.detect_edges,
                              edge_step=new.edge_step, scale=new.scale,
                              color=spec.color if keep else None, texture=spec.texture if keep else None, **cut,
@@ -732,7 +749,7 @@ class Session:
             self.note_is_warning = True
             self.note = advice
 
-    def _rebuild(self, body_spec=None) -> None:
+    def _rebuild(self, body_spec: BodySpec | None = None) -> None:
         self.note, self.note_is_warning = "", False
         scene = self.scene
         if body_spec is not None:
@@ -759,13 +776,13 @@ class Session:
         c = self.collider
         return None if c is None else collider_shape_name(c)
 
-    def collider_params(self) -> tuple:
+    def collider_params(self) -> tuple[str, ...]:
         """Names of the collider values the selected collider has (none without a selection)."""
         shape = self.collider_shape
         return tuple(n for n, (_, _, shapes) in COLLIDER_FIELDS.items() if shape in shapes)
 
-    def add_collider(self, shape: str = "rect", *, center=None, angle: float = 0.0, size=(3.0, 0.3),
-                     radius=None):
+    def add_collider(self, shape: str = "rect", *, center: Iterable[float] | None = None, angle: float = 0.0,
+                     size: tuple[float, float] = (3.0, 0.3), radius: float | None = None) -> Collider:
         """Add a collider at ``center`` (default: the camera centre) and select it.
 
         Parameters
@@ -793,6 +810,7 @@ class Session:
         if shape not in COLLIDER_SHAPES:
             raise ValueError(f"collider shape must be one of {', '.join(COLLIDER_SHAPES)}, got {shape!r}")
         cx, cy = (float(v) for v in (self.camera_center if center is None else center))
+        c: Collider
         if shape == "rect":
             c = Rect((cx, cy), size, angle)
         elif shape == "circle":
@@ -822,7 +840,7 @@ class Session:
         n = len(self.world.colliders)
         self.collider_index = None if n == 0 else min(i, n - 1)
 
-    def select_collider(self, index) -> None:
+    def select_collider(self, index: int | None) -> None:
         """Make collider ``index`` the one the inspector edits (None for none)."""
         n = len(self.world.colliders)
         if index is not None and not 0 <= index < n:
@@ -830,7 +848,7 @@ class Session:
         self.collider_index = index
         self.collider_active = index is not None
 
-    def move_collider(self, center) -> None:
+    def move_collider(self, center: Iterable[float]) -> None:
         """Put the selected collider's centre at ``center`` (metres): mouse dragging."""
         c = self.collider
         if c is None:
@@ -848,7 +866,7 @@ class Session:
         self._change_collider(angle=round(angle, 9))
         return c.angle
 
-    def _edit_collider(self, name, value) -> None:
+    def _edit_collider(self, name: str, value: Any) -> None:
         c = self.collider
         if c is None:
             raise ValueError("there is no collider selected: add one first")
@@ -874,7 +892,7 @@ class Session:
             value = tuple(whole)
         self._change_collider(**{attr: value})
 
-    def _change_collider(self, **changes) -> None:
+    def _change_collider(self, **changes: Any) -> None:
         """Set attributes of the selected collider, all or none: each is set on a copy first,
         whose setters check it, so a refused value leaves the collider as it was."""
         c = self.collider
@@ -885,7 +903,7 @@ class Session:
             setattr(c, attr, value)
         self.collider_active = True
 
-    def collider_at(self, point, *, radius: float = 0.0) -> int | None:
+    def collider_at(self, point: ArrayLike, *, radius: float = 0.0) -> int | None:
         """Index of the topmost collider containing ``point`` (metres); failing that, of the
         collider whose boundary passes nearest it within ``radius`` metres (a wire has no
         inside to click, a thin slab little); None if there is neither."""
@@ -902,7 +920,7 @@ class Session:
         return None if best is None else best[1]
 
     # -- files --------------------------------------------------------------------------------
-    def save(self, path) -> Path:
+    def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the current setup as a scene file; returns the path written.
 
         Raises
