@@ -184,3 +184,27 @@ def test_deforma_warmup_runs_the_warm_up_and_says_what_it_did(monkeypatch, capsy
     out = capsys.readouterr().out
     assert seen == ["slope", "jelly"]
     assert out.startswith("warm-up: ") and "built-in scenes in 2.5 s (every kernel was already compiled)" in out
+
+
+def test_a_run_that_fails_stops_the_warm_up_instead_of_waiting(tmp_path, monkeypatch, capsys):
+    from deforma import scene as scenes
+    from test_startup import fresh_kernels
+
+    mod = fresh_kernels(tmp_path, monkeypatch, "warmup_kernels_b")
+
+    def compile_then_fail(name):
+        mod.cached_kernel(1.0)
+        raise ValueError("a scene that cannot be read")
+
+    monkeypatch.setattr(scenes, "load", compile_then_fail)
+    jobs = []
+
+    def start(running):  # a warm-up that would run for ten minutes
+        jobs.append(warmup.Background(subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"]), 0.0))
+        return jobs[-1]
+
+    monkeypatch.setattr(warmup, "start_background", start)
+    assert main(["run", "slope", "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "a scene that cannot be read" in err and "other built-in scenes" not in err
+    assert len(jobs) == 1 and not jobs[0].running()

@@ -364,12 +364,20 @@ def cmd_run(a) -> int:
         if job is not None:
             background.append(job)
 
+    done = False
     try:
         with CompileWatch(on_first=first_compile) as watch:
-            return _run_scene(a, watch, shown)
+            code = _run_scene(a, watch, shown)
+        done = True
+        return code
     finally:
         for job in background:
-            job.wait(warn)
+            # a run that ended well waits for the warm-up; one stopped by an error, Ctrl-C or
+            # a signal does not keep the user waiting for it (the next run starts it again)
+            if done:
+                job.wait(warn)
+            else:
+                job.stop()
 
 
 def _run_scene(a, watch, shown: dict) -> int:

@@ -149,9 +149,15 @@ class Background:
                 f"{time.perf_counter() - self.started:.0f} s ago, in a second process)...")
         try:
             self.process.wait()
-        except KeyboardInterrupt:
-            self.process.kill()
+        except BaseException:  # Ctrl-C or a signal while waiting: no warm-up left behind
+            self.stop()
             raise
+
+    def stop(self) -> None:
+        """End the warm-up now (the next command that compiles starts it again)."""
+        if self.running():
+            self.process.terminate()
+        self.process.wait()
 
 
 def start_background(running: str | None = None) -> Background | None:
