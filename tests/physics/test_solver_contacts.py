@@ -90,7 +90,9 @@ def test_a_large_stiff_body_stands_on_the_floor_at_a_display_step_under_implicit
     assert w.integrator_stats["factorizations"] == 1  # the contact set stayed, so did the factor
 
 
-@pytest.mark.parametrize("name, iterations", [("implicit-euler", None), ("xpbd", 30)])
+# (implicit-bdf2: its vertices on the slope took backward Euler's velocity, and the block slid
+# at 0.87 of the rate, frictionless or not)
+@pytest.mark.parametrize("name, iterations", [("implicit-euler", None), ("implicit-bdf2", None), ("xpbd", 30)])
 @pytest.mark.parametrize("angle, mu_s, mu_d", [(30.0, 0.4, 0.3), (25.0, 0.0, 0.0), (20.0, 0.6, 0.3)])
 def test_a_block_on_a_slope_slides_or_sticks_at_a_display_step(name, iterations, angle, mu_s, mu_d):
     a = math.radians(angle)

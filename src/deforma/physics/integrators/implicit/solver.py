@@ -587,6 +587,27 @@ class ImplicitEuler(Integrator):
                          "now": (dx.copy(), dv.copy())}
         return self._history["now"]
 
+    @staticmethod
+    def _second_order_velocities(model, x, v, solved, x_s, x_n, hits, stamp, hs, h):
+        """BDF2's velocities, into ``v`` (which holds backward Euler's, ``(x - x_n) / h``,
+        after the collider response): ``(x - x^) / hs`` where the response left the vertex
+        alone. Where it moved it, the response's normal velocity (a stop) and its friction
+        stay, and a vertex it lets slide takes BDF2's difference from backward Euler along
+        the face too: with backward Euler's velocity there, the vertices sliding on a
+        face lagged the rest by half a step's acceleration every step, and a block slid down
+        a frictionless slope at 0.87 of g sin a (a box pushed at 2 m/s settled at 1.75 m/s).
+        A vertex the response holds still (static friction) stays still."""
+        diff = (solved - x_s) * (1.0 / hs) - (solved - x_n) * (1.0 / h)
+        free = (x == solved).all(axis=1) & ~model.pinned
+        v[free] += diff[free]
+        hit = np.flatnonzero(~free & ~model.pinned & (hits.stamp == stamp))
+        if len(hit):
+            n = hits.normal[hit]
+            vt = v[hit] - (v[hit] * n).sum(axis=1)[:, None] * n
+            dt = diff[hit] - (diff[hit] * n).sum(axis=1)[:, None] * n
+            sliding = (vt * vt).sum(axis=1) > 0.0
+            v[hit[sliding]] += dt[sliding]
+
     def step(self, model, state_in, state_out, control, contacts, h, *, substeps=1, max_speed=math.inf):
         n = model.n_vertices
         if self._scratch_n != n:
@@ -712,14 +733,12 @@ class ImplicitEuler(Integrator):
                                  hits, model.vertex_inv_mass, float(hs))
             if second:
                 solved = x.copy()
-            bad = finish_position_step(x, v, x_n, rects, hits, scr.status["stamp"][0] + 1, float(h), vmax2)
+            stamp = scr.status["stamp"][0] + 1
+            bad = finish_position_step(x, v, x_n, rects, hits, stamp, float(h), vmax2)
             if bad:
                 return StepReport(int(bad), True)
             if second:
-                # BDF2's velocity (x - x^) / hs where the collider response left the vertex
-                # alone; where it moved it, the response's (backward Euler's, with friction)
-                free = (x == solved).all(axis=1) & ~model.pinned
-                v[free] += (x[free] - x_s[free]) * (1.0 / hs) - (x[free] - x_n[free]) * (1.0 / h)
+                self._second_order_velocities(model, x, v, solved, x_s, x_n, hits, stamp, hs, float(h))
             # scr.xp still holds x_n (detect_contacts only read it): no second gather_start; the
             # stage's impulses change velocities only (contact_stage says why)
             if contact_epilogue(x, v, model.vertex_inv_mass, x_n, topo, scr, buf, rects, hits, float(h), False) < 0:
