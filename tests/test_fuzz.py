@@ -14,21 +14,76 @@ from deforma.scene.build import build
 from deforma.scene.schema import SceneError, parse_scene
 
 PHYSICS_KEYS = ["dt", "substeps", "gravity", "damping", "mass", "stiffness", "friction", "static_friction",
-                "max_speed", "integrator", "contact_thickness", "air_drag", "material", "youngs_modulus",
-                "poisson_ratio", "density", "material_damping", "tear_strain", "yield_strain", "plastic_rate",
-                "max_stretch"]
-BODY_KEYS = ["mass", "stiffness", "damping", "tear_strain", "yield_strain", "max_stretch", "pressure", "collide",
-             "self_collision", "friction", "pin", "detail", "edges", "position", "corners"]
-COLLIDER_KEYS = ["center", "size", "angle", "friction"]
+                "max_speed", "integrator", "integrator_options", "contact_thickness", "air_drag", "sleep", "material",
+                "youngs_modulus", "poisson_ratio", "density", "material_damping", "plane", "tear_strain",
+                "yield_strain", "plastic_rate", "max_stretch"]
+BODY_KEYS = ["mass", "stiffness", "damping", "material", "youngs_modulus", "poisson_ratio", "density",
+             "material_damping", "plane", "tear_strain", "yield_strain", "plastic_rate", "max_stretch", "pressure",
+             "collide", "self_collision", "friction", "static_friction", "angle", "velocity", "angular_velocity",
+             "pin", "pin_vertices", "shape", "corners", "detail", "edges", "position", "color", "texture"]
+COLLIDER_KEYS = ["shape", "center", "size", "angle", "friction", "static_friction", "velocity", "angular_velocity",
+                 "color"]
+CAMERA_KEYS = ["center", "size", "wireframe", "follow", "background"]
+INTERACTION_KEYS = ["explosive_force", "mouse_strength"]
+RUN_KEYS = ["seconds", "fps"]
+EVENT_KEYS = ["time", "action", "strength"]
+PULL_KEYS = ["at", "to", "start", "end", "release", "radius", "strength"]
+JOINT_KEYS = ["a", "b", "at", "kind", "stiffness", "damping", "motor_speed", "max_torque", "break_force"]
 
 hostile = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**20, 10**20),
-                    st.sampled_from([0, -1, 1e-300, 1e300, 1e-7, 2, 10**9]), st.booleans(), st.text(max_size=6))
+                    st.sampled_from([0, -1, 1e-300, 1e300, 1e-7, 2, 10**9, 10**400, -10**400]), st.booleans(),
+                    st.text(max_size=6), st.dictionaries(st.text(max_size=3), st.integers(-2, 2), max_size=2))
 sane = st.one_of(st.floats(1e-3, 1e3), st.integers(1, 12), st.sampled_from([0.0, 0.3, 0.5, 1.05, 1 / 600]))
 pairs = st.lists(st.one_of(sane, st.floats(-5, 5)), min_size=2, max_size=2)
-names = st.sampled_from(["springs", "corotated", "neo-hookean", "xpbd", "implicit-euler", "symplectic-euler"])
-PAIR_KEYS = {"gravity", "position", "center", "size"}
+INTEGRATORS = ["symplectic-euler", "implicit-euler", "implicit-bdf2", "xpbd", "avbd"]
+MATERIALS = ["springs", "corotated", "neo-hookean", "rigid", "jelly", "rubber", "wood"]
+names = st.sampled_from(INTEGRATORS + MATERIALS)
+PAIR_KEYS = {"gravity", "position", "center", "size", "velocity", "at", "to"}
 NAME_KEYS = {"integrator", "material"}
-SWITCH_KEYS = {"collide", "self_collision", "edges"}
+SWITCH_KEYS = {"collide", "self_collision", "edges", "sleep", "wireframe"}
+#: every integrator's options, as [physics.integrator_options] takes them (the names the integrators list)
+OPTION_VALUES = {
+    "iterations": st.integers(1, 12), "max_iterations": st.integers(1, 50), "order": st.integers(1, 2),
+    "rigid_passes": st.integers(1, 6), "cluster_size": st.sampled_from([0, 1, 4, 64, 10**6]),
+    "tolerance": st.sampled_from([0.0, 1e-3, 1.0, 1e5]), "contact_weight": st.sampled_from([1e-3, 10.0, 1e12]),
+    "reach": st.sampled_from([0.0, 0.5, 5.0]), "chebyshev": st.sampled_from([0.0, 0.5, 0.99]),
+    "penalty_start": st.sampled_from([1e-6, 1.0, 1e6]), "penalty_ramp": st.sampled_from([0.0, 1e5, 1e12]),
+    "penalty_max": st.sampled_from([1.0, 1e10, 1e17]), "mode": st.sampled_from(["auto", "serial", "parallel"]),
+}
+#: values of the right kind for the keys that are neither numbers, pairs, names nor switches
+KIND_VALUES = {
+    "plane": st.sampled_from(["stress", "strain"]),
+    "shape": st.sampled_from(["box", "mesh", "image", "rect", "circle", "segment", "polygon"]),
+    "color": st.sampled_from(["#e07a5f", "#E07A5F80", "#zzzzzz", "red", "#fff"]),
+    "texture": st.sampled_from(["bunny", "cloth", "donut", "no-such-picture.png", ""]),
+    "background": st.lists(st.sampled_from(["#dbe8f5", "#000000", "#ABCDEF80", "white"]), min_size=2, max_size=2),
+    "pin": st.lists(pairs, min_size=2, max_size=2),
+    "pin_vertices": st.lists(st.integers(-2, 40), max_size=4),
+    "corners": st.lists(pairs, min_size=4, max_size=4),
+    "follow": st.sampled_from([0, 1, 2, -1, 10**9, True, 0.0, 1.5]),
+    "a": st.sampled_from([0, 1, 2, -1, True, 0.0]), "b": st.sampled_from([0, 1, 2, -1, False, 1.0]),
+    "kind": st.sampled_from(["pin", "weld", "spring", "motor", "hinge"]),
+    "action": st.sampled_from(["explode", "implode"]),
+    "time": st.sampled_from([0.0, 0.02, 0.05, 1.0]), "start": st.sampled_from([0.0, 0.02, 0.05]),
+    "end": st.sampled_from([0.0, 0.03, 0.1]), "release": st.sampled_from([0.0, 0.04, 0.2]),
+    "motor_speed": st.one_of(st.floats(-1e3, 1e3), st.sampled_from([0.0, 1e6, -1e6, 1e7])),
+    "angle": st.one_of(st.floats(-360, 360), st.sampled_from([720.0, 1e6])),
+    "angular_velocity": st.one_of(st.floats(-720, 720), st.sampled_from([1e6, 1e9])),
+}
+
+
+@st.composite
+def integrator_options(draw, integrator, least=0):
+    """``least`` to three options: of ``integrator`` (its own names) but one time in six another's or an unknown
+    name; each value of its kind, or (one time in four) hostile."""
+    from deforma.physics.integrators import make_integrator
+
+    own = [o.name for o in type(make_integrator(integrator)).OPTIONS]
+    names = st.integers(0, 5).flatmap(lambda k: st.sampled_from(own) if k else
+                                      st.sampled_from([*OPTION_VALUES, "itertions", ""]))
+    keys = draw(st.lists(names, min_size=least, max_size=3, unique=True))
+    return {k: draw(hostile if draw(st.integers(0, 3)) == 0 or k not in OPTION_VALUES else OPTION_VALUES[k])
+            for k in keys}
 
 
 @st.composite
@@ -38,6 +93,11 @@ def settings_for(draw, keys, most):
     for key in draw(st.lists(st.sampled_from(keys), max_size=most, unique=True)):
         if draw(st.integers(0, 3)) == 0:
             out[key] = draw(st.one_of(hostile, st.lists(hostile, max_size=3)))
+        elif key == "integrator_options":
+            integrator = out.get("integrator")
+            out[key] = draw(integrator_options(integrator if integrator in INTEGRATORS else "avbd"))
+        elif key in KIND_VALUES:
+            out[key] = draw(KIND_VALUES[key])
         elif key in PAIR_KEYS:
             out[key] = draw(pairs)
         elif key in NAME_KEYS:
@@ -54,34 +114,107 @@ def one_line(e: Exception) -> None:
     assert text and "\n" not in text and "Traceback" not in text, text
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(physics=settings_for(PHYSICS_KEYS, 3), body=settings_for(BODY_KEYS, 2),
-       collider=settings_for(COLLIDER_KEYS, 1))
-def test_hostile_scene_values_are_refused_in_one_line_or_run(physics, body, collider):
-    data = {"physics": physics, "body": [{"shape": "box", "detail": 2, **body}],
-            "collider": [{"center": [0.0, -0.5], "size": [4.0, 1.0], **collider}]}
+def _load_build_and_step(data):
+    """parse_scene, build and five steps with the scene's events and pulls played: a one-line SceneError,
+    ValueError (what needs the built bodies) or SimulationUnstable (the world put back), or a sound world."""
+    from deforma.scene.script import Script
+
     try:
         scene = parse_scene(data, source="fuzz.toml")
     except SceneError as e:
         event("refused by the loader")
         one_line(e)
-        return
+        assert str(e).startswith("fuzz.toml: "), str(e)
+        return None
     try:
         world = build(scene)
     except ValueError as e:  # checks that need the built bodies (overlaps, meshes)
         event("refused when built")
         one_line(e)
-        return
+        return None
     try:
+        script = Script(scene, world)
         for _ in range(5):
+            script.apply()
             world.step()
     except deforma.SimulationUnstable as e:
         event("reported unstable")
         one_line(e)
         assert e.hint and np.isfinite(world.state.x).all()  # put back as it was
-        return
+        return world
     event("ran")
     assert np.isfinite(world.state.x).all()
+    return world
+
+
+@settings(max_examples=250, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(physics=settings_for(PHYSICS_KEYS, 3), body=settings_for(BODY_KEYS, 2),
+       collider=settings_for(COLLIDER_KEYS, 1), camera=st.just({}) | settings_for(CAMERA_KEYS, 1),
+       interaction=st.just({}) | settings_for(INTERACTION_KEYS, 1), run=st.just({}) | settings_for(RUN_KEYS, 1),
+       events=st.lists(settings_for(EVENT_KEYS, 3), max_size=1), pulls=st.lists(settings_for(PULL_KEYS, 3), max_size=1))
+def test_hostile_scene_values_are_refused_in_one_line_or_run(physics, body, collider, camera, interaction, run, events,
+                                                             pulls):
+    data = {"physics": physics, "body": [{"shape": "box", "detail": 2, **body}],
+            "collider": [{"center": [0.0, -0.5], "size": [4.0, 1.0], **collider}],
+            "camera": camera, "interaction": interaction, "run": run}
+    if events:
+        data["event"] = events
+    if pulls:
+        data["pull"] = [{"at": [0.0, 0.0], **p} for p in pulls]  # on the box, unless the pull says otherwise
+    _load_build_and_step(data)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(integrator=st.integers(0, 7).flatmap(lambda k: st.sampled_from(INTEGRATORS) if k else hostile),
+       data=st.data())
+def test_hostile_integrator_options_are_refused_in_one_line_or_run(integrator, data):
+    # each integrator's options (avbd's iterations to rigid_passes and mode, implicit-euler's and implicit-bdf2's
+    # tolerance, max_iterations, contact_weight, xpbd's iterations, symplectic-euler's mode) on a soft box under
+    # a rigid one
+    options = data.draw(integrator_options(integrator if integrator in INTEGRATORS else "avbd", least=1))
+    scene = {"physics": {"integrator": integrator, "integrator_options": options},
+             "body": [{"shape": "box", "detail": 2, "position": [0.0, 0.6]},
+                      {"shape": "box", "detail": 1, "position": [0.0, 1.8], "material": "rigid", "density": 50.0}],
+             "collider": [{"center": [0.0, -0.5], "size": [4.0, 1.0]}]}
+    _load_build_and_step(scene)
+
+
+#: the keys that go with each kind of joint (a spring's stiffness and damping, a pin's motor)
+JOINT_KIND_KEYS = {"pin": ["motor_speed", "max_torque", "break_force"], "weld": ["break_force"],
+                   "spring": ["stiffness", "damping", "break_force"]}
+
+
+@st.composite
+def joint_tables(draw):
+    """One or two [[joint]] tables on the two boxes below, where they touch: a kind and some of its own keys,
+    plus up to two of any joint keys (a, b and at too), each of its kind or (one time in four) hostile."""
+    out = []
+    for _ in range(draw(st.integers(1, 2))):
+        kind = draw(st.sampled_from(list(JOINT_KIND_KEYS)))
+        joint = {"a": 0, "b": 1, "at": [0.5, draw(st.sampled_from([1.0, 0.8, 1.4]))], "kind": kind}
+        if draw(st.booleans()):
+            del joint["b"]  # held to the world
+        joint.update(draw(settings_for(JOINT_KIND_KEYS[kind], 3)))
+        joint.update(draw(settings_for(JOINT_KEYS, 2)))
+        out.append(joint)
+    return out
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(joints=joint_tables(), second=st.sampled_from([{"material": "rigid", "density": 80.0}, {},
+                                                     {"material": "jelly"}, {"material": "rigid"}]),
+       integrator=st.sampled_from(["avbd", "avbd", "symplectic-euler", "implicit-bdf2", "xpbd"]))
+def test_hostile_joints_are_refused_in_one_line_or_run(joints, second, integrator):
+    # a rigid box beside a second box (rigid, springs, a jelly, or rigid without a density), joined where they touch
+    data = {"physics": {"integrator": integrator},
+            "body": [{"shape": "box", "detail": 1, "position": [0.0, 1.0], "material": "rigid", "density": 100.0},
+                     {"shape": "box", "detail": 2, "position": [1.0, 1.0], **second}],
+            "collider": [{"center": [0.0, -0.5], "size": [4.0, 1.0]}], "joint": joints}
+    world = _load_build_and_step(data)
+    if world is not None:
+        assert len(world.joints) <= len(joints)  # made, or broken by its break_force
+        for j in world.joints:
+            assert np.isfinite(j.force).all() and math.isfinite(j.torque)
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -441,3 +574,46 @@ def test_mesh_of_a_body_past_the_point_limit_is_one_line_writing_nothing(tmp_pat
     assert code == 1 and len(err.splitlines()) == 1 and "Traceback" not in err, err
     assert err.startswith(message), err
     assert sorted(os.listdir(tmp_path)) == ["disc.png"]
+
+
+# -- found by the fuzz tests above once they covered every key (issue 51) ---------------------------
+@pytest.mark.parametrize("data, message", [
+    # a shape that is an array or a table: TypeError (unhashable) looking it up
+    ({"body": [{"shape": [1]}]}, "f.toml: body[0].shape: expected a string, got array [1]; allowed: box, image, mesh"),
+    ({"collider": [{"shape": {"a": 1}}]}, "f.toml: collider[0].shape: expected a string, got table {'a': 1}; allowed: "
+                                          "rect, circle, polygon, segment, image"),
+    # an integer too large for a float in a number option: OverflowError in the option's check
+    ({"physics": {"integrator_options": {"tolerance": 10**400}}},
+     "f.toml: physics.integrator_options.tolerance: avbd option tolerance must be a number in [0, inf), got an "
+     "integer of 401 digits"),
+    ({"physics": {"integrator": "implicit-bdf2", "integrator_options": {"max_iterations": 10**5000}}},
+     "f.toml: physics.integrator_options.max_iterations: implicit-bdf2 option max_iterations must be an integer in "
+     "[1, 1e+06], got an integer of more than 4300 digits"),
+    # a vertex index past int64: OverflowError when the pins were made
+    ({"body": [{"shape": "box", "detail": 2, "pin_vertices": [3, 10**30]}]},
+     f"<scene>: body[0].pin_vertices: vertex index {10**30} is out of range; the body has vertices 0..15"),
+    # named physics: grab_strength, a key the file does not have
+    ({"interaction": {"mouse_strength": 1e-300}},
+     "f.toml: interaction.mouse_strength: must be in [1e-09, 1e+12] N/m, got 1e-300"),
+    # said to be made of finite elements with an elasticity, which a rigid body has not
+    ({"body": [{"shape": "box", "material": "rigid", "density": 5.0, "mass": 2.0}]},
+     "f.toml: body[0].mass: the body is 'rigid', whose mass is density * area and which does not deform: remove "
+     "mass, or set material = \"springs\""),
+])
+def test_keys_the_fuzz_found_are_refused_in_one_line_naming_the_key(data, message):
+    with pytest.raises(SceneError) as e:
+        build(parse_scene(data, source="f.toml"))
+    one_line(e.value)
+    assert str(e.value) == message
+
+
+def test_an_integer_option_too_large_for_a_float_is_refused_by_the_world_in_one_line():
+    for options in ({"tolerance": 10**400}, {"penalty_max": -10**5000}):
+        with pytest.raises(ValueError, match=r"^avbd option \w+ must be a number in .* got an integer of "
+                                             r"(401|more than 4300) digits$") as e:
+            deforma.World(integrator_options=options)
+        one_line(e.value)
+        w = deforma.World(integrator_options={"iterations": 4})
+        with pytest.raises(ValueError, match=r"^avbd option"):
+            w.integrator_options = options
+        assert w.integrator_options["iterations"] == 4  # nothing changed

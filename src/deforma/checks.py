@@ -91,6 +91,29 @@ def digit_count(value: int) -> str:
         return f"more than {sys.get_int_max_str_digits()}"
 
 
+def check_option_numbers(options, integrator) -> None:
+    """Refuse, in one line naming the option and what it takes, an integer in ``options`` (a
+    mapping of an integrator's option names to values) too long to be shown or to become a
+    float: ``float(10**400)`` overflows, and a message would print every digit. Other values
+    are the integrator's own check (:meth:`~deforma.physics.integrators.base.Option.check`).
+
+    Examples
+    --------
+    >>> from deforma.physics.integrators import make_integrator
+    >>> check_option_numbers({"tolerance": 10**400}, make_integrator("avbd"))
+    Traceback (most recent call last):
+    ...
+    ValueError: avbd option tolerance must be a number in [0, inf), got an integer of 401 digits
+    """
+    if not hasattr(options, "items"):
+        return  # the integrator says what a table of options is
+    known = {o.name: o for o in type(integrator).OPTIONS}
+    for key, value in options.items():
+        if key in known and isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**40:
+            raise ValueError(f"{integrator.name} option {key} must be {known[key].allowed()}, got an integer of "
+                             f"{digit_count(value)} digits")
+
+
 def _limited(v: float, value, name: str, unit: str, lo: float, lo_open: bool) -> float:
     if v < lo or (lo_open and v == lo):  # the sign first: the usual mistake, said as before
         raise ValueError(f"{name} must be {'>' if lo_open else '>='} {lo:g} {unit}, got {value!r}")

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..checks import MAX_COORDINATE, MAX_GRAVITY, MAX_SUBSTEPS, MIN_SUBSTEP
+from ..checks import MAX_COORDINATE, MAX_GRAVITY, MAX_SUBSTEPS, MIN_SUBSTEP, check_option_numbers
 from ..checks import non_negative as _non_negative
 from ..checks import number as _finite
 from ..checks import pair as _pair
@@ -621,6 +621,7 @@ class World:
 
     @integrator_options.setter
     def integrator_options(self, options: Mapping[str, Any]) -> None:
+        check_option_numbers(options, self._integrator)  # 10**400: one line, not an OverflowError
         self._integrator.configure(options)
 
     @property

@@ -126,12 +126,13 @@ def pin_mask(spec, positions) -> np.ndarray:
                              f"the box over the part to hold")
         mask |= inside
     if spec.pin_vertices:
-        idx = np.asarray(spec.pin_vertices, dtype=np.int64)
-        if idx.min() < 0 or idx.max() >= len(x):
-            bad = int(idx[(idx < 0) | (idx >= len(x))][0])
+        # the range first, on Python's integers: 10**30 would overflow an int64 array
+        outside = [int(i) for i in spec.pin_vertices if not 0 <= i < len(x)]
+        if outside:
+            bad = outside[0]
             raise ValueError(f"pin_vertices: vertex index {bad} is out of range; the body has vertices "
                              f"0..{len(x) - 1}")
-        mask[idx] = True
+        mask[np.asarray(spec.pin_vertices, dtype=np.int64)] = True
     return mask
 
 

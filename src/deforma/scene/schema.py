@@ -53,7 +53,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 # an image body's background: the rule of deforma.mesh.from_image itself
-from ..checks import LIMITS, MAX_COORDINATE, check_box_points, digit_count
+from ..checks import LIMITS, MAX_COORDINATE, check_box_points, check_option_numbers, digit_count
 from ..mesh.image import check_background
 from .assets import picture_reference, resolve_picture, resolve_texture, texture_reference
 from .construct import build
@@ -318,6 +318,8 @@ def _kind(data, path, kinds: dict, default: str):
     if not isinstance(data, dict):
         raise _Problem(path, f"expected a table, got {_show(data)}")
     shape = data.get("shape", default)
+    if not isinstance(shape, str):  # an array or a table is no name (and cannot be looked up: unhashable)
+        raise _Problem(f"{path}.shape", f"expected a string, got {_show(shape)}; allowed: {', '.join(kinds)}")
     if shape not in kinds:
         close = difflib.get_close_matches(str(shape), list(kinds), n=1)
         hint = f"did you mean {close[0]!r}? " if close else ""
@@ -469,7 +471,8 @@ def _check_integrator_options(physics: PhysicsSettings, path: str) -> PhysicsSet
     from ..physics.integrators.base import unknown_option
 
     name = physics.integrator
-    options = {o.name: o for o in type(make_integrator(name)).OPTIONS}
+    integrator = make_integrator(name)
+    options = {o.name: o for o in type(integrator).OPTIONS}
     given = {}
     for key, value in physics.integrator_options:
         if key not in options:
@@ -477,6 +480,7 @@ def _check_integrator_options(physics: PhysicsSettings, path: str) -> PhysicsSet
         if options[key].kind == "int" and isinstance(value, float) and value.is_integer():
             value = int(value)  # as for the file's other integer keys (substeps = 2.0)
         try:
+            check_option_numbers({key: value}, integrator)  # 10**400: said, not an OverflowError
             given[key] = options[key].check(value, name)
         except ValueError as e:
             raise _Problem(f"{path}.{key}", str(e)) from None
@@ -555,6 +559,11 @@ def parse_scene(data: dict, *, source: str = "<scene>", base_dir=None) -> Scene:
                         _check_joint(out[-1], p, len(values.get("body", ())))
                 values[name] = tuple(out)
         _check_materials(values)
+        # what World(grab_strength=) refuses, said by this file's key
+        strength = values["interaction"].mouse_strength if "interaction" in values else None
+        lo, hi = LIMITS["grab_strength"]
+        if strength is not None and not lo <= strength <= hi:
+            raise _Problem("interaction.mouse_strength", f"must be in [{lo:g}, {hi:g}] N/m, got {strength:g}")
         follow = values["camera"].follow if "camera" in values else None
         if follow is not None and follow >= len(values.get("body", ())):
             n = len(values.get("body", ()))

@@ -558,6 +558,9 @@ def material_settings(physics: PhysicsSettings, body: BodyPhysics | None = None)
     springs = [k for k in _SPRING_KEYS if body is not None and getattr(body, k) is not None]
     if model != "springs" and springs:
         where = "" if "material" in own else " (physics.material)"
+        if model == "rigid":  # no elasticity to speak of: a rigid body's mass is all it has
+            raise MaterialKeyError(springs[0], f"the body is 'rigid'{where}, whose mass is density * area and which "
+                                               f"does not deform: remove {springs[0]}, or set material = \"springs\"")
         raise MaterialKeyError(springs[0], f"the body is made of {model!r} finite elements{where}, whose mass is "
                                            f"density * area and whose elasticity is youngs_modulus and "
                                            f"poisson_ratio: remove {springs[0]}, or set material = \"springs\"")
