@@ -46,3 +46,15 @@ def patched_matrices(monkeypatch):
 
     monkeypatch.setattr(implicit, "system_matrix", system_matrix)
     return checked
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under pytest-xdist (``-n``, ``--dist loadgroup``): each test file runs whole in one
+    worker, in its order (module-scoped fixtures and tests that build on the one before), and
+    every file that opens OpenGL contexts or windows (render/, viewer/, and the examples that
+    draw) runs in one worker, in the order a serial run has: two viewer tests, run after
+    another set of GL files in a second process, read a black window."""
+    for item in items:
+        path = item.path.as_posix()
+        gl = "/tests/render/" in path or "/tests/viewer/" in path
+        item.add_marker(pytest.mark.xdist_group("gl" if gl else path))
