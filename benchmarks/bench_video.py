@@ -65,7 +65,10 @@ def one_frame_at_a_time() -> None:
     def write_now(self, frame):
         if self._closed:
             raise ValueError(f"{self.path}: writer is closed")
-        self._write(np.ascontiguousarray(self._check(frame)))
+        f = np.ascontiguousarray(self._check(frame))
+        if self.frames_written == 0:
+            self._start(f)  # what the writer's thread needs first (an MP4's ffmpeg), as write() does
+        self._write(f)
         self.frames_written += 1
 
     recorder.FrameRecorder.__init__ = init_one
