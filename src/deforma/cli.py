@@ -661,15 +661,16 @@ def cmd_scenes(a) -> int:
 
 
 def cmd_warmup(a) -> int:
+    from .scene.assets import builtin_scenes
     from .startup import CompileWatch
     from .warmup import warm_up
 
     on_terminal = bool(getattr(sys.stderr, "isatty", lambda: False)())
-    from .scene.assets import builtin_scenes
-
     bar = _progress(len(builtin_scenes()), on_terminal, "warm-up", "scene") if on_terminal else None
+    done = []
 
     def progress(name: str) -> None:
+        done.append(name)
         if bar is not None:
             bar.set_postfix_str(name)
             bar.update(1)
@@ -678,7 +679,7 @@ def cmd_warmup(a) -> int:
         seconds = warm_up(progress=progress)
     if bar is not None:
         bar.close()
-    print(f"warm-up: {len(builtin_scenes())} built-in scenes in {seconds:.1f} s "
+    print(f"warm-up: {len(done)} built-in scenes in {seconds:.1f} s "
           + (f"({watch.seconds:.1f} s compiling {watch.compiled} kernels)" if watch.compiled
              else "(every kernel was already compiled)"))
     return 0

@@ -67,7 +67,7 @@ def _exercise(name: str, steps: int) -> None:
     world = scenes.load(name).build()
     for _ in range(steps):
         world.step()
-    soft = [b for b in world.bodies if b.material.model != "rigid"] or world.bodies
+    soft = [b for b in world.bodies if not b.material.is_rigid] or world.bodies
     if soft:
         centre = np.asarray(soft[0].positions, dtype=float).mean(axis=0)
         try:
