@@ -8,6 +8,7 @@ background as well as on a dark scene or a textured body passing behind it.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -89,6 +90,7 @@ def _metrics(h: int) -> tuple[int, int, int, int, int]:
 _LABEL_CHARS = "t = -0123456789.s kmcµ"
 
 
+@functools.lru_cache(maxsize=16)  # asked at every frame a view draws with its overlay on (75 us a call)
 def overlay_insets(height: int) -> tuple[int, int]:
     """Rows ``(top, bottom)`` of a picture ``height`` pixels high that the overlay's text may use.
 
