@@ -171,6 +171,16 @@ def test_a_body_drifting_slowly_through_space_keeps_its_momentum():
     assert still.sleeping and not body.sleeping
 
 
+def _step_until_touching(w, a, b, steps, failure):
+    """Step ``w`` until ``a`` and ``b`` (bodies or a collider) touch; fail with ``failure`` if
+    they do not within ``steps`` steps."""
+    for _ in range(steps):
+        w.step()
+        if w.contacts_between(a, b) is not None:
+            return
+    pytest.fail(failure)
+
+
 def test_a_sleeping_body_is_awake_for_the_step_a_thrown_body_reaches_it():
     # woken only after the step of the impact (by its contact pairs), the sleeping box met
     # the thrown one held, as a wall: the cards scene's wheel bounced off the house of cards
@@ -181,12 +191,7 @@ def test_a_sleeping_body_is_awake_for_the_step_a_thrown_body_reaches_it():
     w.step()  # (a body added wakes every island at the next step)
     low.sleeping = True
     top.velocities = np.tile([0.0, -8.0], (top.n_vertices, 1))  # 13 cm a step: past any contact margin
-    for _ in range(120):
-        w.step()
-        if w.contacts_between(low, top) is not None:
-            break
-    else:
-        pytest.fail("the thrown box never reached the one below")
+    _step_until_touching(w, low, top, 120, "the thrown box never reached the one below")
     # it moved in the step of the impact: held (asleep), its velocities would stay exactly 0
     assert np.abs(low.velocities).max() > 0.0
 
@@ -200,10 +205,5 @@ def test_a_sleeping_body_is_awake_for_the_step_a_moving_collider_reaches_it():
     paddle.velocity = (6.0, 0.0)  # 10 cm a step, towards the box 0.85 m away
     w.step()  # (a collider's change of motion wakes every island at the next step)
     box.sleeping = True
-    for _ in range(60):
-        w.step()
-        if w.contacts_between(box, paddle) is not None:
-            break
-    else:
-        pytest.fail("the paddle never reached the box")
+    _step_until_touching(w, box, paddle, 60, "the paddle never reached the box")
     assert np.abs(box.velocities).max() > 0.0  # held (asleep), they would stay exactly 0
