@@ -14,7 +14,11 @@ Run from the repository root::
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from bench_rigid import pyramid_boxes  # noqa: E402 - the benchmark's layout: the scene is what it measures
 
 OUT = Path(__file__).resolve().parents[1] / "src" / "deforma" / "assets" / "scenes" / "pyramid.toml"
 ROWS = 20
@@ -26,9 +30,10 @@ COLORS = ("#d9822b", "#f2d091")   # the rows alternate: burnt orange, sand
 
 
 def boxes(rows: int = ROWS) -> list[tuple[int, float, float]]:
-    """(row, x, y) of each box's centre, bottom row first: ``pyramid_boxes()`` of the benchmark."""
-    return [(r, (c - (rows - r - 1) / 2) * (SIZE + GAP), SIZE / 2 + r * (SIZE + LIFT))
-            for r in range(rows) for c in range(rows - r)]
+    """(row, x, y) of each box's centre, bottom row first: ``pyramid_boxes()`` of the benchmark
+    (row r holds rows - r boxes), with its row."""
+    row = [r for r in range(rows) for _ in range(rows - r)]
+    return [(r, x, y) for r, (x, y, _, _) in zip(row, pyramid_boxes(rows), strict=True)]
 
 
 def scene() -> str:
