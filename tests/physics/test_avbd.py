@@ -291,7 +291,7 @@ def test_an_impact_is_split_so_the_box_below_is_not_crushed():
     except deforma.SimulationUnstable as error:
         assert "lost its shape" in str(error)
     else:
-        assert worst_unsplit > 10 and least_unsplit < 0.25
+        assert worst_unsplit > 10 and least_unsplit < 0.3
 
 
 def test_the_jelly_stack_settles():
@@ -307,17 +307,17 @@ def test_the_jelly_stack_settles():
     assert inverted_triangles(w) == 0
 
 
-OVER_BRAKED = pytest.mark.xfail(strict=True, reason=(
-    "at ten sweeps the rows between the bodies end each step pushing 28 % over the block's weight "
-    "(10.3 N against 8.04 N at 35 degrees, the mean over its slide), so friction brakes the slide by "
-    "29 % too much (2.29 against 3.22 m/s^2); 2.6 % over at forty sweeps (issue 48)"))
-
-
-@pytest.mark.parametrize("iterations", [pytest.param(10, marks=OVER_BRAKED), 40])
+# at ten sweeps, with rows between the bodies as stiff as the stiffer side, they ended each
+# step pushing 28 % over the block's weight (10.3 N against 8.04 N at 35 degrees) and friction
+# braked the slide 29 % too much (avbd.rows.BODY_PENALTY_SHARE)
+@pytest.mark.parametrize("iterations, plank_stiffness", [(10, None), (40, None), (10, 2e5)])
 @pytest.mark.parametrize("angle, mu_s, mu_d", [(35.0, 0.5, 0.3), (30.0, 0.4, 0.1)])
-def test_a_block_slides_down_another_body_at_g_sin_minus_mu_cos(angle, mu_s, mu_d, iterations):
-    w, _, block, _, t = plank_and_block(angle, mu_s=mu_s, mu_d=mu_d, damping=2.0, integrator="avbd", dt=H,
+def test_a_block_slides_down_another_body_at_g_sin_minus_mu_cos(angle, mu_s, mu_d, iterations, plank_stiffness):
+    # (on a plank ten times stiffer than the block, 2e5 N/m, it was braked 76 % too much)
+    w, plank, block, _, t = plank_and_block(angle, mu_s=mu_s, mu_d=mu_d, damping=2.0, integrator="avbd", dt=H,
                                             substeps=1)
+    if plank_stiffness is not None:
+        plank.stiffness = plank_stiffness
     w.integrator_options = {"iterations": iterations}
     accel, _ = slide_acceleration(w, block, t, steps=48, after=0.3)
     a = math.radians(angle)

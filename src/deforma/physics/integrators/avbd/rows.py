@@ -91,6 +91,15 @@ MEMORY_COLUMNS = 5
 #: of a step (m/s) is held by static friction in the step, a faster one by dynamic friction.
 STICK_SPEED = 0.01
 
+#: A row between two soft bodies starts at this share of the softer side's start (``k_start``
+#: of its collision vertex against its edge's stiffer end). As stiff as the stiffer side, a row
+#: pinned its vertices to each other: a sweep moves each only a little towards the other's
+#: place, the ten sweeps of a step left the rows' forces scattered by newtons about the
+#: load, and the dual step, which keeps only what pushes, summed them 28 % over it (a block
+#: sliding down a soft plank was braked 29 % too hard, 76 % on a stiffer plank). The load
+#: is carried by the multipliers, warm-started from the step before.
+BODY_PENALTY_SHARE = 0.1
+
 
 @njit(cache=True, inline="always")
 def warm_start(state, k, memory, m, same, k0, carry, soften, k_max):
@@ -290,11 +299,13 @@ def body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, bgeo, state, c):
 
 
 @njit(cache=True)
-def start_body_rows(topo, buf, count, memory, state, bidx, bgeo, k_start, carry, soften, k_max, v):
+def start_body_rows(topo, buf, count, memory, state, bidx, bgeo, k_start, carry, soften, k_max, v, rigid):
     """Open the step's body rows (``buf[:count]``): their vertices into ``bidx`` and their
     geometry into ``bgeo`` (:data:`RowSet`), warm-started from ``memory`` (per collision
     vertex: edge, ``lambda_n``, ``lambda_t``, ``k_n``, ``k_t``) when the same vertex met the
-    same edge last step; static friction for the step when the pair's relative velocity
+    same edge, or the edge next to it, last step; a row between two soft bodies at least
+    :data:`BODY_PENALTY_SHARE` of the softer side's ``k_start``, any other at least its
+    stiffest vertex's; static friction for the step when the pair's relative velocity
     along the edge was below :data:`STICK_SPEED` as it began. Where two outlines lie face to
     face each contact comes twice (a vertex of each side against the other's edge), and
     both rows keep their friction: each is bounded by its own normal force, and the normal
@@ -302,11 +313,31 @@ def start_body_rows(topo, buf, count, memory, state, bidx, bgeo, k_start, carry,
     with only that side's share of the load: a block on a plank on a 15 degree slope,
     static friction 0.5, slid at 1.5 m/s^2."""
     cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    # a vertex that slid onto the next edge of the same outline keeps its row's warm start:
+    # the contact goes on. (Begun again from nothing at every edge it crossed, a block
+    # sliding at 2 m/s, half an edge a step, met the plank with rows that carried no load
+    # yet, sank into it and was braked by the rows that did.) One row per vertex inherits:
+    # the same edge's if it has one, else the first neighbouring edge's.
+    claimed = np.zeros(memory.shape[0], np.bool_)
     for c in range(count):
-        q = buf.vertex[c]
-        ip, ia, ib = cv[q], cv[ce_a[buf.edge[c]]], cv[ce_b[buf.edge[c]]]
-        k0 = max(k_start[ip], k_start[ia], k_start[ib])
-        warm_start(state, c, memory, q, memory[q, MEM_ROW] == buf.edge[c], k0, carry, soften, k_max)
+        if memory[buf.vertex[c], MEM_ROW] == buf.edge[c]:
+            claimed[buf.vertex[c]] = True
+    for c in range(count):
+        q, e = buf.vertex[c], buf.edge[c]
+        ip, ia, ib = cv[q], cv[ce_a[e]], cv[ce_b[e]]
+        if rigid[ip] or rigid[ia] or rigid[ib] or topo.cv_body[q] == topo.ce_body[e]:
+            # a rigid vertex's own start is its share of the body's inertia, not what holds
+            # it (that is :func:`start_rigid_rows`' business): the soft side's start; and a
+            # body against itself (an ear folded onto a head) has one material on both sides
+            k0 = max(k_start[ip], k_start[ia], k_start[ib])
+        else:
+            k0 = BODY_PENALTY_SHARE * min(k_start[ip], max(k_start[ia], k_start[ib]))
+        m = int(memory[q, MEM_ROW])
+        same = m == e
+        if not same and m >= 0 and not claimed[q] and (ce_a[m] == ce_a[e] or ce_a[m] == ce_b[e]
+                                                        or ce_b[m] == ce_a[e] or ce_b[m] == ce_b[e]):
+            same = claimed[q] = True
+        warm_start(state, c, memory, q, same, k0, carry, soften, k_max)
         s = buf.s[c]
         nx, ny = buf.normal[c, 0], buf.normal[c, 1]
         bidx[c, 0], bidx[c, 1], bidx[c, 2] = ip, ia, ib

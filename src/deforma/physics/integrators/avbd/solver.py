@@ -929,7 +929,7 @@ class AVBD(Integrator):
             self._b_entry = np.empty(6 * n_body, np.int64)
         opts = self._options
         start_body_rows(ctopo, buf, n_body, self._body_memory[0], self._bstate, self._bidx, self._bgeo, k_start,
-                        self.CARRY, self.SOFTEN, opts["penalty_max"], v)
+                        self.CARRY, self.SOFTEN, opts["penalty_max"], v, model.rigid)
         body_row_incidence(self._bidx, n_body, model.n_vertices, self._b_start, self._b_entry)
         nc = self._n_corner
         n_edges = len(ctopo.ce_a)
