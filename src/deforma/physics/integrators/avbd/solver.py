@@ -355,6 +355,25 @@ def sweep_colour_given(x, x_n, y, mass_h2, inv_mass, order, start, stop, g, hb, 
 
 
 @njit(cache=True)
+def ease_apart(topo, buf, count, full, rigid, share, step):
+    """Raise the target of each contact between soft vertices that
+    :func:`~deforma.physics.contact.response.hold_start_distance` held closer than ``share``
+    of its thickness ``full`` towards that share, by at most ``step`` (m). Held only where it
+    began, such a pair (after a hard landing) sank by the rows' tolerance in every step and
+    the fail-safe put it back: the resting ``jelly`` stack, in every step for good. (Rigid
+    pairs rest closer by design: their fail-safe keeps the bodies whole.)"""
+    cv, ce_a, ce_b = topo.cv_vertex, topo.ce_a, topo.ce_b
+    for c in range(count):
+        held = buf.target[c]
+        if held >= share * full[c]:
+            continue
+        e = buf.edge[c]
+        if rigid[cv[buf.vertex[c]]] or rigid[cv[ce_a[e]]] or rigid[cv[ce_b[e]]]:
+            continue
+        buf.target[c] = min(share * full[c], held + step)
+
+
+@njit(cache=True)
 def narrow_targets(topo, buf, count, margin):
     """Take the margin back off the targets of the contacts between two bodies found with
     their thickness widened by it (:meth:`AVBD._collide`)."""
@@ -435,6 +454,12 @@ def chebyshev_omega(k: int, rho: float, previous: float) -> float:
 #: The contact stage after the solve, the fail-safe, acts on pairs closer than this share of
 #: their contact thickness (:meth:`AVBD._failsafe_topology`).
 FAILSAFE_SHARE = 0.5
+#: A pair of soft outlines that begins a step closer than ``EASE_SHARE * FAILSAFE_SHARE`` of its
+#: contact thickness has its row's target raised towards that by at most ``EASE_SPEED`` (m/s)
+#: times the step: the rows, not the fail-safe, take it back out, slowly enough that it
+#: does not fly apart (:func:`ease_apart`).
+EASE_SHARE = 1.2
+EASE_SPEED = 0.01
 
 
 @register_integrator("avbd")
@@ -716,7 +741,7 @@ class AVBD(Integrator):
                 x_n = self._x_n
                 # collide once, before the solve: the collider contacts and the body contacts of
                 # the predicted motion (each held no closer than its pair began the step)
-                count, n_body, found = self._collide(x_n, self._y, rects, ctopo, scr, hs)
+                count, n_body, found = self._collide(x_n, self._y, rects, ctopo, scr, hs, model.rigid)
                 if parts == 1 and reach > 0.0:
                     size = self._edge_size(model)
                     deep = max(deepest_reach(self._y, v, self._planes, self._touch, count, ctopo, found, n_body, size,
@@ -870,7 +895,7 @@ class AVBD(Integrator):
         return ctopo._replace(thick_other=ctopo.thick_other * share, thick_self=ctopo.thick_self * share,
                               body_thickness=ctopo.body_thickness * share)
 
-    def _collide(self, x_n, y, rects, ctopo, scr, h):
+    def _collide(self, x_n, y, rects, ctopo, scr, h, rigid):
         """Collide once, before the solve: the collider contacts of the predicted motion
         from ``x_n`` to ``y`` and the body contacts within a margin of it, ``(count, n_body,
         buffer)``.
@@ -903,7 +928,9 @@ class AVBD(Integrator):
             mine.status["pairs_needed"][0] = 0
             self._search = (ctopo, mine, found)
         narrow_targets(ctopo, found, n_body, margin)
+        full = found.target[:n_body].copy()
         hold_start_distance(x_n, ctopo, found, n_body)
+        ease_apart(ctopo, found, n_body, full, rigid, EASE_SHARE * FAILSAFE_SHARE, EASE_SPEED * h)
         # collider corners an outline edge may meet, within the same margin
         while True:
             n_corner = corner_contacts(x_n, y, rects, ctopo.ce_a, ctopo.ce_b, ctopo.cv_vertex, margin, h,
