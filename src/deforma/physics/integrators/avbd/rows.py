@@ -99,6 +99,11 @@ STICK_SPEED = 0.01
 #: sliding down a soft plank was braked 29 % too hard, 76 % on a stiffer plank). The load
 #: is carried by the multipliers, warm-started from the step before.
 BODY_PENALTY_SHARE = 0.1
+#: ... but no softer than lets a row sink this far (m) in a step by the share of its load
+#: its warm start does not carry over (``(1 - carry) lambda / k``): at a tenth of the softer
+#: side's start, a box's corner carrying 22 N on another box's side in the resting ``pile``
+#: sank 0.2 mm a step, past the fail-safe's line, and the fail-safe put it back in every step.
+BODY_SINK = 1e-4
 
 
 @njit(cache=True, inline="always")
@@ -304,8 +309,8 @@ def start_body_rows(topo, buf, count, memory, state, bidx, bgeo, k_start, carry,
     geometry into ``bgeo`` (:data:`RowSet`), warm-started from ``memory`` (per collision
     vertex: edge, ``lambda_n``, ``lambda_t``, ``k_n``, ``k_t``) when the same vertex met the
     same edge, or the edge next to it, last step; a row between two soft bodies at least
-    :data:`BODY_PENALTY_SHARE` of the softer side's ``k_start``, any other at least its
-    stiffest vertex's; static friction for the step when the pair's relative velocity
+    :data:`BODY_PENALTY_SHARE` of the softer side's ``k_start`` (and as :data:`BODY_SINK`
+    asks), any other at least its stiffest vertex's; static friction for the step when the pair's relative velocity
     along the edge was below :data:`STICK_SPEED` as it began. Where two outlines lie face to
     face each contact comes twice (a vertex of each side against the other's edge), and
     both rows keep their friction: each is bounded by its own normal force, and the normal
@@ -325,7 +330,8 @@ def start_body_rows(topo, buf, count, memory, state, bidx, bgeo, k_start, carry,
     for c in range(count):
         q, e = buf.vertex[c], buf.edge[c]
         ip, ia, ib = cv[q], cv[ce_a[e]], cv[ce_b[e]]
-        if rigid[ip] or rigid[ia] or rigid[ib] or topo.cv_body[q] == topo.ce_body[e]:
+        soft_pair = not (rigid[ip] or rigid[ia] or rigid[ib] or topo.cv_body[q] == topo.ce_body[e])
+        if not soft_pair:
             # a rigid vertex's own start is its share of the body's inertia, not what holds
             # it (that is :func:`start_rigid_rows`' business): the soft side's start; and a
             # body against itself (an ear folded onto a head) has one material on both sides
@@ -338,6 +344,8 @@ def start_body_rows(topo, buf, count, memory, state, bidx, bgeo, k_start, carry,
                                                         or ce_b[m] == ce_a[e] or ce_b[m] == ce_b[e]):
             same = claimed[q] = True
         warm_start(state, c, memory, q, same, k0, carry, soften, k_max)
+        if same and soft_pair:  # (see BODY_SINK)
+            state[c, K_N] = min(max(state[c, K_N], (1.0 - carry) * state[c, LAG] / BODY_SINK), k_max)
         s = buf.s[c]
         nx, ny = buf.normal[c, 0], buf.normal[c, 1]
         bidx[c, 0], bidx[c, 1], bidx[c, 2] = ip, ia, ib
