@@ -49,6 +49,7 @@ OPTION_VALUES = {
     "reach": st.sampled_from([0.0, 0.5, 5.0]), "chebyshev": st.sampled_from([0.0, 0.5, 0.99]),
     "penalty_start": st.sampled_from([1e-6, 1.0, 1e6]), "penalty_ramp": st.sampled_from([0.0, 1e5, 1e12]),
     "penalty_max": st.sampled_from([1.0, 1e10, 1e17]), "mode": st.sampled_from(["auto", "serial", "parallel"]),
+    "start": st.sampled_from(["velocity", "rigid"]),
 }
 #: values of the right kind for the keys that are neither numbers, pairs, names nor switches
 KIND_VALUES = {

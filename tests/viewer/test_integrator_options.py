@@ -21,7 +21,7 @@ ROWS = {"symplectic-euler": ["integrator_mode"],
                           "integrator_contact_weight"],
         "avbd": ["integrator_mode", "integrator_iterations", "integrator_tolerance", "integrator_reach",
                  "integrator_order",
-                 "integrator_cluster_size",
+                 "integrator_cluster_size", "integrator_start",
                  "integrator_chebyshev",
                  "integrator_penalty_start", "integrator_penalty_ramp", "integrator_penalty_max",
                  "integrator_rigid_passes"]}
@@ -31,7 +31,7 @@ def test_every_registered_option_has_a_row_apart_from_the_fixed_ones():
     rows = {p.name: p for p in integrator_params()}
     assert list(rows) == ["integrator_mode", "integrator_iterations", "integrator_tolerance",
                           "integrator_max_iterations", "integrator_contact_weight", "integrator_reach",
-                          "integrator_order", "integrator_cluster_size",
+                          "integrator_order", "integrator_cluster_size", "integrator_start",
                           "integrator_chebyshev", "integrator_penalty_start", "integrator_penalty_ramp",
                           "integrator_penalty_max", "integrator_rigid_passes"]
     assert not set(rows) & set(PARAMS)
