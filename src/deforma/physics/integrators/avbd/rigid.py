@@ -355,6 +355,21 @@ def _place_listed(x, x_n, act, p0, p1, cnx, cny, cx, cy, phi):
         x[i, 1] = cy + si * rx + co * ry
 
 
+@njit(cache=True, inline="always")
+def centre_and_velocity(x, v, mass, a, b):
+    """``(M, cx, cy, vx, vy)``: the mass of vertices ``a:b``, their centre of mass and its
+    velocity."""
+    sm = cx = cy = px = py = 0.0
+    for i in range(a, b):
+        m = mass[i]
+        sm += m
+        cx += m * x[i, 0]
+        cy += m * x[i, 1]
+        px += m * v[i, 0]
+        py += m * v[i, 1]
+    return sm, cx / sm, cy / sm, px / sm, py / sm
+
+
 @njit(cache=True)
 def rigid_targets(x, v, x_n, y, vertex_mass, blocks, gx, gy, keep, force, has_force, h):
     """Start a substep for the rigid bodies (after :func:`~deforma.physics.integrators.avbd.solver.predict`,
@@ -364,17 +379,7 @@ def rigid_targets(x, v, x_n, y, vertex_mass, blocks, gx, gy, keep, force, has_fo
     h2 = h * h
     for k in range(blocks.lo.shape[0]):
         a, b = blocks.lo[k], blocks.hi[k]
-        sm = cx = cy = px = py = 0.0
-        for i in range(a, b):
-            m = vertex_mass[i]
-            sm += m
-            cx += m * x_n[i, 0]
-            cy += m * x_n[i, 1]
-            px += m * v[i, 0]
-            py += m * v[i, 1]
-        cx /= sm
-        cy /= sm
-        vx, vy = px / sm, py / sm
+        sm, cx, cy, vx, vy = centre_and_velocity(x_n, v, vertex_mass, a, b)
         moment = spin = fx = fy = tau = 0.0
         for i in range(a, b):
             m = vertex_mass[i]

@@ -97,6 +97,7 @@ from .joints import (
     update_joint_rows,
 )
 from .rigid import (
+    centre_and_velocity,
     rigid_active,
     rigid_blocks,
     rigid_correction,
@@ -177,22 +178,9 @@ def start_rigidly(x, x_n, v, mass, inv_mass, body_start, hk):
     rigidly it rests. A body with a pinned vertex keeps its vertices' velocities."""
     for body in range(body_start.shape[0] - 1):
         lo, hi = body_start[body], body_start[body + 1]
-        sm = cx = cy = px = py = 0.0
-        for i in range(lo, hi):
-            if inv_mass[i] == 0.0:
-                sm = -1.0
-                break
-            m = mass[i]
-            sm += m
-            cx += m * x_n[i, 0]
-            cy += m * x_n[i, 1]
-            px += m * v[i, 0]
-            py += m * v[i, 1]
-        if sm <= 0.0:
+        if hi == lo or (inv_mass[lo:hi] == 0.0).any():
             continue
-        cx /= sm
-        cy /= sm
-        vx, vy = px / sm, py / sm
+        _, cx, cy, vx, vy = centre_and_velocity(x_n, v, mass, lo, hi)
         ang = ine = 0.0
         for i in range(lo, hi):
             rx, ry = x_n[i, 0] - cx, x_n[i, 1] - cy
