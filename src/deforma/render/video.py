@@ -353,6 +353,7 @@ class Mp4Writer(FrameWriter):
         self.quality = quality
         self._tmp = temp_beside(self.path)
         self._gen = None
+        self._proc = None
 
     def _start(self, frame):
         # ffmpeg is started here, in the caller's thread: started from the writer's thread, the
@@ -372,6 +373,9 @@ class Mp4Writer(FrameWriter):
             self._gen.send(None)
         except OSError as e:
             raise self._failed(e) from None
+        # ffmpeg's process, to be sure it is gone before its file is removed (_discard)
+        frame_locals = self._gen.gi_frame.f_locals if self._gen.gi_frame is not None else {}
+        self._proc = frame_locals.get("p")
 
     def _write(self, frame):
         h, w = frame.shape[:2]
@@ -416,6 +420,17 @@ class Mp4Writer(FrameWriter):
             try:
                 self._gen.close()
             except BaseException:  # noqa: BLE001 - ffmpeg may already be gone after Ctrl-C
+                pass
+        # imageio-ffmpeg kills ffmpeg when stopped (SIGTERM, Ctrl-C) but does not wait for it:
+        # ffmpeg, still finishing a call, wrote its file again after it was removed (a run
+        # stopped by SIGTERM under load left its .partial.mp4 behind)
+        proc = self._proc
+        if proc is not None:
+            try:
+                if proc.poll() is None:
+                    proc.kill()
+                proc.wait(timeout=10)
+            except BaseException:  # noqa: BLE001 - a second signal: remove what we can
                 pass
         self._tmp.unlink(missing_ok=True)
 
