@@ -16,6 +16,7 @@ that thread is raised, as one line, by the next :meth:`~FrameWriter.write` or by
 from __future__ import annotations
 
 import errno
+import logging
 import os
 import queue
 import shutil
@@ -417,10 +418,17 @@ class Mp4Writer(FrameWriter):
 
     def _discard(self):
         if self._gen is not None:
+            # (stopped before its first frame, imageio-ffmpeg warns on stderr that "the written
+            # video is invalid": it is being removed, and the run says so in its own line)
+            log = logging.getLogger("imageio_ffmpeg")
+            was = log.disabled
+            log.disabled = True
             try:
                 self._gen.close()
             except BaseException:  # noqa: BLE001 - ffmpeg may already be gone after Ctrl-C
                 pass
+            finally:
+                log.disabled = was
         # imageio-ffmpeg kills ffmpeg when stopped (SIGTERM, Ctrl-C) but does not wait for it:
         # ffmpeg, still finishing a call, wrote its file again after it was removed (a run
         # stopped by SIGTERM under load left its .partial.mp4 behind)
