@@ -356,9 +356,10 @@ def _place_listed(x, x_n, act, p0, p1, cnx, cny, cx, cy, phi):
 
 
 @njit(cache=True, inline="always")
-def centre_and_velocity(x, v, mass, a, b):
-    """``(M, cx, cy, vx, vy)``: the mass of vertices ``a:b``, their centre of mass and its
-    velocity."""
+def centre_velocity_spin(x, v, mass, a, b):
+    """``(M, cx, cy, vx, vy, omega)``: the mass of vertices ``a:b``, their centre of mass,
+    its velocity and the vertices' spin about it (angular momentum over moment of inertia;
+    0 for a single vertex)."""
     sm = cx = cy = px = py = 0.0
     for i in range(a, b):
         m = mass[i]
@@ -367,7 +368,14 @@ def centre_and_velocity(x, v, mass, a, b):
         cy += m * x[i, 1]
         px += m * v[i, 0]
         py += m * v[i, 1]
-    return sm, cx / sm, cy / sm, px / sm, py / sm
+    cx, cy, vx, vy = cx / sm, cy / sm, px / sm, py / sm
+    moment = spin = 0.0
+    for i in range(a, b):
+        m = mass[i]
+        rx, ry = x[i, 0] - cx, x[i, 1] - cy
+        moment += m * (rx * rx + ry * ry)
+        spin += m * (rx * (v[i, 1] - vy) - ry * (v[i, 0] - vx))
+    return sm, cx, cy, vx, vy, (spin / moment if moment > 0.0 else 0.0)
 
 
 @njit(cache=True)
@@ -379,18 +387,13 @@ def rigid_targets(x, v, x_n, y, vertex_mass, blocks, gx, gy, keep, force, has_fo
     h2 = h * h
     for k in range(blocks.lo.shape[0]):
         a, b = blocks.lo[k], blocks.hi[k]
-        sm, cx, cy, vx, vy = centre_and_velocity(x_n, v, vertex_mass, a, b)
-        moment = spin = fx = fy = tau = 0.0
-        for i in range(a, b):
-            m = vertex_mass[i]
-            rx, ry = x_n[i, 0] - cx, x_n[i, 1] - cy
-            moment += m * (rx * rx + ry * ry)
-            spin += m * (rx * (v[i, 1] - vy) - ry * (v[i, 0] - vx))
-            if has_force:
+        _, cx, cy, vx, vy, omega = centre_velocity_spin(x_n, v, vertex_mass, a, b)
+        fx = fy = tau = 0.0
+        if has_force:
+            for i in range(a, b):
                 fx += force[i, 0]
                 fy += force[i, 1]
-                tau += rx * force[i, 1] - ry * force[i, 0]
-        omega = spin / moment if moment > 0.0 else 0.0
+                tau += (x_n[i, 0] - cx) * force[i, 1] - (x_n[i, 1] - cy) * force[i, 0]
         blocks.c_n[k, 0], blocks.c_n[k, 1] = cx, cy
         blocks.v_n[k, 0], blocks.v_n[k, 1], blocks.v_n[k, 2] = vx, vy, omega
         blocks.load[k, 0] = gx + fx / blocks.mass[k]

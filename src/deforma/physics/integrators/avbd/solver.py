@@ -97,7 +97,7 @@ from .joints import (
     update_joint_rows,
 )
 from .rigid import (
-    centre_and_velocity,
+    centre_velocity_spin,
     rigid_active,
     rigid_blocks,
     rigid_correction,
@@ -178,15 +178,12 @@ def start_rigidly(x, x_n, v, mass, inv_mass, body_start, hk):
     rigidly it rests. A body with a pinned vertex keeps its vertices' velocities."""
     for body in range(body_start.shape[0] - 1):
         lo, hi = body_start[body], body_start[body + 1]
-        if hi == lo or (inv_mass[lo:hi] == 0.0).any():
-            continue
-        _, cx, cy, vx, vy = centre_and_velocity(x_n, v, mass, lo, hi)
-        ang = ine = 0.0
+        pinned = False
         for i in range(lo, hi):
-            rx, ry = x_n[i, 0] - cx, x_n[i, 1] - cy
-            ang += mass[i] * (rx * (v[i, 1] - vy) - ry * (v[i, 0] - vx))
-            ine += mass[i] * (rx * rx + ry * ry)
-        w = ang / ine if ine > 0.0 else 0.0
+            pinned = pinned or inv_mass[i] == 0.0
+        if hi == lo or pinned:
+            continue
+        _, cx, cy, vx, vy, w = centre_velocity_spin(x_n, v, mass, lo, hi)
         for i in range(lo, hi):
             rx, ry = x_n[i, 0] - cx, x_n[i, 1] - cy
             x[i, 0] += hk * (vx - w * ry - v[i, 0])
