@@ -140,6 +140,42 @@ def test_sigterm_and_sighup_clean_up_like_ctrl_c(tmp_path):
         kill_leftovers([p for _, _, p in runs])
 
 
+def test_a_stop_whose_exception_python_dropped_still_stops_the_run(tmp_path, capsys, monkeypatch):
+    # a SIGHUP that arrived as ffmpeg's process was started ran its handler inside a fork hook,
+    # where Python prints the handler's exception as "Exception ignored" and drops it: that run
+    # wrote its whole video and exited 0. Here the signal comes inside a finaliser, where Python
+    # drops it the same way; the run must stop at its next frame and leave nothing.
+    import os
+    import signal
+    import sys
+
+    from deforma.cli import Stopped
+    from deforma.render import world_view
+
+    dropped, calls = [], []
+    monkeypatch.setattr(sys, "unraisablehook", lambda u: dropped.append(u.exc_type))
+    real = world_view.WorldView.draw
+
+    class Finaliser:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(1000):  # the handler runs here, inside the finaliser
+                pass
+
+    def draw(self, **kw):
+        calls.append(1)
+        if len(calls) == 3:
+            Finaliser()  # dropped at once: its __del__ runs now
+        return real(self, **kw)
+
+    monkeypatch.setattr(world_view.WorldView, "draw", draw)
+    code, _, err = run(capsys, "run", "sample", "--seconds", "1", "--size", "64x48", "--quiet", "-o",
+                       str(tmp_path / "out.mp4"))
+    assert dropped == [Stopped]  # Python did drop the handler's exception
+    assert code == 128 + signal.SIGTERM and err.endswith("stopped by SIGTERM; no partial output was left\n")
+    assert len(calls) == 3 and os.listdir(tmp_path) == []
+
+
 def test_ctrl_c_in_a_png_folder_run_leaves_no_frames(tmp_path, capsys, monkeypatch):
     import os
 

@@ -42,6 +42,21 @@ class Stopped(BaseException):
         self.signum = signum
 
 
+#: The signal whose :class:`Stopped` the handler raised, until the handlers are restored
+#: (see :func:`_raise_if_stopped`).
+_stopping: list[int] = []
+
+
+def _raise_if_stopped() -> None:
+    """Raise :class:`Stopped` again for a signal whose handler ran but whose exception Python
+    dropped. A handler that runs inside a fork hook (ffmpeg's process being started) or a
+    finaliser has its exception printed as "Exception ignored" and the command goes on: a run
+    sent SIGHUP just then wrote its whole video and exited 0. The frame loop calls this once
+    a frame."""
+    if _stopping:
+        raise Stopped(_stopping[0])
+
+
 def _stop_on_signals():
     """Make SIGTERM and SIGHUP raise :class:`Stopped`; returns a function that restores the old handlers."""
     import signal
@@ -54,11 +69,13 @@ def _stop_on_signals():
     def handler(signum, frame):
         for n in signums:  # a second signal must not cut through the clean-up
             signal.signal(n, signal.SIG_IGN)
+        _stopping.append(signum)
         raise Stopped(signum)
 
     previous = {n: signal.signal(n, handler) for n in signums}
 
     def restore():
+        _stopping.clear()
         for n, h in previous.items():
             signal.signal(n, h)
     return restore
@@ -453,6 +470,7 @@ def _run_scene(a, watch, shown: dict) -> int:
         # the scene's [[event]] explosions and [[pull]] grabs, frame by frame
         playback = Playback(scene, world, fps=fps, record=bool(a.states))
         for k in playback.frames(n_frames):
+            _raise_if_stopped()
             if recorder is not None:
                 recorder.add()
             if export is not None:
