@@ -185,9 +185,14 @@ def group_pairs(imp: ContactImpulses, vertex_body: np.ndarray, bodies, colliders
     if not len(rows):
         return {}
     # the other side: a body (>= 0) or a collider (encoded -1 - index)
-    other = np.where(hi[rows] >= 0, hi[rows], -1 - imp.collider[rows])
-    key = np.stack([lo[rows], other], axis=1)
-    uniq, which = np.unique(key, axis=0, return_inverse=True)
+    other = np.where(hi[rows] >= 0, hi[rows], -1 - imp.collider[rows]).astype(np.int64)
+    # one integer per (lo, other), in the same order: np.unique(axis=0) compares rows as
+    # structured arrays, and NumPy turns a Ctrl-C that lands in that comparison into a
+    # TypeError ("Cannot compare structured arrays"), which escaped a run as a traceback
+    first = int(other.min())
+    width = int(other.max()) - first + 1
+    codes, which = np.unique(lo[rows].astype(np.int64) * width + (other - first), return_inverse=True)
+    uniq = np.stack([codes // width, codes % width + first], axis=1)
     which = which.reshape(-1)
     n = imp.normal[rows] * sign[rows, None]
     t = np.stack([-n[:, 1], n[:, 0]], axis=1)
