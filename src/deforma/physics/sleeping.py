@@ -26,8 +26,8 @@ Units: m/s, s.
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+
+from .union_find import component_labels
 
 #: A body whose every vertex is slower than this (m/s) is still.
 SLEEP_SPEED = 5e-3
@@ -94,9 +94,10 @@ def islands(n_bodies: int, links: np.ndarray) -> np.ndarray:
     >>> islands(4, np.array([[0, 2], [2, 3]])).tolist()
     [0, 1, 0, 0]
     """
-    links = np.asarray(links, np.int64).reshape(-1, 2)
-    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n_bodies, n_bodies))
-    return connected_components(graph, directed=False)[1]
+    links = np.ascontiguousarray(links, np.int64).reshape(-1, 2)
+    if not len(links):
+        return np.arange(n_bodies, dtype=np.int64)
+    return component_labels(n_bodies, links)
 
 
 def sleep_changes(asleep: np.ndarray, still: np.ndarray, speed: np.ndarray, label: np.ndarray,

@@ -1,9 +1,10 @@
-"""Union-find over an array of parents, shared by the contact fail-safe's impact zones and
-tearing's pieces.
+"""Union-find over an array of parents, shared by the contact fail-safe's impact zones,
+tearing's pieces and sleeping's islands.
 """
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 
@@ -14,3 +15,25 @@ def find_root(parent, k):
         parent[k] = parent[parent[k]]
         k = parent[k]
     return k
+
+
+@njit(cache=True)
+def component_labels(n, links):
+    """Each of ``n`` nodes' component (n,) int64 under the undirected ``links`` (L, 2) int64,
+    numbered in the order of each component's first node (as SciPy's ``connected_components``
+    numbers them, at a hundredth of its cost for a few bodies: it was 0.3 ms of every step)."""
+    parent = np.arange(n)
+    for e in range(links.shape[0]):
+        a, b = find_root(parent, links[e, 0]), find_root(parent, links[e, 1])
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    label = np.empty(n, np.int64)
+    count = 0
+    for k in range(n):
+        r = find_root(parent, k)
+        if r == k:
+            label[k] = count
+            count += 1
+        else:
+            label[k] = label[r]
+    return label
