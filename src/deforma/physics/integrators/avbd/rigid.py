@@ -498,19 +498,39 @@ def _share(x, v, a, b, w, cx, cy, nx, ny, sums):
 def block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc):
     """The gradient and Hessian over a rigid body's pose (vertices ``a:b``, centre ``(cx,
     cy)``, those with a row or a grab ``act[p0:p1]``) of its grabs and contact rows, into
-    ``acc`` (see :func:`_add_row`). A row between
+    ``acc[:9]`` (see :func:`_add_row`), and their energy where the body is (J, what
+    :func:`rigid_energy` gives for no move) into ``acc[9]``: the line search's start, from the
+    same pass over the rows (a pass of its own was a third of the pyramid's step). A row between
     two of its own vertices (an edge of its outline) is counted once with the moments of
     both: summed vertex by vertex, its stiffness lost the cross terms and a box met on an
     edge's middle took half of it."""
-    for j in range(9):
+    for j in range(10):
         acc[j] = 0.0
     sums = np.zeros(3)
+    e = 0.0
     for q in range(p0, p1):
         i = act[q]
         s = grab_slot[i]
         rx, ry = x[i, 0] - cx, x[i, 1] - cy
+        # a soft body's joints held by this vertex, each side once: their energy alone (their
+        # gradient is the joint's block's)
+        for p in range(rs.jv[i], rs.jv[i + 1]):
+            code = rs.jv[p]
+            if code % 3:
+                continue
+            j, side = code // 6, (code // 3) % 2
+            px_, py_ = 0.0, 0.0
+            for slot in range(3):
+                vtx = rs.ji[j, FV + 3 * side + slot]
+                px_ += rs.jf[j, FW + 3 * side + slot] * x[vtx, 0]
+                py_ += rs.jf[j, FW + 3 * side + slot] * x[vtx, 1]
+            ox, oy = held_point(x, rs.ji, rs.jf, j, 1 - side)
+            sg = 1.0 if side == 0 else -1.0
+            e += joint_point_energy(rs.ji, rs.jf, j, sg * (px_ - ox), sg * (py_ - oy))
         if s >= 0:  # a zero-length spring of strength S to the target
             k = grab_pull[s, 0]
+            tx, ty = grab_pull[s, 1] / k, grab_pull[s, 2] / k
+            e += 0.5 * k * ((x[i, 0] - tx) ** 2 + (x[i, 1] - ty) ** 2)
             gx, gy = k * x[i, 0] - grab_pull[s, 1], k * x[i, 1] - grab_pull[s, 2]
             acc[0] += gx
             acc[1] += gy
@@ -527,6 +547,7 @@ def block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc)
             fn, ft, _, _, _ = contact_forces(x, x_n, i, rs.planes, rs.rows, k)
             nx, ny = rs.planes[k, 0], rs.planes[k, 1]
             st = rs.rows
+            e += row_energy(fn, ft, st[k, K_N], st[k, K_T], st[k, BOUND])
             _add_row(acc, fn, ft, st[k, K_N], st[k, K_T], st[k, BOUND], nx, ny, 1.0, rx * ny - ry * nx,
                      rx * nx + ry * ny)
         for p in range(rs.b_start[i], rs.b_start[i + 1]):
@@ -540,6 +561,7 @@ def block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc)
             _share(x, ib, a, b, -s, cx, cy, nx, ny, sums)
             fn, ft, _, _, _ = body_row_forces(x, x_n, ip, ia, ib, s, nx, ny, target, rs.bgeo, rs.bstate, c)
             st = rs.bstate
+            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
             _add_row(acc, fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND], nx, ny, sums[0], sums[1], sums[2])
         for p in range(rs.c_start[i], rs.c_start[i + 1]):
             c = rs.c_entry[p] // 2
@@ -553,7 +575,9 @@ def block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc)
             _share(x, ib, a, b, s, cx, cy, nx, ny, sums)
             fn, ft, _, _, _ = corner_row_forces(x, x_n, ia, ib, rs.cf, rs.cstate, c)
             st = rs.cstate
+            e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
             _add_row(acc, fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND], nx, ny, sums[0], sums[1], sums[2])
+    acc[9] = e
 
 
 @njit(cache=True)
@@ -565,7 +589,7 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_o
     (N,): no mass per vertex (the body's own inertia replaces its vertices'). Returns the
     largest squared vertex move (m^2)."""
     most = 0.0
-    acc = np.zeros(9)
+    acc = np.zeros(10)
     act, act_start = blocks.act, blocks.act_start
     for k in range(blocks.lo.shape[0]):
         if blocks.held[k] or (joined_only and (jr.j_start[k + 1] == jr.j_start[k] or jr.island_touch[jr.island[k]])):
@@ -595,8 +619,7 @@ def rigid_sweep(x, x_n, zeros, blocks, grab_slot, grab_pull, rs, jr, h, joined_o
             continue
         step = 1.0
         if p1 > p0 or joined:  # rows, grabs or joints: backtrack on the objective (else it is quadratic: exact)
-            e0 = _inertia_energy(blocks, k, cx, cy, phi, inv_h2) + rigid_energy(
-                x, x_n, x_n, zeros, act, p0, p1, a, b, grab_slot, grab_pull, rs, cx, cy, 0.0, 0.0, 0.0)
+            e0 = _inertia_energy(blocks, k, cx, cy, phi, inv_h2) + acc[9]
             if joined:
                 e0 += joint_energy(jr, blocks, x, k, cx, cy, phi)
             while step > 1e-3:
