@@ -238,7 +238,7 @@ class Model:
         self.contact = ContactTopology(i32(cv), i32(cb), vertex_cv, body_outline, body_interior, tri, body_tri,
                                        i32(ea), i32(eb), i32(ebody),
                                        np.zeros(v), np.zeros(v), np.zeros(nb, np.int32), np.zeros(nb),
-                                       np.zeros((nb, 2)), np.zeros(1), np.zeros(nb + 1, np.int64),
+                                       np.zeros((nb, 2)), np.array([0.0, np.inf]), np.zeros(nb + 1, np.int64),
                                        np.zeros(0, np.int32), np.zeros(1))
         for b in range(nb):
             if contact is not None:

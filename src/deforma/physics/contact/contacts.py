@@ -65,7 +65,12 @@ ContactTopology = namedtuple("ContactTopology", [
     "body_flags",       # (B,) int32: COLLIDE | SELF_COLLIDE
     "body_thickness",   # (B,) float64: each body's contact thickness (m)
     "body_friction",    # (B, 2) float64: dynamic, static coefficient for body contacts
-    "margin",           # (1,) float64: growth of the edge boxes (m): SPECULATIVE times the largest thickness
+    "margin",           # (2,) float64: growth of the edge boxes (m): SPECULATIVE times the largest
+                        #   thickness; and the slack of a body's own pairs (m): narrow_phase lists
+                        #   only those that may come within their reach plus 3 times this as they
+                        #   move (inf: every pair whose boxes overlap, as the contact stage wants;
+                        #   avbd's one search of a step, whose boxes its motion widens, gives the
+                        #   stage's margin)
     "joined_start",     # (B + 1,) int64: CSR, the bodies a joint holds to body b (which it does not collide with)
     "joined",           # (P,) int32: ... are joined[joined_start[b]:joined_start[b + 1]]
     "behind",           # (1,) float64: a vertex that starts behind another body's outline edge by
@@ -118,7 +123,7 @@ def empty_topology(n_bodies: int = 0) -> ContactTopology:
     i32, f64, offsets = np.zeros(0, np.int32), np.zeros(0), np.zeros(n_bodies + 1, np.int64)
     return ContactTopology(i32, i32, i32, offsets, offsets, np.zeros((0, 3), np.int32), offsets, i32, i32, i32, f64,
                            f64, np.zeros(n_bodies, np.int32),
-                           np.zeros(n_bodies), np.zeros((n_bodies, 2)), np.zeros(1), np.zeros(n_bodies + 1, np.int64),
+                           np.zeros(n_bodies), np.zeros((n_bodies, 2)), np.array([0.0, np.inf]), np.zeros(n_bodies + 1, np.int64),
                            i32, np.zeros(1))
 
 

@@ -170,6 +170,58 @@ def _holds(joined_start, joined, a, b):
     return False
 
 
+@njit(cache=True, inline="always")
+def _may_meet(xp, x, cv, k, a, b, reach):
+    """Whether collision vertex ``k`` may come within ``reach`` (m) of the edge ``(a, b)`` as
+    all three move in a straight line from ``xp`` to ``x`` (rows of ``x``: ``cv``): its start
+    distance from the edge, less how far it moves relative to either end, is within
+    ``reach``. Exact as a bound: the gap between a point and a point of the edge at a fixed
+    place along it changes by at most the larger of the two relative moves. A body in flight
+    moves its outline together: its swept boxes overlap everywhere along it, but its own
+    pairs do not move apart or together (a donut thrown at 6 m/s had 574,024 candidate pairs
+    with itself and 84 contacts; the pairs took 21 ms of its 51 ms step)."""
+    ik, ia, ib = cv[k], cv[a], cv[b]
+    dkx, dky = x[ik, 0] - xp[k, 0], x[ik, 1] - xp[k, 1]
+    rel = max(math.hypot(dkx - (x[ia, 0] - xp[a, 0]), dky - (x[ia, 1] - xp[a, 1])),
+              math.hypot(dkx - (x[ib, 0] - xp[b, 0]), dky - (x[ib, 1] - xp[b, 1])))
+    ex, ey = xp[b, 0] - xp[a, 0], xp[b, 1] - xp[a, 1]
+    qx, qy = xp[k, 0] - xp[a, 0], xp[k, 1] - xp[a, 1]
+    ll = ex * ex + ey * ey
+    s = min(max((qx * ex + qy * ey) / ll, 0.0), 1.0) if ll > 0.0 else 0.0
+    gap = math.hypot(qx - s * ex, qy - s * ey)
+    return gap <= reach + rel + 1e-9 * (1.0 + gap)
+
+
+@njit(cache=True)
+def _own_frames(x, topo, scr):
+    """Per self-colliding body, its outline's mean move from ``scr.xp`` to ``x`` (B, 2), and
+    per outline edge its swept box with that move taken away (Ec, 4: xmin, ymin, xmax,
+    ymax): a body's own pairs meet only where these boxes do, however far it goes."""
+    cv, xp, flags = topo.cv_vertex, scr.xp, topo.body_flags
+    nb = flags.shape[0]
+    shift = np.zeros((nb, 2))
+    for b in range(nb):
+        lo, hi = topo.body_outline[b], topo.body_outline[b + 1]
+        if (flags[b] & SELF_COLLIDE) == 0 or hi == lo:
+            continue
+        for k in range(lo, hi):
+            shift[b, 0] += x[cv[k], 0] - xp[k, 0]
+            shift[b, 1] += x[cv[k], 1] - xp[k, 1]
+        shift[b, 0] /= hi - lo
+        shift[b, 1] /= hi - lo
+    ce_a, ce_b, ce_body = topo.ce_a, topo.ce_b, topo.ce_body
+    rbox = np.empty((ce_a.shape[0], 4))
+    for j in range(ce_a.shape[0]):
+        a, b, eb = ce_a[j], ce_b[j], ce_body[j]
+        ax, ay = x[cv[a], 0] - shift[eb, 0], x[cv[a], 1] - shift[eb, 1]
+        bx, by = x[cv[b], 0] - shift[eb, 0], x[cv[b], 1] - shift[eb, 1]
+        rbox[j, 0] = min(min(xp[a, 0], xp[b, 0]), min(ax, bx))
+        rbox[j, 1] = min(min(xp[a, 1], xp[b, 1]), min(ay, by))
+        rbox[j, 2] = max(max(xp[a, 0], xp[b, 0]), max(ax, bx))
+        rbox[j, 3] = max(max(xp[a, 1], xp[b, 1]), max(ay, by))
+    return shift, rbox
+
+
 @njit(cache=True)
 def narrow_phase(x, topo, scr, out):
     """List the candidate pairs: a collision vertex and an outline edge whose boxes overlap.
@@ -190,6 +242,10 @@ def narrow_phase(x, topo, scr, out):
     mask = np.int64(scr.cell_fill.shape[0] - 1)
     pcap = pair_vertex.shape[0]
     n_outline = topo.body_interior[0]
+    # a body's own pairs: how much further than their reach they may be and still be listed
+    # (ContactTopology.margin; inf: every pair whose boxes overlap)
+    reach = 3.0 * topo.margin[1]
+    shift, rbox = _own_frames(x, topo, scr)
     n = 0
     for m in range(scr.status.active[0]):
         k = active[m]
@@ -226,7 +282,16 @@ def narrow_phase(x, topo, scr, out):
                     if eb == bk:
                         if inner or (fk & SELF_COLLIDE) == 0:
                             continue
-                        if ce_a[j] == k or ce_b[j] == k:
+                        a = ce_a[j]
+                        b = ce_b[j]
+                        if a == k or b == k:
+                            continue
+                        g = SPECULATIVE * thick_self[k] + reach
+                        px, py = x[i, 0] - shift[bk, 0], x[i, 1] - shift[bk, 1]
+                        if (rbox[j, 0] > max(xp[k, 0], px) + g or rbox[j, 2] < min(xp[k, 0], px) - g
+                                or rbox[j, 1] > max(xp[k, 1], py) + g or rbox[j, 3] < min(xp[k, 1], py) - g):
+                            continue
+                        if not _may_meet(xp, x, cv, k, a, b, g):
                             continue
                     elif (fk & COLLIDE) == 0 or (flags[eb] & COLLIDE) == 0:
                         continue

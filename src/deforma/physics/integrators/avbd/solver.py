@@ -947,8 +947,11 @@ class AVBD(Integrator):
         # the stage after the sweep then tested (a block sliding at 1.5 m/s was braked by
         # its own outline there)
         margin = float(np.sqrt(((y - x_n) ** 2).sum(axis=1).max())) if len(y) else 0.0
+        # (its pairs are listed once: a body's own by how its outline moves relative to
+        # itself, not by how far the body goes, with the stage's margin as slack)
         wide = ctopo._replace(thick_other=ctopo.thick_other + margin, body_thickness=ctopo.body_thickness + margin,
-                              margin=ctopo.margin + SPECULATIVE * margin, behind=self._behind)
+                              margin=np.array([ctopo.margin[0] + SPECULATIVE * margin, ctopo.margin[0]]),
+                              behind=self._behind)
         if self._search is None or self._search[0] is not ctopo:
             self._search = (ctopo, make_scratch(len(ctopo.cv_vertex), len(ctopo.ce_a), len(ctopo.body_thickness)),
                             make_buffer(64, 64))
