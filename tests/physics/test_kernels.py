@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 import deforma
 from deforma.physics.integrators import symplectic
@@ -191,3 +193,63 @@ def test_the_implicit_matrix_assembly_matches_a_dense_sum():
     keep = ~pinned[more_r]
     np.add.at(dense, (more_r[keep], more_c[keep]), more_v[keep])
     assert b.has_canonical_format and np.allclose(b.toarray(), dense, rtol=0, atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 30), st.lists(st.tuples(st.integers(0, 29), st.integers(0, 29)), max_size=40))
+def test_island_labels_are_scipys_connected_components(n, links):
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from deforma.physics.sleeping import islands
+
+    links = np.array([(a % n, b % n) for a, b in links], np.int64).reshape(-1, 2)
+    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n, n))
+    np.testing.assert_array_equal(islands(n, links), connected_components(graph, directed=False)[1])
+
+
+def _contacts_found(topo, x0, x1, margins):
+    """The candidate pairs and the contacts (vertex, edge, kind) in order of the motion
+    ``x0 -> x1`` under the ContactTopology ``topo`` with its margins replaced by ``margins``."""
+    from deforma.physics.contact.broad_phase import build_grid, gather_start
+    from deforma.physics.contact.contacts import make_buffer, make_scratch
+    from deforma.physics.contact.narrow_phase import activate_vertices, check_pairs, narrow_phase
+
+    t = topo._replace(margin=np.array(margins, float))
+    scr = make_scratch(len(t.cv_vertex), len(t.ce_a), len(t.body_thickness))
+    buf = make_buffer(20_000, 2_000_000)
+    gather_start(x0, t, scr)
+    activate_vertices(x1, t, scr)
+    build_grid(x1, t, scr, t.margin[0])
+    n = narrow_phase(x1, t, scr, buf)
+    c = check_pairs(x1, t, scr, buf, 0, n, True, False)
+    assert n >= 0 and c >= 0
+    return n, list(zip(buf.vertex[:c].tolist(), buf.edge[:c].tolist(), buf.kind[:c].tolist()))
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-0.3, 1.0), st.floats(-0.5, 0.5))
+@example(0.5, 0.2, 0.0, 0.0).via("squeezed flat in flight")
+@example(0.3, 0.2, -0.2, 0.2).via("turned inside out in flight")
+@example(0.5, 0.2, 1.0, 0.0).via("a pure flight")
+def test_a_bodys_own_pairs_listed_by_its_relative_motion_lose_no_contact(dx, dy, squeeze, turn):
+    # a donut flies (dx, dy) in a step while its hole is squeezed shut (squeeze <= 0: its
+    # outline crosses itself) and it turns: the pairs
+    # of its outline with itself are listed by how it moves relative to itself (margin[1]: the
+    # slack; 0, the tightest, for a search done once), and must give the same contacts, in the
+    # same order, as every pair whose swept boxes overlap (margin[1] = inf)
+    w = deforma.World()
+    b = w.add_body(deforma.mesh.from_image("donut", resolution=12, scale=0.0012), position=(0.0, 0.0))
+    topo = w.model.contact
+    x0 = b.positions.copy()
+    c = x0.mean(axis=0)
+    r = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    x1 = (x0 - c) * [1.0, squeeze] @ r.T + c + [dx, dy]
+    every_n, every = _contacts_found(topo, x0, x1, [topo.margin[0] + 2.0 * np.hypot(dx, dy), np.inf])
+    own_n, own = _contacts_found(topo, x0, x1, [topo.margin[0] + 2.0 * np.hypot(dx, dy), 0.0])
+    assert own == every
+    assert own_n <= every_n
+    if squeeze <= 0.0:  # the outline went through itself: contacts to find
+        assert len(every) > 100
+    if squeeze == 1.0 and turn == 0.0 and np.hypot(dx, dy) > 0.1:  # a pure flight lists almost nothing
+        assert own_n < every_n / 10
