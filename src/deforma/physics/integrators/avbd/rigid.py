@@ -241,6 +241,28 @@ def _moved(x, v, lo, hi, cx, cy, dx, dy, co, si):
     return x[v, 0], x[v, 1]
 
 
+@njit(cache=True, inline="always")
+def _soft_joint_energy(x, jv, ji, jf, i, lo, hi, cx, cy, dx, dy, co, si):
+    """The energy (J) of the soft bodies' joints whose triangle vertex ``i`` is the first of
+    (``jv``: :class:`~deforma.physics.integrators.avbd.rows.RowSet`'s), each side once, with
+    the vertices ``lo:hi`` moved as :func:`_moved` moves them."""
+    e = 0.0
+    for p in range(jv[i], jv[i + 1]):
+        code = jv[p]
+        if code % 3:
+            continue
+        j, side = code // 6, (code // 3) % 2
+        px, py = 0.0, 0.0
+        for slot in range(3):
+            vx, vy = _moved(x, ji[j, FV + 3 * side + slot], lo, hi, cx, cy, dx, dy, co, si)
+            px += jf[j, FW + 3 * side + slot] * vx
+            py += jf[j, FW + 3 * side + slot] * vy
+        ox, oy = held_point(x, ji, jf, j, 1 - side)
+        sg = 1.0 if side == 0 else -1.0
+        e += joint_point_energy(ji, jf, j, sg * (px - ox), sg * (py - oy))
+    return e
+
+
 @njit(cache=True)
 def rigid_energy(x, x_n, y, mass_h2, verts, p0, p1, lo, hi, grab_slot, grab_pull, rs, cx, cy, dx, dy, th):
     """The objective's inertia, grab and contact-row part (J) over the vertices ``verts[p0:p1]``
@@ -295,21 +317,8 @@ def rigid_energy(x, x_n, y, mass_h2, verts, p0, p1, lo, hi, grab_slot, grab_pull
             fn, ft, _, _, _ = corner_row_forces_at(pax, pay, pbx, pby, x_n[ia, 0], x_n[ia, 1], x_n[ib, 0], x_n[ib, 1],
                                                    rs.cf, st, c)
             e += row_energy(fn, ft, st[c, K_N], st[c, K_T], st[c, BOUND])
-        # a soft body's joints, each side once (at its triangle's first vertex)
-        for p in range(rs.jv[i], rs.jv[i + 1]):
-            code = rs.jv[p]
-            if code % 3:
-                continue
-            j, side = code // 6, (code // 3) % 2
-            px_, py_ = 0.0, 0.0
-            for slot in range(3):
-                vx, vy = _moved(x, rs.ji[j, FV + 3 * side + slot], lo, hi, cx, cy, dx, dy, co, si)
-                px_ += rs.jf[j, FW + 3 * side + slot] * vx
-                py_ += rs.jf[j, FW + 3 * side + slot] * vy
-            ox, oy = held_point(x, rs.ji, rs.jf, j, 1 - side)
-            sg = 1.0 if side == 0 else -1.0
-            e += joint_point_energy(rs.ji, rs.jf, j, sg * (px_ - ox),
-                                    sg * (py_ - oy))
+        if rs.jv[i + 1] > rs.jv[i]:  # a soft body's joints
+            e += _soft_joint_energy(x, rs.jv, rs.ji, rs.jf, i, lo, hi, cx, cy, dx, dy, co, si)
     return e
 
 
@@ -512,21 +521,8 @@ def block_rows(x, x_n, a, b, act, p0, p1, cx, cy, grab_slot, grab_pull, rs, acc)
         i = act[q]
         s = grab_slot[i]
         rx, ry = x[i, 0] - cx, x[i, 1] - cy
-        # a soft body's joints held by this vertex, each side once: their energy alone (their
-        # gradient is the joint's block's)
-        for p in range(rs.jv[i], rs.jv[i + 1]):
-            code = rs.jv[p]
-            if code % 3:
-                continue
-            j, side = code // 6, (code // 3) % 2
-            px_, py_ = 0.0, 0.0
-            for slot in range(3):
-                vtx = rs.ji[j, FV + 3 * side + slot]
-                px_ += rs.jf[j, FW + 3 * side + slot] * x[vtx, 0]
-                py_ += rs.jf[j, FW + 3 * side + slot] * x[vtx, 1]
-            ox, oy = held_point(x, rs.ji, rs.jf, j, 1 - side)
-            sg = 1.0 if side == 0 else -1.0
-            e += joint_point_energy(rs.ji, rs.jf, j, sg * (px_ - ox), sg * (py_ - oy))
+        if rs.jv[i + 1] > rs.jv[i]:  # a soft body's joints: their energy alone (the gradient is the joint's block's)
+            e += _soft_joint_energy(x, rs.jv, rs.ji, rs.jf, i, a, b, cx, cy, 0.0, 0.0, 1.0, 0.0)
         if s >= 0:  # a zero-length spring of strength S to the target
             k = grab_pull[s, 0]
             tx, ty = grab_pull[s, 1] / k, grab_pull[s, 2] / k
