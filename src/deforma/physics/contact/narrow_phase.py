@@ -245,7 +245,11 @@ def narrow_phase(x, topo, scr, out):
     # a body's own pairs: how much further than their reach they may be and still be listed
     # (ContactTopology.margin; inf: every pair whose boxes overlap)
     reach = 3.0 * topo.margin[1]
-    shift, rbox = _own_frames(x, topo, scr)
+    sorted_own = reach < np.inf
+    if sorted_own:
+        shift, rbox = _own_frames(x, topo, scr)
+    else:  # (the contact stage: not worth the frames)
+        shift, rbox = np.zeros((0, 2)), np.zeros((0, 4))
     n = 0
     for m in range(scr.status.active[0]):
         k = active[m]
@@ -286,13 +290,14 @@ def narrow_phase(x, topo, scr, out):
                         b = ce_b[j]
                         if a == k or b == k:
                             continue
-                        g = SPECULATIVE * thick_self[k] + reach
-                        px, py = x[i, 0] - shift[bk, 0], x[i, 1] - shift[bk, 1]
-                        if (rbox[j, 0] > max(xp[k, 0], px) + g or rbox[j, 2] < min(xp[k, 0], px) - g
-                                or rbox[j, 1] > max(xp[k, 1], py) + g or rbox[j, 3] < min(xp[k, 1], py) - g):
-                            continue
-                        if not _may_meet(xp, x, cv, k, a, b, g):
-                            continue
+                        if sorted_own:
+                            g = SPECULATIVE * thick_self[k] + reach
+                            px, py = x[i, 0] - shift[bk, 0], x[i, 1] - shift[bk, 1]
+                            if (rbox[j, 0] > max(xp[k, 0], px) + g or rbox[j, 2] < min(xp[k, 0], px) - g
+                                    or rbox[j, 1] > max(xp[k, 1], py) + g or rbox[j, 3] < min(xp[k, 1], py) - g):
+                                continue
+                            if not _may_meet(xp, x, cv, k, a, b, g):
+                                continue
                     elif (fk & COLLIDE) == 0 or (flags[eb] & COLLIDE) == 0:
                         continue
                     elif _holds(joined_start, joined, bk, eb):
