@@ -227,7 +227,10 @@ def narrow_phase(x, topo, scr, out):
     """List the candidate pairs: a collision vertex and an outline edge whose boxes overlap.
 
     The vertex's swept box is grown by its contact thickness; pairs the flags or the outline
-    rule exclude are left out. Writes ``out.pair_vertex`` / ``out.pair_edge``; returns their
+    rule exclude are left out. Where ``topo.margin[1]`` is finite, a body's own pairs are
+    listed only where the two may meet as they move relative to each other (the boxes with
+    the body's mean move taken away, :func:`_own_frames`, then :func:`_may_meet`), with that
+    margin three times as slack. Writes ``out.pair_vertex`` / ``out.pair_edge``; returns their
     number, or ``-(needed)`` if they did not fit.
     """
     cv, body, flags = topo.cv_vertex, topo.cv_body, topo.body_flags
