@@ -192,6 +192,18 @@ def _may_meet(xp, x, cv, k, a, b, reach):
     return gap <= reach + rel + 1e-9 * (1.0 + gap)
 
 
+@njit(cache=True, inline="always")
+def _may_vanish(xp, x, cv, a, b):
+    """Whether the edge ``(a, b)`` may shrink through zero length as its ends move in a straight
+    line from ``xp`` to ``x`` (its body turned inside out in the step): its line then turns
+    over past points far from it, which :func:`pair_contact` takes as crossings, so its pairs
+    are listed whatever the bounds of :func:`_may_meet` and :func:`_own_frames` say."""
+    ex, ey = xp[b, 0] - xp[a, 0], xp[b, 1] - xp[a, 1]
+    mx = (x[cv[b], 0] - xp[b, 0]) - (x[cv[a], 0] - xp[a, 0])
+    my = (x[cv[b], 1] - xp[b, 1]) - (x[cv[a], 1] - xp[a, 1])
+    return mx * mx + my * my >= ex * ex + ey * ey
+
+
 @njit(cache=True)
 def _own_frames(x, topo, scr):
     """Per self-colliding body, its outline's mean move from ``scr.xp`` to ``x`` (B, 2), and
@@ -230,7 +242,7 @@ def narrow_phase(x, topo, scr, out):
     rule exclude are left out. Where ``topo.margin[1]`` is finite, a body's own pairs are
     listed only where the two may meet as they move relative to each other (the boxes with
     the body's mean move taken away, :func:`_own_frames`, then :func:`_may_meet`), with that
-    margin three times as slack. Writes ``out.pair_vertex`` / ``out.pair_edge``; returns their
+    margin three times as slack, or where the edge may vanish (:func:`_may_vanish`). Writes ``out.pair_vertex`` / ``out.pair_edge``; returns their
     number, or ``-(needed)`` if they did not fit.
     """
     cv, body, flags = topo.cv_vertex, topo.cv_body, topo.body_flags
@@ -293,7 +305,7 @@ def narrow_phase(x, topo, scr, out):
                         b = ce_b[j]
                         if a == k or b == k:
                             continue
-                        if sorted_own:
+                        if sorted_own and not _may_vanish(xp, x, cv, a, b):
                             g = SPECULATIVE * thick_self[k] + reach
                             px, py = x[i, 0] - shift[bk, 0], x[i, 1] - shift[bk, 1]
                             if (rbox[j, 0] > max(xp[k, 0], px) + g or rbox[j, 2] < min(xp[k, 0], px) - g
