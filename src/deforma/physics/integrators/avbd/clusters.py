@@ -87,26 +87,20 @@ def _add_jacobian_terms(g, hm, j00, j01, j02, j10, j11, j12, p0, p1, p2, p3, hf,
     3 x 3 blocks ``J0^T hf_uv J0`` of the 2 x 2 blocks of ``hf`` (the full 4 x 6 products
     cost the patches a fifth of their time). Each block is summed as the full product sums
     it, so the result is the same to the last bit."""
+    j0, j1 = (j00, j01, j02), (j10, j11, j12)  # J0's rows
     for p in range(3):
-        jp0 = j00 if p == 0 else (j01 if p == 1 else j02)
-        jp1 = j10 if p == 0 else (j11 if p == 1 else j12)
-        g[_X_UNKNOWNS[p]] += a * (jp0 * p0 + jp1 * p1)
-        g[_Y_UNKNOWNS[p]] += a * (jp0 * p2 + jp1 * p3)
+        g[_X_UNKNOWNS[p]] += a * (j0[p] * p0 + j1[p] * p1)
+        g[_Y_UNKNOWNS[p]] += a * (j0[p] * p2 + j1[p] * p3)
     for bu in range(2):
         for bv in range(2):
             h00, h01 = hf[2 * bu, 2 * bv], hf[2 * bu, 2 * bv + 1]
             h10, h11 = hf[2 * bu + 1, 2 * bv], hf[2 * bu + 1, 2 * bv + 1]
             for q in range(3):
-                jq0 = j00 if q == 0 else (j01 if q == 1 else j02)
-                jq1 = j10 if q == 0 else (j11 if q == 1 else j12)
-                m0, m1 = h00 * jq0 + h01 * jq1, h10 * jq0 + h11 * jq1  # (hf_uv J0)[:, q]
+                m0, m1 = h00 * j0[q] + h01 * j1[q], h10 * j0[q] + h11 * j1[q]  # (hf_uv J0)[:, q]
                 cq = _X_UNKNOWNS[q] if bv == 0 else _Y_UNKNOWNS[q]
                 for p in range(3):
-                    jp0 = j00 if p == 0 else (j01 if p == 1 else j02)
-                    jp1 = j10 if p == 0 else (j11 if p == 1 else j12)
-                    val = a * (jp0 * m0 + jp1 * m1)
+                    val = a * (j0[p] * m0 + j1[p] * m1)
                     hm[_X_UNKNOWNS[p] if bu == 0 else _Y_UNKNOWNS[p], cq] += val
-
 
 @njit(cache=True, inline="always")
 def add_moments(mom, gx, gy, hxx, hxy, hyy, a0, a1, a2):
