@@ -223,6 +223,36 @@ def test_a_block_rests_on_a_colliders_corner_held_by_a_row():
     assert b.positions[:, 1].min() < 1e-6
 
 
+def test_a_corner_beside_an_edge_as_the_step_begins_keeps_its_row_when_predicted_past_its_end():
+    """A collider's corner beside an outline edge as the step begins, but predicted just past
+    the edge's end, is still that edge's row: held by the end, along the line from the corner
+    to it. (Listed only where the prediction put it beside the edge, the corner had a row
+    every other step at a ``demo`` bunny's ear resting on a ramp's corner; in the steps
+    between, the solve pulled the edge back over it, the fail-safe pushed it off, and the
+    ear buzzed at 5 cm/s for good.) A corner past the end at the start as at the end is no
+    row of the edge's: a body slides off a ledge freely."""
+    from deforma.physics.colliders.response import (CORNER_COLUMNS, CORNER_NX, CORNER_NY, CORNER_S,
+                                                    corner_contacts)
+    from deforma.physics.colliders.shapes import pack_colliders
+
+    rects = pack_colliders([deforma.Rect((0.0, -0.1 / math.sqrt(2)), (0.1, 0.1), 45.0)], friction=0.3,
+                           static_friction=0.5)  # a diamond with its top corner at the origin
+    edge_a, edge_b, vertex = np.array([0], np.int32), np.array([1], np.int32), np.arange(2, dtype=np.int32)
+    pairs, out = np.zeros((4, 4), np.int64), np.zeros((4, CORNER_COLUMNS))
+
+    def listed(start_x, moved_x):
+        x0 = np.array([[start_x - 1.0, 0.001], [start_x, 0.001]])  # an edge 1 mm above, the body above it
+        y = x0 + [moved_x, -0.002]  # predicted 1 mm through the corner's height
+        return corner_contacts(x0, y, rects, edge_a, edge_b, vertex, 0.02, H, pairs, out)
+
+    assert listed(0.02, -0.01) == 1 and out[0, CORNER_S] == pytest.approx(0.99)  # beside it, as before
+    assert listed(0.02, -0.03) == 1  # beside it at the start, predicted 1 cm past the end
+    end = np.array([-0.01, -0.001])  # the end's predicted place, seen from the corner
+    assert out[0, CORNER_S] == 1.0
+    assert out[0, [CORNER_NX, CORNER_NY]] == pytest.approx(end / np.hypot(*end))
+    assert listed(-0.02, -0.01) == 0  # past the end all along
+
+
 def fastest(bodies):
     """The fastest vertex's speed (m/s)."""
     return max(float(np.hypot(*b.velocities.T).max()) for b in bodies)

@@ -89,6 +89,9 @@ def test_builtin_scene_frame_shows_each_body_where_it_is(gl_ctx, name):
     for b in world.bodies:
         px = np.floor(r.camera.world_to_pixel(b.positions, r.size)).astype(int)
         onscreen = (px[:, 0] >= 2) & (px[:, 0] < 318) & (px[:, 1] >= 2) & (px[:, 1] < 178)
+        if world.joints:  # a joint's dot is drawn over the body, its light centre near the sky's colour
+            dots = r.camera.world_to_pixel(np.array([j.point for j in world.joints]), r.size)
+            onscreen &= np.hypot(*(px[:, None, :] - dots[None]).transpose(2, 0, 1)).min(axis=1) > JOINT_DOT_PIXELS
         if not onscreen.any():
             continue
         # around each vertex (3x3 pixels) the picture differs from the empty one: the body is there
@@ -124,8 +127,30 @@ def test_builtin_scene_comes_to_rest_with_no_triangle_inside_out(name):
     for k, b in enumerate(world.bodies):
         area = signed_areas(b.positions, b.triangles)
         assert (area > 0).all(), (name, k, np.flatnonzero(area <= 0)[:5].tolist())
-    if name == "demo":  # issue 18: the video used to end as the bunny landed; now it rests first
-        assert np.abs(world.bodies[0].velocities).max() < 0.05
+    if name == "demo":
+        # issue 18: the video used to end as the bunny landed; now it lands by 8 s (when, the
+        # rounding of a chaotic tumble down three ramps decides) and its free ear's wobble
+        # dies down over the next seconds
+        for _ in range(int(round(10.0 / world.dt))):
+            world.step()
+        assert np.abs(world.bodies[0].velocities).max() < 0.01
+
+
+def test_demo_nudged_by_a_nanometre_rests_without_the_failsafe():
+    # the bunny started 1e-9 m off (another rounding would do the same) took the path where it
+    # rests with an ear on a ramp's corner; that corner had a solver row only every other
+    # step, the fail-safe pushed it back out of the ear in the steps between (60 times in
+    # 2 s), and the ear buzzed at 5 cm/s for good. Now the row stays.
+    world = scenes.load_scene("demo")
+    world.sleep = False  # (sleep off: the solver's own rest is measured)
+    (b,) = world.bodies
+    b.positions = b.positions + 1e-9 * np.random.default_rng(4).standard_normal(b.positions.shape)
+    for _ in range(int(round(10.0 / world.dt))):
+        world.step()
+    before = world.integrator_stats["failsafe"]
+    for _ in range(int(round(2.0 / world.dt))):
+        world.step()
+    assert world.integrator_stats["failsafe"] - before < 10
 
 
 def test_sample_box_lands_flat_without_turning_or_drifting():

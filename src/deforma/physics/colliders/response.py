@@ -468,7 +468,7 @@ def corner_count(rects, r):
 
 
 #: Columns of :func:`corner_contacts`' float output: the edge point's parameter ``s``, the
-#: edge's unit normal into the body, the corner at the end of the substep, how far it moved
+#: row's unit normal into the body (the edge's, or from the corner to the edge's end), the corner at the end of the substep, how far it moved
 #: in the substep, the static and dynamic friction coefficients and the gap to hold (m).
 CORNER_S, CORNER_NX, CORNER_NY, CORNER_PX, CORNER_PY, CORNER_MX, CORNER_MY = 0, 1, 2, 3, 4, 5, 6
 CORNER_STATIC, CORNER_DYNAMIC, CORNER_TARGET = 7, 8, 9
@@ -486,7 +486,10 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
     within ``margin`` of it or through it by less than its length, and was outside the body
     across this edge at the start, ``x0`` (seen from the collider, by under 1 % of the edge's
     length): a corner already through an edge, or one behind the body's far side, is no
-    contact of this edge's.
+    contact of this edge's. A corner beside the edge at the start but predicted past an end
+    is the edge's too, held by that end (``s`` 0 or 1) along the line from the corner to it,
+    within ``margin``: the solve may end it beside the edge again, and listed by the
+    prediction alone a corner at a resting body's outline vertex had a row every other step.
 
     Parameters
     ----------
@@ -551,21 +554,40 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
                 continue
             best, best_s, best_k = -margin, 0.0, -1
             best_px = best_py = best_mx = best_my = 0.0
+            best_nx, best_ny = nx, ny
             w = rects[r, OMEGA]
             for k in range(corner_count(rects, r)):
                 px, py = collider_corner(rects, r, k)
-                t = ((px - ax) * dx + (py - ay) * dy) / length2
-                depth = (px - ax) * nx + (py - ay) * ny
-                if not (0.0 < t < 1.0 and depth > best and depth * depth < length2):
-                    continue
                 # how far the corner moved in the substep: where it was at the start, against
                 # where the edge was
                 mx = h * (rects[r, VEL_X] - w * (py - rects[r, RECT_CY]))
                 my = h * (rects[r, VEL_Y] + w * (px - rects[r, RECT_CX]))
+                t = ((px - ax) * dx + (py - ay) * dy) / length2
+                cnx, cny = nx, ny
+                if 0.0 < t < 1.0:
+                    depth = (px - ax) * nx + (py - ay) * ny
+                else:
+                    # predicted past an end but beside the edge as the substep began: the
+                    # solve may well end it beside the edge again (a 2-step cycle left the
+                    # ``demo`` bunny's ear buzzing on a ramp's corner, listed every other
+                    # step), so the end holds it, along the line from the corner to the end
+                    t0 = ((px - mx - a0x) * d0x + (py - my - a0y) * d0y) / (len0 * len0)
+                    if not 0.0 < t0 < 1.0:
+                        continue
+                    t = 1.0 if t > 0.0 else 0.0
+                    qx, qy = ax + t * dx - px, ay + t * dy - py
+                    dist = np.sqrt(qx * qx + qy * qy)
+                    if dist == 0.0:
+                        continue
+                    depth = -dist
+                    cnx, cny = qx / dist, qy / dist
+                if not (depth > best and depth * depth < length2):
+                    continue
                 if (px - mx - a0x) * n0x + (py - my - a0y) * n0y > 0.01 * len0:
                     continue
                 best, best_s, best_k = depth, t, k
                 best_px, best_py, best_mx, best_my = px, py, mx, my
+                best_nx, best_ny = cnx, cny
             if best_k < 0:
                 continue
             if count >= pairs.shape[0]:
@@ -573,7 +595,7 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
                 continue
             pairs[count, 0], pairs[count, 1], pairs[count, 2], pairs[count, 3] = ia, ib, e, r
             out[count, CORNER_S] = best_s
-            out[count, CORNER_NX], out[count, CORNER_NY] = nx, ny
+            out[count, CORNER_NX], out[count, CORNER_NY] = best_nx, best_ny
             out[count, CORNER_PX], out[count, CORNER_PY] = best_px, best_py
             out[count, CORNER_MX], out[count, CORNER_MY] = best_mx, best_my
             out[count, CORNER_STATIC] = rects[r, RECT_STATIC_FRICTION]
