@@ -105,6 +105,48 @@ def test_interrupted_write_leaves_the_old_file_and_no_temporary(tmp_path, name):
     assert sorted(os.listdir(tmp_path)) == [name]
 
 
+def test_ctrl_c_as_ffmpeg_starts_leaves_no_file(tmp_path):
+    # imageio-ffmpeg starts its process, then enters the try that stops it: a Ctrl-C in between
+    # left the process running with its input open, and it wrote its file once the run had
+    # exited (which closed that input), after the run had removed it. Here, in a run of its
+    # own, a stand-in encoder writes its file 0.3 s after its input ends, and the Ctrl-C comes
+    # right after it starts.
+    import subprocess
+    import sys
+    import time
+
+    script = """
+import signal, subprocess, sys
+import imageio_ffmpeg
+import numpy as np
+from deforma.render.video import open_writer
+
+def encoder(path, size, **kwargs):
+    code = f"import sys, time; sys.stdin.buffer.read(); time.sleep(0.3); open({str(path)!r}, 'wb').write(b'late')"
+    p = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE)
+    signal.raise_signal(signal.SIGINT)
+    try:
+        while True:
+            p.stdin.write((yield))
+    finally:  # as imageio-ffmpeg's: ends the input, and kills it unless closed
+        p.stdin.close()
+        if p.poll() is None and sys.exc_info()[0] is not GeneratorExit:
+            p.kill()
+
+imageio_ffmpeg.write_frames = encoder
+try:
+    with open_writer(sys.argv[1], fps=10) as w:
+        w.write(np.zeros((48, 64, 3), np.uint8))
+except KeyboardInterrupt:
+    sys.exit(130)
+"""
+    run = subprocess.run([sys.executable, "-c", script, str(tmp_path / "a.mp4")], capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == 130, run.stderr
+    time.sleep(1.0)  # past the stand-in's 0.3 s after the run's exit
+    assert os.listdir(tmp_path) == []
+
+
 def test_output_kinds():
     assert output_kind("x.MP4") == "mp4"
     assert output_kind("x.gif") == "gif"

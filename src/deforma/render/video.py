@@ -15,11 +15,13 @@ that thread is raised, as one line, by the next :meth:`~FrameWriter.write` or by
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import logging
 import os
 import queue
 import shutil
+import signal
 import threading
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -339,6 +341,36 @@ def mp4_complete(path: str | os.PathLike[str]) -> bool:
     return at == end and {b"ftyp", b"moov", b"mdat"} <= kinds
 
 
+@contextlib.contextmanager
+def _signals_held():
+    """Hold Ctrl-C, SIGTERM and SIGHUP until the block ends, then act on them as they would
+    have acted (the handlers in place when it began run then). In the main thread only;
+    elsewhere the block runs as it is.
+
+    What for: starting ffmpeg. imageio-ffmpeg starts its process and only then enters the
+    ``try`` that stops it; an interrupt in between left it running in its own process group
+    with nothing to stop it, and as it finished when the run exited it wrote its file again
+    after the run had removed it (a Ctrl-C'd run said "no partial output was left" and left
+    its ``.partial.mp4``).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+    previous = {}
+    try:
+        for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+            n = getattr(signal, name, None)
+            if n is not None and signal.getsignal(n) is not None:  # (None: set outside Python)
+                previous[n] = signal.signal(n, lambda signum, frame: held.append(signum))
+        yield
+    finally:
+        for n, h in previous.items():
+            signal.signal(n, h)
+        for n in dict.fromkeys(held):
+            signal.raise_signal(n)
+
+
 class Mp4Writer(FrameWriter):
     """H.264 MP4 (yuv420p, plays everywhere) through the ffmpeg binary bundled with imageio-ffmpeg.
 
@@ -364,19 +396,20 @@ class Mp4Writer(FrameWriter):
 
         h, w = frame.shape[:2]
         self._padded = (w + w % 2, h + h % 2)
-        self._gen = imageio_ffmpeg.write_frames(
-            str(self._tmp), self._padded, fps=self.fps, codec="libx264", pix_fmt_in="rgb24",
-            pix_fmt_out="yuv420p", quality=self.quality, macro_block_size=1, ffmpeg_log_level="quiet",
-            # veryfast: half the encoding time of the default preset, and no bigger here
-            output_params=["-preset", "veryfast", "-movflags", "+faststart"],
-        )
-        try:
-            self._gen.send(None)
-        except OSError as e:
-            raise self._failed(e) from None
-        # ffmpeg's process, to be sure it is gone before its file is removed (_discard)
-        frame_locals = self._gen.gi_frame.f_locals if self._gen.gi_frame is not None else {}
-        self._proc = frame_locals.get("p")
+        with _signals_held():  # until ffmpeg's process is in hand (see _signals_held)
+            self._gen = imageio_ffmpeg.write_frames(
+                str(self._tmp), self._padded, fps=self.fps, codec="libx264", pix_fmt_in="rgb24",
+                pix_fmt_out="yuv420p", quality=self.quality, macro_block_size=1, ffmpeg_log_level="quiet",
+                # veryfast: half the encoding time of the default preset, and no bigger here
+                output_params=["-preset", "veryfast", "-movflags", "+faststart"],
+            )
+            try:
+                self._gen.send(None)
+            except OSError as e:
+                raise self._failed(e) from None
+            # ffmpeg's process, to be sure it is gone before its file is removed (_discard)
+            frame_locals = self._gen.gi_frame.f_locals if self._gen.gi_frame is not None else {}
+            self._proc = frame_locals.get("p")
 
     def _write(self, frame):
         h, w = frame.shape[:2]
