@@ -468,8 +468,9 @@ def corner_count(rects, r):
 
 
 #: Columns of :func:`corner_contacts`' float output: the edge point's parameter ``s``, the
-#: row's unit normal into the body (the edge's, or from the corner to the edge's end), the corner at the end of the substep, how far it moved
-#: in the substep, the static and dynamic friction coefficients and the gap to hold (m).
+#: row's unit normal into the body (the edge's, or from the corner to the edge's end), the
+#: corner at the end of the substep, how far it moved in the substep, the static and dynamic
+#: friction coefficients and the gap to hold (m).
 CORNER_S, CORNER_NX, CORNER_NY, CORNER_PX, CORNER_PY, CORNER_MX, CORNER_MY = 0, 1, 2, 3, 4, 5, 6
 CORNER_STATIC, CORNER_DYNAMIC, CORNER_TARGET = 7, 8, 9
 CORNER_COLUMNS = 10
