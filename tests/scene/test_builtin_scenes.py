@@ -86,12 +86,12 @@ def test_builtin_scene_frame_shows_each_body_where_it_is(gl_ctx, name):
     r.render([], world.colliders, collider_colors=view.collider_colors)
     empty = r.read().astype(int)
     changed = np.abs(img - empty).sum(axis=-1) > 24
+    dots = r.camera.world_to_pixel(np.array([j.point for j in world.joints]).reshape(-1, 2), r.size)
     for b in world.bodies:
         px = np.floor(r.camera.world_to_pixel(b.positions, r.size)).astype(int)
         onscreen = (px[:, 0] >= 2) & (px[:, 0] < 318) & (px[:, 1] >= 2) & (px[:, 1] < 178)
         if world.joints:  # a joint's dot is drawn over the body, its light centre near the sky's colour
-            dots = r.camera.world_to_pixel(np.array([j.point for j in world.joints]), r.size)
-            onscreen &= np.hypot(*(px[:, None, :] - dots[None]).transpose(2, 0, 1)).min(axis=1) > JOINT_DOT_PIXELS
+            onscreen &= np.linalg.norm(px[:, None, :] - dots[None], axis=2).min(axis=1) > JOINT_DOT_PIXELS
         if not onscreen.any():
             continue
         # around each vertex (3x3 pixels) the picture differs from the empty one: the body is there
@@ -101,7 +101,6 @@ def test_builtin_scene_frame_shows_each_body_where_it_is(gl_ctx, name):
     allpx = np.concatenate([r.camera.world_to_pixel(b.positions, r.size) for b in world.bodies])
     lo, hi = allpx.min(axis=0) - 4, allpx.max(axis=0) + 4
     if world.joints:
-        dots = r.camera.world_to_pixel(np.array([j.point for j in world.joints]), r.size)
         lo = np.minimum(lo, dots.min(axis=0) - JOINT_DOT_PIXELS - 2)
         hi = np.maximum(hi, dots.max(axis=0) + JOINT_DOT_PIXELS + 2)
     cols, rows = np.meshgrid(np.arange(320), np.arange(180))

@@ -563,6 +563,7 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
                 # where the edge was
                 mx = h * (rects[r, VEL_X] - w * (py - rects[r, RECT_CY]))
                 my = h * (rects[r, VEL_Y] + w * (px - rects[r, RECT_CX]))
+                sx, sy = px - mx - a0x, py - my - a0y  # from the edge's start, as the substep began
                 t = ((px - ax) * dx + (py - ay) * dy) / length2
                 cnx, cny = nx, ny
                 if 0.0 < t < 1.0:
@@ -572,7 +573,7 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
                     # solve may well end it beside the edge again (a 2-step cycle left the
                     # ``demo`` bunny's ear buzzing on a ramp's corner, listed every other
                     # step), so the end holds it, along the line from the corner to the end
-                    t0 = ((px - mx - a0x) * d0x + (py - my - a0y) * d0y) / (len0 * len0)
+                    t0 = (sx * d0x + sy * d0y) / (len0 * len0)
                     if not 0.0 < t0 < 1.0:
                         continue
                     t = 1.0 if t > 0.0 else 0.0
@@ -584,7 +585,7 @@ def corner_contacts(x0, y, rects, edge_a, edge_b, vertex, margin, h, pairs, out)
                     cnx, cny = qx / dist, qy / dist
                 if not (depth > best and depth * depth < length2):
                     continue
-                if (px - mx - a0x) * n0x + (py - my - a0y) * n0y > 0.01 * len0:
+                if sx * n0x + sy * n0y > 0.01 * len0:
                     continue
                 best, best_s, best_k = depth, t, k
                 best_px, best_py, best_mx, best_my = px, py, mx, my

@@ -102,6 +102,7 @@ def _add_jacobian_terms(g, hm, j00, j01, j02, j10, j11, j12, p0, p1, p2, p3, hf,
                     val = a * (j0[p] * m0 + j1[p] * m1)
                     hm[_X_UNKNOWNS[p] if bu == 0 else _Y_UNKNOWNS[p], cq] += val
 
+
 @njit(cache=True, inline="always")
 def add_moments(mom, gx, gy, hxx, hxy, hyy, a0, a1, a2):
     """Add a term whose x and y move by ``a . (d0, A00, A01)`` and ``a . (d1, A10, A11)``, with
