@@ -324,6 +324,27 @@ def test_an_impact_is_split_so_the_box_below_is_not_crushed():
         assert worst_unsplit > 10  # crushed: 42 triangles turned over (0.31 m high)
 
 
+@pytest.mark.xfail(strict=True, reason="the reach measured at the inertial target counts gravity's g h^2 as "
+                   "reach into a resting contact (issue 48)")
+def test_a_body_resting_on_the_floor_is_not_split_by_its_weight():
+    # crates' jelly donut (2.4 mm edges) resting on the floor. Its prediction lies g h^2
+    # (2.7 mm) below the floor in every step; counted as reach into the contact, every step
+    # is split in two (60 splits a second, 2.9x the time) for as long as it rests. Measured
+    # at x_n + h v instead it is not split, but demo and cards then take other paths on
+    # which their tests fail (docs/changelog.md, 2026-12-08)
+    w = deforma.World(sleep=False)  # (sleep off: the solver's own steps are counted)
+    w.add_collider(deforma.Rect((0.0, -0.25), (4.0, 0.5), 0.0))
+    m = deforma.mesh.from_image("donut", resolution=12, scale=0.0012)
+    b = w.add_body(m, position=(0.0, np.ptp(m.vertices[:, 1]) / 2 + 0.001), material=deforma.Material.preset("jelly"))
+    for _ in range(120):  # landed
+        w.step()
+    landed = w.integrator_stats["split"]
+    for _ in range(60):
+        w.step()
+    assert w.integrator_stats["split"] == landed
+    assert np.abs(b.velocities).max() < 0.05 and inverted_triangles(w) == 0
+
+
 def test_the_jelly_stack_settles():
     """The built-in ``jelly`` (three spring boxes of 700-6000 N/m, damping 2.5) at one avbd
     step a frame: its sway decays to below 1 mm/s within 12 s (converged backward Euler

@@ -280,6 +280,27 @@ def test_cards_stand_by_friction_until_the_wheel_comes(sleep):
     assert heights[10] > 0.3  # the two below stand
 
 
+@pytest.mark.xfail(strict=True, reason="avbd's row search takes a vertex behind an edge's line by up to the "
+                   "widened thickness as in front of it, even past a thin body's far side (issue 48)")
+def test_the_house_of_cards_stands_in_whole_steps_while_the_wheel_rolls():
+    # reach = 0: no step is split. The wheel rolling at 1 m/s widens the rows' search to 1.7
+    # cm, more than a card is thick; a card's foot resting on the flat card below then lies
+    # within that of the flat card's underside (1.05 cm behind it) and is pulled down through
+    # it: the house blows up in its first step (10.9 m/s, then 1.7e3 m/s by step 60). The
+    # shipped scene hides it: every step is split in two or three parts there, since the
+    # wheel's 1.2 mm edges lie g h^2 past the floor in the prediction (test_avbd.py,
+    # test_a_body_resting_on_the_floor_is_not_split_by_its_weight).
+    world = scenes.load_scene("cards")
+    world.sleep = False  # (sleep off: the house's own stand is measured)
+    world.integrator_options = {"reach": 0.0}
+    cards = world.bodies[:15]
+    start = [b.center_of_mass.copy() for b in cards]
+    for _ in range(60):
+        world.step()
+    assert world.integrator_stats["split"] == 0
+    assert max(np.abs(b.center_of_mass - c).max() for b, c in zip(cards, start)) < 0.01
+
+
 def box_corners(b):
     """A rigid box's four corners now, anticlockwise: the vertices at the extremes of its mesh."""
     x, y = b.topology.rest_positions.T
